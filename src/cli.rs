@@ -1,0 +1,299 @@
+//! Command-line interface (clap): argument definitions and the commands.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+use tracelab::image::{Image, check_writable};
+use tracelab::integrator::{Integrator, MisHeuristic, PathTracer};
+use tracelab::render::{RenderSettings, RenderStats, Session};
+use tracelab::sampling::SamplerKind;
+use tracelab::scene::{Limits, Scene};
+use tracelab::{Error, Result};
+
+/// tracelab: Monte Carlo light transport, measured.
+#[derive(Parser, Debug)]
+#[command(name = "tracelab", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render a scene to an EXR (linear float) or PNG (tone-mapped sRGB) file.
+    Render(RenderArgs),
+    /// Compare two images: RMSE, relative MSE and mean relative error (as tev computes them).
+    Compare {
+        /// The image to measure.
+        image: PathBuf,
+        /// The reference.
+        reference: PathBuf,
+    },
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum IntegratorArg {
+    /// Path tracing with next-event estimation, MIS and Russian roulette.
+    Path,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum SamplerArg {
+    Independent,
+    Stratified,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum MisArg {
+    None,
+    Balance,
+    Power,
+}
+
+#[derive(Args, Debug)]
+struct RenderArgs {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    #[arg(long, value_enum, default_value = "path")]
+    integrator: IntegratorArg,
+    /// Samples per pixel.
+    #[arg(long, conflicts_with = "time")]
+    spp: Option<u32>,
+    /// Render for this many seconds instead of a sample count.
+    #[arg(long)]
+    time: Option<f64>,
+    #[arg(long, value_enum, default_value = "independent")]
+    sampler: SamplerArg,
+    /// Maximum bounces (1 = direct lighting); Mitsuba's max_depth is one more.
+    #[arg(long, default_value_t = 8)]
+    max_depth: u32,
+    /// Russian roulette starts after this many bounces.
+    #[arg(long, default_value_t = 5)]
+    rr_depth: u32,
+    /// Turn Russian roulette off.
+    #[arg(long)]
+    no_rr: bool,
+    /// Turn next-event estimation (light sampling) off: BSDF sampling only.
+    #[arg(long)]
+    no_nee: bool,
+    /// How light and BSDF samples are combined.
+    #[arg(long, value_enum, default_value = "power")]
+    mis: MisArg,
+    /// Image width (overrides the scene).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height (overrides the scene).
+    #[arg(long)]
+    height: Option<u32>,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Worker threads (default: one per core).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Exposure in stops for PNG output.
+    #[arg(long, default_value_t = 0.0)]
+    exposure: f32,
+    /// Largest accepted image side.
+    #[arg(long, default_value_t = Limits::default().max_resolution)]
+    max_resolution: u32,
+    /// Largest accepted triangle count.
+    #[arg(long, default_value_t = Limits::default().max_triangles)]
+    max_triangles: usize,
+    /// Output file: .exr (linear float32) or .png (tone-mapped sRGB).
+    #[arg(long, short)]
+    out: PathBuf,
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Some(Command::Render(args)) => render(&args),
+        Some(Command::Compare { image, reference }) => compare(&image, &reference),
+        None => {
+            eprintln!("tracelab: no command given; rendering the default Cornell box (see `tracelab --help`).");
+            let scene = default_scene_path();
+            let scene = scene.to_string_lossy().into_owned();
+            let argv = ["tracelab", "render", scene.as_str(), "--spp", "256", "--out", "cornell_box.png"];
+            let cli = Cli::try_parse_from(argv).map_err(|e| Error::new(e.to_string()))?;
+            run(cli)
+        }
+    }
+}
+
+fn default_scene_path() -> PathBuf {
+    let local = PathBuf::from("scenes/cornell_box.toml");
+    if local.is_file() { local } else { Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml") }
+}
+
+enum OutputFormat {
+    Exr,
+    Png,
+}
+
+fn output_format(path: &Path) -> Result<OutputFormat> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("exr") => Ok(OutputFormat::Exr),
+        Some("png") => Ok(OutputFormat::Png),
+        _ => Err(Error::at(path, None, "output must end in .exr (linear float) or .png (tone-mapped sRGB)")),
+    }
+}
+
+fn render(args: &RenderArgs) -> Result<()> {
+    let format = output_format(&args.out)?;
+    check_writable(&args.out)?;
+    if let Some(t) = args.time {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(Error::new(format!("--time must be a positive number of seconds, got {t}")));
+        }
+    }
+    if args.spp == Some(0) {
+        return Err(Error::new("--spp must be at least 1"));
+    }
+    let limits = Limits { max_resolution: args.max_resolution, max_triangles: args.max_triangles };
+    let load_start = Instant::now();
+    let mut scene = Scene::load_with_limits(&args.scene, &limits)?;
+    if args.width.is_some() || args.height.is_some() {
+        let (w, h) = (args.width.unwrap_or(scene.camera.width), args.height.unwrap_or(scene.camera.height));
+        limits.check_resolution(w, h).map_err(|e| Error::new(format!("--width/--height: {e}")))?;
+        scene.set_resolution(w, h);
+    }
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {w}", args.scene.display());
+    }
+    let load_time = load_start.elapsed();
+
+    let integrator = match args.integrator {
+        IntegratorArg::Path => Integrator::Path(PathTracer {
+            max_depth: args.max_depth,
+            rr_depth: args.rr_depth,
+            russian_roulette: !args.no_rr,
+            nee: !args.no_nee,
+            mis: match args.mis {
+                MisArg::None => MisHeuristic::None,
+                MisArg::Balance => MisHeuristic::Balance,
+                MisArg::Power => MisHeuristic::Power,
+            },
+        }),
+    };
+    let sampler = match args.sampler {
+        SamplerArg::Independent => SamplerKind::Independent,
+        SamplerArg::Stratified => SamplerKind::Stratified,
+    };
+    let target_spp = if args.time.is_some() { None } else { Some(args.spp.unwrap_or(64)) };
+    let settings = RenderSettings {
+        integrator,
+        sampler,
+        seed: args.seed,
+        planned_spp: target_spp.unwrap_or(0),
+        threads: args.threads,
+    };
+    let session = Session::new(Arc::new(scene), settings)?;
+    let stats = match target_spp {
+        Some(spp) => render_spp(&session, spp),
+        None => render_time(&session, Duration::from_secs_f64(args.time.unwrap_or(1.0))),
+    };
+    let snapshot = session.snapshot();
+    match format {
+        OutputFormat::Exr => snapshot.image.write_exr(&args.out)?,
+        OutputFormat::Png => snapshot.image.write_png(&args.out, args.exposure)?,
+    }
+    print_summary(&session, &stats, load_time);
+    eprintln!("wrote {}", args.out.display());
+    Ok(())
+}
+
+fn progress_bar(len: u64, unit: &str) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len);
+    let template = format!("{{elapsed_precise}} [{{bar:40}}] {{pos}}/{{len}} {unit} ({{eta}} left)");
+    bar.set_style(ProgressStyle::with_template(&template).unwrap_or_else(|_| ProgressStyle::default_bar()));
+    bar
+}
+
+/// Renders exactly `spp` samples per pixel in passes small enough for a live progress bar.
+fn render_spp(session: &Session, spp: u32) -> RenderStats {
+    let bar = progress_bar(spp as u64, "spp");
+    let mut done = 0;
+    let mut pass = 1;
+    while done < spp {
+        let k = pass.min(spp - done);
+        let start = Instant::now();
+        session.render_pass(k);
+        done += k;
+        bar.set_position(done as u64);
+        // Aim for passes of about a quarter second.
+        if start.elapsed() < Duration::from_millis(250) {
+            pass = (pass * 2).min(64);
+        }
+    }
+    bar.finish_and_clear();
+    session.stats()
+}
+
+/// Renders passes until `budget` is spent, sizing passes so as not to overshoot.
+fn render_time(session: &Session, budget: Duration) -> RenderStats {
+    let bar = progress_bar(budget.as_millis() as u64, "ms");
+    let start = Instant::now();
+    let mut per_spp = Duration::ZERO;
+    loop {
+        let elapsed = start.elapsed();
+        if elapsed >= budget {
+            break;
+        }
+        let remaining = budget - elapsed;
+        let k = if per_spp.is_zero() {
+            1
+        } else {
+            ((remaining.as_secs_f64() / per_spp.as_secs_f64()) as u32).clamp(1, 64)
+        };
+        let pass_start = Instant::now();
+        session.render_pass(k);
+        per_spp = pass_start.elapsed() / k;
+        bar.set_position(start.elapsed().as_millis().min(budget.as_millis()) as u64);
+    }
+    bar.finish_and_clear();
+    session.stats()
+}
+
+fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
+    let seconds = stats.render_time.as_secs_f64();
+    let rays = stats.rays.total();
+    let settings = session.settings();
+    eprintln!(
+        "{} | {} sampler | {} threads | scene loaded in {:.2} s",
+        settings.integrator.describe(),
+        settings.sampler.name(),
+        session.threads(),
+        load_time.as_secs_f64()
+    );
+    println!(
+        "spp {} | {:.3} s | {:.2} M rays (camera {:.2} M, shadow {:.2} M, bounce {:.2} M) | {:.2} Mrays/s | {:.3} M paths/s | non-finite {}",
+        stats.spp,
+        seconds,
+        rays as f64 * 1e-6,
+        stats.rays.camera as f64 * 1e-6,
+        stats.rays.shadow as f64 * 1e-6,
+        stats.rays.bounce as f64 * 1e-6,
+        rays as f64 / seconds * 1e-6,
+        stats.samples as f64 / seconds * 1e-6,
+        stats.non_finite
+    );
+}
+
+fn compare(image: &Path, reference: &Path) -> Result<()> {
+    let a = Image::read(image)?;
+    let b = Image::read(reference)?;
+    let m = a.compare(&b).map_err(|e| Error::new(format!("{} vs {}: {e}", image.display(), reference.display())))?;
+    let (ma, mb) = (a.mean(), b.mean());
+    println!("RMSE {:.6} | relative MSE {:.6} | mean relative error {:.6}", m.rmse, m.relative_mse, m.mean_relative_error);
+    println!(
+        "mean RGB {:.6} {:.6} {:.6} vs {:.6} {:.6} {:.6} (ratio {:.4} {:.4} {:.4})",
+        ma[0], ma[1], ma[2], mb[0], mb[1], mb[2], ma[0] / mb[0], ma[1] / mb[1], ma[2] / mb[2]
+    );
+    Ok(())
+}

@@ -1,0 +1,186 @@
+//! The progressive film: per-pixel running sums of samples and of their
+//! squares, and sample counts, in tiles that passes fill one at a time.
+//!
+//! Each tile has its own lock, held only while a pass adds that tile's
+//! samples, so a snapshot can be taken at any time while passes run and waits
+//! at most for one tile. The reconstruction filter is a box of one pixel:
+//! a pixel is the plain mean of the samples taken inside it (Mitsuba's `box`).
+
+use crate::image::Image;
+use crate::math::Rgb;
+use std::sync::Mutex;
+
+/// Side of a square tile in pixels.
+pub const TILE_SIZE: u32 = 16;
+
+/// Running sums of one pixel. f64 keeps long renders (10^5 spp) exact enough
+/// for the variance estimate.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PixelSums {
+    pub sum: [f64; 3],
+    pub sum_sq: [f64; 3],
+    pub count: u32,
+    /// Samples that were NaN or infinite and were left out.
+    pub non_finite: u32,
+}
+
+impl PixelSums {
+    /// Adds one sample, or counts it as non-finite and leaves it out.
+    #[inline]
+    pub fn add(&mut self, value: Rgb) {
+        if !value.is_finite() {
+            self.non_finite += 1;
+            return;
+        }
+        for c in 0..3 {
+            let v = value[c] as f64;
+            self.sum[c] += v;
+            self.sum_sq[c] += v * v;
+        }
+        self.count += 1;
+    }
+
+    /// Mean of the samples (zero without samples).
+    pub fn mean(&self) -> [f32; 3] {
+        if self.count == 0 {
+            return [0.0; 3];
+        }
+        let n = self.count as f64;
+        [(self.sum[0] / n) as f32, (self.sum[1] / n) as f32, (self.sum[2] / n) as f32]
+    }
+
+    /// Standard error of the mean from the unbiased sample variance
+    /// s^2 = (sum_sq - sum^2 / n) / (n - 1); infinite with fewer than two samples.
+    pub fn standard_error(&self) -> [f32; 3] {
+        if self.count < 2 {
+            return [f32::INFINITY; 3];
+        }
+        let n = self.count as f64;
+        let mut se = [0.0f32; 3];
+        for c in 0..3 {
+            let variance = ((self.sum_sq[c] - self.sum[c] * self.sum[c] / n) / (n - 1.0)).max(0.0);
+            se[c] = (variance / n).sqrt() as f32;
+        }
+        se
+    }
+}
+
+/// A rectangle of the film with its sums, in row-major order.
+#[derive(Debug)]
+pub struct Tile {
+    pub x0: u32,
+    pub y0: u32,
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<PixelSums>,
+}
+
+/// The whole film.
+#[derive(Debug)]
+pub struct Film {
+    width: u32,
+    height: u32,
+    tiles: Vec<Mutex<Tile>>,
+}
+
+/// A consistent-enough copy of the film for display and export.
+#[derive(Clone, Debug)]
+pub struct FilmSnapshot {
+    /// Per-pixel mean radiance.
+    pub image: Image,
+    /// Per-pixel standard error of the mean.
+    pub standard_error: Image,
+    /// Per-pixel sample counts.
+    pub samples: Vec<u32>,
+    /// Total non-finite samples left out.
+    pub non_finite: u64,
+}
+
+impl Film {
+    /// An empty film of `width` x `height` pixels.
+    pub fn new(width: u32, height: u32) -> Self {
+        let mut tiles = Vec::new();
+        for y0 in (0..height).step_by(TILE_SIZE as usize) {
+            for x0 in (0..width).step_by(TILE_SIZE as usize) {
+                let (w, h) = (TILE_SIZE.min(width - x0), TILE_SIZE.min(height - y0));
+                tiles.push(Mutex::new(Tile {
+                    x0,
+                    y0,
+                    width: w,
+                    height: h,
+                    pixels: vec![PixelSums::default(); (w * h) as usize],
+                }));
+            }
+        }
+        Film { width, height, tiles }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// The tiles, for passes to fill in parallel.
+    pub fn tiles(&self) -> &[Mutex<Tile>] {
+        &self.tiles
+    }
+
+    /// Copies the current means, standard errors and counts.
+    pub fn snapshot(&self) -> FilmSnapshot {
+        let n = (self.width * self.height) as usize;
+        let mut image = Image::new(self.width, self.height);
+        let mut standard_error = Image::new(self.width, self.height);
+        let mut samples = vec![0u32; n];
+        let mut non_finite = 0u64;
+        for tile in &self.tiles {
+            // A poisoned lock only means a pass panicked; the sums are still valid.
+            let tile = tile.lock().unwrap_or_else(|e| e.into_inner());
+            for ty in 0..tile.height {
+                for tx in 0..tile.width {
+                    let p = &tile.pixels[(ty * tile.width + tx) as usize];
+                    let i = ((tile.y0 + ty) * self.width + tile.x0 + tx) as usize;
+                    image.pixels[i] = p.mean();
+                    standard_error.pixels[i] = p.standard_error();
+                    samples[i] = p.count;
+                    non_finite += p.non_finite as u64;
+                }
+            }
+        }
+        FilmSnapshot { image, standard_error, samples, non_finite }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mean_and_standard_error_match_the_textbook() {
+        let mut p = PixelSums::default();
+        for v in [1.0, 2.0, 3.0, 4.0] {
+            p.add(Rgb::splat(v));
+        }
+        p.add(Rgb::new(f32::NAN, 0.0, 0.0));
+        p.add(Rgb::splat(f32::INFINITY));
+        assert_eq!(p.count, 4);
+        assert_eq!(p.non_finite, 2);
+        assert_eq!(p.mean(), [2.5; 3]);
+        // s^2 = 5/3, se = sqrt(5/3 / 4).
+        let se = (5.0f64 / 3.0 / 4.0).sqrt() as f32;
+        assert!((p.standard_error()[0] - se).abs() < 1e-6);
+    }
+
+    #[test]
+    fn tiles_cover_odd_sizes_exactly() {
+        let film = Film::new(37, 20);
+        let area: u32 = film.tiles().iter().map(|t| {
+            let t = t.lock().unwrap();
+            t.width * t.height
+        }).sum();
+        assert_eq!(area, 37 * 20);
+        assert_eq!(film.snapshot().samples.len(), 37 * 20);
+    }
+}

@@ -1,0 +1,167 @@
+//! Linear RGB images: reading and writing EXR (float32) and PNG (tone-mapped
+//! sRGB), always written atomically (temporary file, then rename), and the
+//! error metrics used to compare renders.
+
+use crate::error::{Error, Result};
+use image::{ImageFormat, Rgb32FImage, RgbImage};
+use std::path::{Path, PathBuf};
+
+/// A linear RGB float image, row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 3]>,
+}
+
+/// Error metrics between an image and a reference, averaged over all pixels
+/// and channels, as tev defines them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorMetrics {
+    /// sqrt(mean((a - b)^2)).
+    pub rmse: f64,
+    /// mean((a - b)^2 / (b^2 + 0.01)).
+    pub relative_mse: f64,
+    /// mean(|a - b| / (|b| + 0.01)).
+    pub mean_relative_error: f64,
+}
+
+impl Image {
+    /// A black image.
+    pub fn new(width: u32, height: u32) -> Self {
+        Image { width, height, pixels: vec![[0.0; 3]; (width * height) as usize] }
+    }
+
+    /// Mean of each channel.
+    pub fn mean(&self) -> [f64; 3] {
+        let mut m = [0.0f64; 3];
+        for p in &self.pixels {
+            for c in 0..3 {
+                m[c] += p[c] as f64;
+            }
+        }
+        m.map(|x| x / self.pixels.len().max(1) as f64)
+    }
+
+    /// Reads an EXR (or any format the image crate knows) as linear float RGB.
+    pub fn read(path: &Path) -> Result<Image> {
+        let img = image::open(path).map_err(|e| Error::at(path, None, format!("cannot read image: {e}")))?;
+        let rgb = img.into_rgb32f();
+        let (width, height) = rgb.dimensions();
+        let pixels = rgb.pixels().map(|p| p.0).collect();
+        Ok(Image { width, height, pixels })
+    }
+
+    /// Writes linear float32 RGB EXR.
+    pub fn write_exr(&self, path: &Path) -> Result<()> {
+        let data: Vec<f32> = self.pixels.iter().flatten().copied().collect();
+        let buffer = Rgb32FImage::from_raw(self.width, self.height, data)
+            .ok_or_else(|| Error::new("internal: image buffer size mismatch"))?;
+        write_atomically(path, |tmp| buffer.save_with_format(tmp, ImageFormat::OpenExr).map_err(|e| e.to_string()))
+    }
+
+    /// Writes an 8-bit sRGB PNG: radiance times 2^exposure, clamped, sRGB-encoded.
+    pub fn write_png(&self, path: &Path, exposure: f32) -> Result<()> {
+        let buffer = self.to_srgb8(exposure);
+        write_atomically(path, |tmp| buffer.save_with_format(tmp, ImageFormat::Png).map_err(|e| e.to_string()))
+    }
+
+    /// Tone-mapped 8-bit sRGB copy.
+    pub fn to_srgb8(&self, exposure: f32) -> RgbImage {
+        let scale = exposure.exp2();
+        let data: Vec<u8> =
+            self.pixels.iter().flatten().map(|&v| (linear_to_srgb(v * scale) * 255.0 + 0.5) as u8).collect();
+        RgbImage::from_raw(self.width, self.height, data).expect("buffer matches its dimensions")
+    }
+
+    /// Error of `self` against `reference`.
+    pub fn compare(&self, reference: &Image) -> Result<ErrorMetrics> {
+        if (self.width, self.height) != (reference.width, reference.height) {
+            return Err(Error::new(format!(
+                "images differ in size: {}x{} vs {}x{}",
+                self.width, self.height, reference.width, reference.height
+            )));
+        }
+        let (mut se, mut rel_se, mut rel_ae) = (0.0f64, 0.0f64, 0.0f64);
+        for (a, b) in self.pixels.iter().zip(&reference.pixels) {
+            for c in 0..3 {
+                let (a, b) = (a[c] as f64, b[c] as f64);
+                let d = a - b;
+                se += d * d;
+                rel_se += d * d / (b * b + 0.01);
+                rel_ae += d.abs() / (b.abs() + 0.01);
+            }
+        }
+        let n = (self.pixels.len() * 3).max(1) as f64;
+        Ok(ErrorMetrics { rmse: (se / n).sqrt(), relative_mse: rel_se / n, mean_relative_error: rel_ae / n })
+    }
+}
+
+/// sRGB transfer function with clamping to [0, 1]; NaN maps to 0.
+pub fn linear_to_srgb(v: f32) -> f32 {
+    let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+    if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// Temporary path next to `path`, so that the final rename stays on one file system.
+fn temporary_path(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+}
+
+/// Checks early that `path` can be written, so a long render does not end in
+/// a failed save. Leaves nothing behind.
+pub fn check_writable(path: &Path) -> Result<()> {
+    let tmp = temporary_path(path);
+    std::fs::write(&tmp, b"")
+        .map_err(|e| Error::at(path, None, format!("cannot write output: {e}")))?;
+    let _ = std::fs::remove_file(&tmp);
+    Ok(())
+}
+
+/// Writes through a temporary file and renames it over `path`, so that an
+/// interrupted write never leaves a half file in place of a good one.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&Path) -> std::result::Result<(), String>,
+) -> Result<()> {
+    let tmp = temporary_path(path);
+    if let Err(e) = write(&tmp) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::at(path, None, format!("cannot write output: {e}")));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        Error::at(path, None, format!("cannot write output: {e}"))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn metrics_of_a_known_difference() {
+        let mut a = Image::new(2, 1);
+        let b = Image { width: 2, height: 1, pixels: vec![[1.0; 3], [0.0; 3]] };
+        a.pixels = vec![[1.1; 3], [0.1; 3]];
+        let m = a.compare(&b).unwrap();
+        assert!((m.rmse - 0.1).abs() < 1e-6);
+        let expected_rel_mse = (0.01 / 1.01 + 0.01 / 0.01) / 2.0;
+        assert!((m.relative_mse - expected_rel_mse).abs() < 1e-5);
+        assert!(a.compare(&Image::new(1, 1)).is_err());
+    }
+
+    #[test]
+    fn exr_round_trips_exactly_and_atomically() {
+        let dir = std::env::temp_dir().join(format!("tracelab-img-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("a.exr");
+        let img = Image { width: 3, height: 2, pixels: (0..6).map(|i| [i as f32 * 0.37, 1e-4, 123.5]).collect() };
+        img.write_exr(&path).unwrap();
+        assert_eq!(Image::read(&path).unwrap(), img);
+        // No temporary file is left next to it.
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,158 @@
+//! Path tracing (Kajiya 1986): one secondary ray per bounce, with next-event
+//! estimation (a shadow ray to a sampled light point at every non-specular
+//! vertex), BSDF sampling for the next direction, the two combined by multiple
+//! importance sampling, and Russian roulette to end long paths without bias.
+//!
+//! The estimator of L along a camera ray, for vertices x_0 (first hit) .. x_k:
+//!   L = Le(x_0) + sum_k beta_k [ w_light * f Le cos / p_light  (shadow ray)
+//!                               + w_bsdf * Le(x_{k+1})          (BSDF ray hits a light) ]
+//! where beta_k is the product of f cos / p_bsdf (and 1/q of roulette) so far.
+
+use super::{MisHeuristic, RayCounts};
+use crate::accel::NO_LIGHT;
+use crate::math::{Frame, Ray, Rgb, offset_ray_origin};
+use crate::sampling::Sampler;
+use crate::scene::Scene;
+
+/// Settings of the path tracer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathTracer {
+    /// Maximum number of bounces: 0 = only emitters seen directly, 1 = direct
+    /// lighting. Mitsuba's `max_depth` counts path segments, one more.
+    pub max_depth: u32,
+    /// Roulette starts after this many bounces (Mitsuba's `rr_depth`, default 5).
+    pub rr_depth: u32,
+    /// Russian roulette on or off (off: every path runs to `max_depth`).
+    pub russian_roulette: bool,
+    /// Next-event estimation: sample a light at every non-specular vertex.
+    pub nee: bool,
+    /// How NEE and BSDF sampling share direct light when NEE is on.
+    pub mis: MisHeuristic,
+}
+
+impl Default for PathTracer {
+    fn default() -> Self {
+        PathTracer { max_depth: 8, rr_depth: 5, russian_roulette: true, nee: true, mis: MisHeuristic::Power }
+    }
+}
+
+impl PathTracer {
+    /// Short description for summaries.
+    pub fn describe(&self) -> String {
+        format!(
+            "path (max depth {}, nee {}, mis {:?}, rr {})",
+            self.max_depth,
+            if self.nee { "on" } else { "off" },
+            self.mis,
+            if self.russian_roulette { format!("from {}", self.rr_depth) } else { "off".into() }
+        )
+    }
+
+    /// One radiance sample along `ray`.
+    pub fn radiance(&self, scene: &Scene, mut ray: Ray, sampler: &mut Sampler, counts: &mut RayCounts) -> Rgb {
+        let mut radiance = Rgb::ZERO;
+        let mut beta = Rgb::ONE;
+        // The camera ray behaves like a specular bounce: emission it finds is
+        // counted in full because no light sample could have found it.
+        let mut specular_bounce = true;
+        let mut prev_bsdf_pdf = 0.0;
+        let mut prev_point = ray.origin;
+        let mut bounces = 0;
+        loop {
+            let Some(hit) = scene.geometry.intersect(&ray) else { break };
+            let wo_world = -ray.direction;
+            let material = &scene.materials[hit.material as usize];
+
+            if hit.light != NO_LIGHT {
+                let emitted = material.emitted(hit.normal, wo_world);
+                if emitted.max_element() > 0.0 {
+                    let weight = if specular_bounce || !self.nee {
+                        1.0
+                    } else if self.mis == MisHeuristic::None {
+                        // Light sampling alone accounts for this path.
+                        0.0
+                    } else {
+                        let light_pdf = scene.lights.pdf(hit.light, prev_point, hit.point, hit.normal);
+                        self.mis.weight(prev_bsdf_pdf, light_pdf)
+                    };
+                    radiance += beta * emitted * weight;
+                }
+            }
+            if bounces >= self.max_depth || material.bsdf.is_black() {
+                break;
+            }
+
+            let bsdf = material.bsdf;
+            let frame = Frame::from_normal(hit.normal);
+            let wo = frame.to_local(wo_world);
+            // Every vertex consumes the same dimensions, so that stratified
+            // samplers keep dimensions aligned across samples.
+            let u_light_select = sampler.next_1d();
+            let u_light = sampler.next_2d();
+            let u_lobe = sampler.next_1d();
+            let u_bsdf = sampler.next_2d();
+            let u_roulette = sampler.next_1d();
+
+            if self.nee && !bsdf.is_specular() {
+                if let Some(ls) = scene.lights.sample(hit.point, u_light_select, u_light) {
+                    let wi = frame.to_local(ls.wi);
+                    let f = bsdf.eval(wo, wi);
+                    if f.max_element() > 0.0 {
+                        let weight = if ls.delta || self.mis == MisHeuristic::None {
+                            1.0
+                        } else {
+                            self.mis.weight(ls.pdf, bsdf.pdf(wo, wi))
+                        };
+                        counts.shadow += 1;
+                        if !scene.geometry.occluded(&shadow_ray(hit.point, hit.normal, &ls)) {
+                            radiance += beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf);
+                        }
+                    }
+                }
+            }
+
+            let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else { break };
+            beta *= sample.weight;
+            specular_bounce = sample.specular;
+            prev_bsdf_pdf = sample.pdf;
+            prev_point = hit.point;
+            bounces += 1;
+
+            if self.russian_roulette && bounces > self.rr_depth {
+                // Survive with probability q, reweight by 1/q: unbiased, and paths
+                // carrying little energy end early (Mitsuba's q = min(max(beta), 0.95)).
+                let q = beta.max_element().min(0.95);
+                if u_roulette >= q {
+                    break;
+                }
+                beta /= q;
+            }
+            if beta.max_element() <= 0.0 {
+                break;
+            }
+
+            let wi_world = frame.to_world(sample.wi);
+            let side = if wi_world.dot(hit.normal) > 0.0 { hit.normal } else { -hit.normal };
+            ray = Ray::new(offset_ray_origin(hit.point, side), wi_world);
+            counts.bounce += 1;
+        }
+        radiance
+    }
+}
+
+/// Shadow ray from a surface point to a sampled light point, both ends moved
+/// off their surfaces so that neither surface can occlude the ray.
+#[inline]
+pub fn shadow_ray(point: glam::Vec3A, normal: glam::Vec3A, ls: &crate::scene::light::LightSample) -> Ray {
+    let side = if ls.wi.dot(normal) > 0.0 { normal } else { -normal };
+    let origin = offset_ray_origin(point, side);
+    let target = if ls.delta {
+        ls.point
+    } else {
+        let light_side = if ls.normal.dot(ls.wi) < 0.0 { ls.normal } else { -ls.normal };
+        offset_ray_origin(ls.point, light_side)
+    };
+    let to_target = target - origin;
+    let distance = to_target.length();
+    Ray { origin, direction: to_target / distance, t_max: distance }
+}

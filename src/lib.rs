@@ -1,0 +1,17 @@
+//! tracelab: a lab for the rendering equation and Monte Carlo light transport.
+//!
+//! The core (scene, geometry, BVH, sampling, materials, integrators, film)
+//! is plain data and free functions; front ends (the CLI, the tests, and the
+//! viewer) drive it through [`render::Session`]. Nothing here imports a GUI.
+
+pub mod accel;
+pub mod error;
+pub mod film;
+pub mod image;
+pub mod integrator;
+pub mod math;
+pub mod render;
+pub mod sampling;
+pub mod scene;
+
+pub use error::{Error, Result};

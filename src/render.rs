@@ -1,0 +1,174 @@
+//! A render session: the one API every front end drives (CLI, tests, and the
+//! viewer later). A session owns a film and a thread pool; each call to
+//! [`Session::render_pass`] adds k samples to every pixel, in parallel over
+//! tiles. Between passes, callers take snapshots, read statistics or cancel.
+//!
+//! Sample `s` of pixel `p` is a pure function of (seed, p, s), and each pixel's
+//! samples are summed in sample order, so the film is bit-identical whatever
+//! the thread count or tile schedule.
+
+use crate::error::{Error, Result};
+use crate::film::{Film, FilmSnapshot};
+use crate::integrator::{Integrator, RayCounts};
+use crate::sampling::{Sampler, SamplerKind};
+use crate::scene::Scene;
+use glam::Vec2;
+use rayon::prelude::*;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+/// How to render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub integrator: Integrator,
+    pub sampler: SamplerKind,
+    pub seed: u64,
+    /// Samples per pixel the render plans to take (0 = unknown); stratified
+    /// samplers stratify over batches of this size.
+    pub planned_spp: u32,
+    /// Worker threads (0 = one per core).
+    pub threads: usize,
+}
+
+/// Counters of a session so far.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderStats {
+    /// Samples per pixel completed (every pixel has this many).
+    pub spp: u32,
+    /// Camera samples taken (= camera paths).
+    pub samples: u64,
+    pub rays: RayCounts,
+    /// Samples that were NaN or infinite and were left out of the film.
+    pub non_finite: u64,
+    /// Wall time spent inside passes.
+    pub render_time: Duration,
+}
+
+/// A progressive render of one scene with fixed settings.
+pub struct Session {
+    scene: Arc<Scene>,
+    settings: RenderSettings,
+    film: Film,
+    pool: rayon::ThreadPool,
+    spp: AtomicU32,
+    samples: AtomicU64,
+    camera_rays: AtomicU64,
+    shadow_rays: AtomicU64,
+    bounce_rays: AtomicU64,
+    non_finite: AtomicU64,
+    render_nanos: AtomicU64,
+    cancelled: AtomicBool,
+}
+
+impl Session {
+    /// Starts a session; nothing renders until [`Session::render_pass`].
+    pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Result<Session> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(settings.threads)
+            .thread_name(|i| format!("tracelab-render-{i}"))
+            .build()
+            .map_err(|e| Error::new(format!("cannot start render threads: {e}")))?;
+        let film = Film::new(scene.camera.width, scene.camera.height);
+        Ok(Session {
+            scene,
+            settings,
+            film,
+            pool,
+            spp: AtomicU32::new(0),
+            samples: AtomicU64::new(0),
+            camera_rays: AtomicU64::new(0),
+            shadow_rays: AtomicU64::new(0),
+            bounce_rays: AtomicU64::new(0),
+            non_finite: AtomicU64::new(0),
+            render_nanos: AtomicU64::new(0),
+            cancelled: AtomicBool::new(false),
+        })
+    }
+
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// Number of worker threads.
+    pub fn threads(&self) -> usize {
+        self.pool.current_num_threads()
+    }
+
+    /// Asks running and future passes to stop at the next tile.
+    pub fn cancel(&self) {
+        self.cancelled.store(true, Ordering::Relaxed);
+    }
+
+    /// Adds `spp` samples to every pixel. Returns false (and leaves the film
+    /// with a partial pass that [`RenderStats::spp`] does not count) when cancelled.
+    pub fn render_pass(&self, spp: u32) -> bool {
+        let start = Instant::now();
+        let first = self.spp.load(Ordering::Relaxed);
+        let scene = &*self.scene;
+        let settings = &self.settings;
+        let width = self.film.width();
+        self.pool.install(|| {
+            self.film.tiles().par_iter().for_each(|tile| {
+                if self.cancelled.load(Ordering::Relaxed) {
+                    return;
+                }
+                let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
+                let mut sampler = Sampler::new(settings.sampler, settings.seed, settings.planned_spp);
+                let mut counts = RayCounts::default();
+                let mut non_finite = 0u64;
+                let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
+                for (i, pixel) in tile.pixels.iter_mut().enumerate() {
+                    let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
+                    let pixel_index = y * width + x;
+                    for s in first..first + spp {
+                        sampler.start(pixel_index, s);
+                        let film_point = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+                        let lens = sampler.next_2d();
+                        let ray = scene.camera.generate_ray(film_point, lens);
+                        counts.camera += 1;
+                        let value = settings.integrator.radiance(scene, ray, &mut sampler, &mut counts);
+                        non_finite += u64::from(!value.is_finite());
+                        pixel.add(value);
+                    }
+                }
+                drop(tile);
+                self.samples.fetch_add(counts.camera, Ordering::Relaxed);
+                self.camera_rays.fetch_add(counts.camera, Ordering::Relaxed);
+                self.shadow_rays.fetch_add(counts.shadow, Ordering::Relaxed);
+                self.bounce_rays.fetch_add(counts.bounce, Ordering::Relaxed);
+                self.non_finite.fetch_add(non_finite, Ordering::Relaxed);
+            });
+        });
+        self.render_nanos.fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        if self.cancelled.load(Ordering::Relaxed) {
+            return false;
+        }
+        self.spp.store(first + spp, Ordering::Relaxed);
+        true
+    }
+
+    /// Copies the film (means, standard errors, counts) while passes may run.
+    pub fn snapshot(&self) -> FilmSnapshot {
+        self.film.snapshot()
+    }
+
+    /// Counters so far.
+    pub fn stats(&self) -> RenderStats {
+        RenderStats {
+            spp: self.spp.load(Ordering::Relaxed),
+            samples: self.samples.load(Ordering::Relaxed),
+            rays: RayCounts {
+                camera: self.camera_rays.load(Ordering::Relaxed),
+                shadow: self.shadow_rays.load(Ordering::Relaxed),
+                bounce: self.bounce_rays.load(Ordering::Relaxed),
+            },
+            non_finite: self.non_finite.load(Ordering::Relaxed),
+            render_time: Duration::from_nanos(self.render_nanos.load(Ordering::Relaxed)),
+        }
+    }
+}

@@ -1,0 +1,108 @@
+//! Warps from the unit square to the domains a renderer samples, each next to
+//! the density it produces (Nori's warptest vocabulary). Every warp is checked
+//! against its pdf by the chi-square tests in `tests/chi2.rs`.
+
+use glam::{Vec2, Vec3A};
+use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+/// Uniform point on the unit disk; Shirley–Chiu concentric map keeps strata compact.
+#[inline]
+pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
+    let o = 2.0 * u - Vec2::ONE;
+    if o.x == 0.0 && o.y == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, FRAC_PI_4 * (o.y / o.x))
+    } else {
+        (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
+    };
+    r * Vec2::new(theta.cos(), theta.sin())
+}
+
+/// Cosine-weighted direction on the +z hemisphere (Malley's method).
+#[inline]
+pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3A {
+    let d = square_to_concentric_disk(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    Vec3A::new(d.x, d.y, z)
+}
+
+/// Density wrt. solid angle: cos(theta) / pi.
+#[inline]
+pub fn cosine_hemisphere_pdf(w: Vec3A) -> f32 {
+    if w.z > 0.0 { w.z / PI } else { 0.0 }
+}
+
+/// Uniform direction on the unit sphere.
+#[inline]
+pub fn square_to_uniform_sphere(u: Vec2) -> Vec3A {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3A::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Density wrt. solid angle: 1 / (4 pi).
+pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
+
+/// Uniform direction in the cone of half-angle acos(cos_max) around +z.
+#[inline]
+pub fn square_to_uniform_cone(u: Vec2, cos_max: f32) -> Vec3A {
+    let cos_theta = 1.0 - u.x * (1.0 - cos_max);
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3A::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+/// Density wrt. solid angle: 1 / (2 pi (1 - cos_max)) inside the cone.
+#[inline]
+pub fn uniform_cone_pdf(cos_max: f32) -> f32 {
+    1.0 / (2.0 * PI * (1.0 - cos_max))
+}
+
+/// Uniform barycentrics (b1, b2) on a triangle: the square-root warp folds the
+/// square onto the triangle with constant density 2 per unit parameter area.
+#[inline]
+pub fn square_to_uniform_triangle(u: Vec2) -> Vec2 {
+    let su = u.x.sqrt();
+    Vec2::new(1.0 - su, u.y * su)
+}
+
+/// Direction around +z with density proportional to cos^n(alpha) on the
+/// hemisphere about +z: the lobe of the normalized modified Phong BRDF.
+#[inline]
+pub fn square_to_phong_lobe(u: Vec2, exponent: f32) -> Vec3A {
+    let cos_alpha = u.x.powf(1.0 / (exponent + 1.0));
+    let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3A::new(sin_alpha * phi.cos(), sin_alpha * phi.sin(), cos_alpha)
+}
+
+/// Density wrt. solid angle: (n + 1) / (2 pi) cos^n(alpha) for cos(alpha) > 0.
+#[inline]
+pub fn phong_lobe_pdf(cos_alpha: f32, exponent: f32) -> f32 {
+    if cos_alpha > 0.0 { (exponent + 1.0) / (2.0 * PI) * cos_alpha.powf(exponent) } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn warps_land_in_their_domains() {
+        for i in 0..32 {
+            for j in 0..32 {
+                let u = Vec2::new(i as f32 / 31.0, j as f32 / 31.0).min(Vec2::splat(0.99999));
+                assert!(square_to_concentric_disk(u).length() <= 1.0 + 1e-6);
+                let w = square_to_cosine_hemisphere(u);
+                assert!(w.z >= 0.0 && (w.length() - 1.0).abs() < 1e-5);
+                assert!((square_to_uniform_sphere(u).length() - 1.0).abs() < 1e-5);
+                assert!(square_to_uniform_cone(u, 0.8).z >= 0.8 - 1e-6);
+                let b = square_to_uniform_triangle(u);
+                assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
+                assert!(square_to_phong_lobe(u, 20.0).z >= 0.0);
+            }
+        }
+    }
+}

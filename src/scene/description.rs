@@ -1,0 +1,185 @@
+//! The scene file format: plain serde structs mirroring the TOML, with spans
+//! kept on every entry so that errors found after parsing can name the line.
+//!
+//! ```toml
+//! [camera]
+//! eye = [278, 273, -800]
+//! look_at = [278, 273, 0]
+//! up = [0, 1, 0]           # default
+//! fov_y = 39.3             # degrees, vertical
+//! width = 256
+//! height = 256
+//! aperture_radius = 0.0    # thin lens; 0 = pinhole
+//! focus_distance = 800     # default: distance from eye to look_at
+//!
+//! [[mesh]]
+//! file = "cornell_box.obj" # relative to this file; materials from its MTL
+//! scale = 1.0              # or [sx, sy, sz]
+//! rotate = [0, 30, 0]      # degrees about x, then y, then z
+//! translate = [0, 0, 0]
+//! material = "glass"       # optional: override every face's material
+//!
+//! [[sphere]]
+//! center = [0, 1, 0]
+//! radius = 0.5
+//! material = "glass"
+//!
+//! [[quad]]                 # corner + s u + t v, s, t in [0, 1]; normal u x v
+//! corner = [0, 0, 0]
+//! u = [1, 0, 0]
+//! v = [0, 0, 1]
+//! material = "white"
+//!
+//! [[point_light]]
+//! position = [0, 5, 0]
+//! intensity = [10, 10, 10] # W/sr
+//!
+//! [materials.glass]        # defines a material, or overrides an MTL one of the same name
+//! type = "dielectric"      # diffuse | glossy | mirror | dielectric
+//! ior = 1.5
+//!
+//! [lights]
+//! sphere_sampling = "solid-angle"   # or "area"
+//! ```
+
+use crate::scene::light::SphereSampling;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use toml::Spanned;
+
+/// A whole scene file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    pub camera: Spanned<CameraDesc>,
+    #[serde(default)]
+    pub mesh: Vec<Spanned<MeshDesc>>,
+    #[serde(default)]
+    pub sphere: Vec<Spanned<SphereDesc>>,
+    #[serde(default)]
+    pub quad: Vec<Spanned<QuadDesc>>,
+    #[serde(default)]
+    pub point_light: Vec<Spanned<PointLightDesc>>,
+    #[serde(default)]
+    pub materials: BTreeMap<String, Spanned<MaterialDesc>>,
+    #[serde(default)]
+    pub lights: LightOptions,
+}
+
+/// `[camera]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    pub eye: [f32; 3],
+    pub look_at: [f32; 3],
+    #[serde(default = "default_up")]
+    pub up: [f32; 3],
+    pub fov_y: f32,
+    pub width: u32,
+    pub height: u32,
+    #[serde(default)]
+    pub aperture_radius: f32,
+    pub focus_distance: Option<f32>,
+}
+
+fn default_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// A uniform or per-axis scale.
+#[derive(Debug, Deserialize, Clone, Copy)]
+#[serde(untagged)]
+pub enum Scale {
+    Uniform(f32),
+    PerAxis([f32; 3]),
+}
+
+impl Default for Scale {
+    fn default() -> Self {
+        Scale::Uniform(1.0)
+    }
+}
+
+/// `[[mesh]]`: an OBJ file with a transform.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshDesc {
+    pub file: String,
+    #[serde(default)]
+    pub scale: Scale,
+    #[serde(default)]
+    pub rotate: [f32; 3],
+    #[serde(default)]
+    pub translate: [f32; 3],
+    pub material: Option<String>,
+}
+
+/// `[[sphere]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereDesc {
+    pub center: [f32; 3],
+    pub radius: f32,
+    pub material: String,
+}
+
+/// `[[quad]]`: the parallelogram `corner + s u + t v`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuadDesc {
+    pub corner: [f32; 3],
+    pub u: [f32; 3],
+    pub v: [f32; 3],
+    pub material: String,
+}
+
+/// `[[point_light]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLightDesc {
+    pub position: [f32; 3],
+    pub intensity: [f32; 3],
+}
+
+/// Kinds of material in `[materials.NAME]`.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum MaterialKind {
+    Diffuse,
+    Glossy,
+    Mirror,
+    Dielectric,
+}
+
+/// `[materials.NAME]`. Which fields apply depends on `type`; the loader
+/// rejects the others so that a typo never goes unnoticed.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDesc {
+    #[serde(rename = "type")]
+    pub kind: MaterialKind,
+    /// diffuse, glossy: diffuse albedo.
+    pub albedo: Option<[f32; 3]>,
+    /// glossy: Phong lobe albedo.
+    pub specular: Option<[f32; 3]>,
+    /// glossy: Phong exponent.
+    pub exponent: Option<f32>,
+    /// mirror: reflectance.
+    pub reflectance: Option<[f32; 3]>,
+    /// dielectric: interior / exterior index of refraction.
+    pub ior: Option<f32>,
+    /// dielectric: transmittance tint.
+    pub tint: Option<[f32; 3]>,
+    /// Emitted radiance (any type).
+    pub emission: Option<[f32; 3]>,
+    /// Emit from both sides (any type).
+    pub two_sided: Option<bool>,
+}
+
+/// `[lights]`: how lights are sampled.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct LightOptions {
+    #[serde(default)]
+    pub sphere_sampling: SphereSampling,
+}

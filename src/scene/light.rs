@@ -1,0 +1,216 @@
+//! Light sources and their sampling for next-event estimation.
+//!
+//! Every emissive triangle and sphere is an area light; point lights are
+//! deltas. A light is chosen in proportion to its emitted power (alias table),
+//! then a point on it: triangles uniformly by area, spheres by area or by the
+//! solid angle they subtend. All densities are returned wrt. solid angle at
+//! the shading point, so the integrators can combine them with BSDF densities.
+
+use crate::math::{Frame, Rgb, luminance};
+use crate::sampling::AliasTable;
+use crate::sampling::warp::{
+    square_to_uniform_cone, square_to_uniform_sphere, square_to_uniform_triangle, uniform_cone_pdf,
+};
+use glam::{Vec2, Vec3A};
+use std::f32::consts::PI;
+
+/// How points on spherical lights are chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SphereSampling {
+    /// Uniform over the sphere's area (half the samples face away and are wasted).
+    Area,
+    /// Uniform over the cone of directions the sphere subtends (no waste).
+    #[default]
+    SolidAngle,
+}
+
+/// One light source.
+#[derive(Clone, Copy, Debug)]
+pub enum Light {
+    /// An emissive triangle `p0 + b1 e1 + b2 e2`.
+    Triangle { p0: Vec3A, e1: Vec3A, e2: Vec3A, normal: Vec3A, area: f32, radiance: Rgb, two_sided: bool },
+    /// An emissive sphere, emitting outwards.
+    Sphere { center: Vec3A, radius: f32, radiance: Rgb, sampling: SphereSampling },
+    /// An isotropic point light of `intensity` (W/sr per channel).
+    Point { position: Vec3A, intensity: Rgb },
+}
+
+/// A point sampled on a light, seen from a shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Point on the light (for shadow rays).
+    pub point: Vec3A,
+    /// Geometric normal at `point` (zero for point lights).
+    pub normal: Vec3A,
+    /// Unit direction from the shading point to `point`.
+    pub wi: Vec3A,
+    /// Distance from the shading point to `point`.
+    pub distance: f32,
+    /// Incident radiance along `wi`; for point lights the irradiance-like
+    /// `I / d^2`, which with `pdf` = selection probability gives the right estimator.
+    pub radiance: Rgb,
+    /// Density wrt. solid angle including the light selection probability;
+    /// for point lights the selection probability alone.
+    pub pdf: f32,
+    /// True for point lights (no MIS: BSDF sampling cannot hit them).
+    pub delta: bool,
+}
+
+impl Light {
+    /// Emitted power in luminance units, used to choose lights.
+    pub fn power(&self) -> f32 {
+        match *self {
+            Light::Triangle { area, radiance, two_sided, .. } => {
+                luminance(radiance) * area * PI * if two_sided { 2.0 } else { 1.0 }
+            }
+            Light::Sphere { radius, radiance, .. } => luminance(radiance) * 4.0 * PI * radius * radius * PI,
+            Light::Point { intensity, .. } => luminance(intensity) * 4.0 * PI,
+        }
+    }
+
+    /// Samples a point on the light as seen from `reference`; `pdf` excludes selection.
+    #[inline]
+    fn sample(&self, reference: Vec3A, u: Vec2) -> Option<LightSample> {
+        match *self {
+            Light::Triangle { p0, e1, e2, normal, area, radiance, two_sided } => {
+                let b = square_to_uniform_triangle(u);
+                let point = p0 + b.x * e1 + b.y * e2;
+                let to_light = point - reference;
+                let dist2 = to_light.length_squared();
+                let distance = dist2.sqrt();
+                let wi = to_light / distance;
+                let cos_light = -normal.dot(wi);
+                if !(cos_light > 0.0 || (two_sided && cos_light < 0.0)) {
+                    return None;
+                }
+                // Area density 1/A converted to solid angle: d^2 / (|cos| A).
+                let pdf = dist2 / (cos_light.abs() * area);
+                Some(LightSample { point, normal, wi, distance, radiance, pdf, delta: false })
+            }
+            Light::Sphere { center, radius, radiance, sampling } => {
+                let to_center = center - reference;
+                let dc2 = to_center.length_squared();
+                let inside = dc2 <= radius * radius * (1.0 + 1e-4);
+                if sampling == SphereSampling::SolidAngle && !inside {
+                    let dc = dc2.sqrt();
+                    let sin2_max = (radius * radius / dc2).min(1.0);
+                    let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+                    let frame = Frame::from_normal(to_center / dc);
+                    let wi = frame.to_world(square_to_uniform_cone(u, cos_max)).normalize();
+                    // Nearest intersection of the sampled direction with the sphere;
+                    // clamping the discriminant handles directions at the silhouette.
+                    let b = wi.dot(to_center);
+                    let perp2 = (to_center - b * wi).length_squared();
+                    let half_chord = (radius * radius - perp2).max(0.0).sqrt();
+                    let distance = (b - half_chord).max(0.0);
+                    let point = reference + distance * wi;
+                    let normal = (point - center).normalize();
+                    let pdf = uniform_cone_pdf(cos_max);
+                    if !pdf.is_finite() {
+                        return None;
+                    }
+                    Some(LightSample { point, normal, wi, distance, radiance, pdf, delta: false })
+                } else {
+                    let normal = square_to_uniform_sphere(u);
+                    let point = center + radius * normal;
+                    let to_light = point - reference;
+                    let dist2 = to_light.length_squared();
+                    let distance = dist2.sqrt();
+                    let wi = to_light / distance;
+                    let cos_light = -normal.dot(wi);
+                    if cos_light <= 0.0 {
+                        return None;
+                    }
+                    let pdf = dist2 / (cos_light * 4.0 * PI * radius * radius);
+                    Some(LightSample { point, normal, wi, distance, radiance, pdf, delta: false })
+                }
+            }
+            Light::Point { position, intensity } => {
+                let to_light = position - reference;
+                let dist2 = to_light.length_squared();
+                let distance = dist2.sqrt();
+                Some(LightSample {
+                    point: position,
+                    normal: Vec3A::ZERO,
+                    wi: to_light / distance,
+                    distance,
+                    radiance: intensity / dist2,
+                    pdf: 1.0,
+                    delta: true,
+                })
+            }
+        }
+    }
+
+    /// Solid-angle density (excluding selection) with which `sample` would
+    /// produce `point` (normal `normal`) seen from `reference`.
+    #[inline]
+    fn pdf(&self, reference: Vec3A, point: Vec3A, normal: Vec3A) -> f32 {
+        let to_light = point - reference;
+        let dist2 = to_light.length_squared();
+        let cos_light = normal.dot(to_light).abs() / dist2.sqrt();
+        match *self {
+            Light::Triangle { area, .. } => dist2 / (cos_light * area),
+            Light::Sphere { center, radius, sampling, .. } => {
+                let dc2 = (center - reference).length_squared();
+                let inside = dc2 <= radius * radius * (1.0 + 1e-4);
+                if sampling == SphereSampling::SolidAngle && !inside {
+                    let cos_max = (1.0 - (radius * radius / dc2).min(1.0)).max(0.0).sqrt();
+                    uniform_cone_pdf(cos_max)
+                } else {
+                    dist2 / (cos_light * 4.0 * PI * radius * radius)
+                }
+            }
+            Light::Point { .. } => 0.0,
+        }
+    }
+}
+
+/// All lights of a scene with the power-proportional selection table.
+#[derive(Clone, Debug, Default)]
+pub struct Lights {
+    lights: Vec<Light>,
+    selection: Option<AliasTable>,
+}
+
+impl Lights {
+    /// Builds the selection table. Lights of zero power can never be chosen.
+    pub fn new(lights: Vec<Light>) -> Self {
+        let powers: Vec<f32> = lights.iter().map(Light::power).collect();
+        let selection = AliasTable::new(&powers);
+        Lights { lights, selection }
+    }
+
+    /// The lights, indexed by the light ids stored on emissive primitives.
+    pub fn as_slice(&self) -> &[Light] {
+        &self.lights
+    }
+
+    /// True when nothing can be sampled.
+    pub fn is_empty(&self) -> bool {
+        self.selection.is_none()
+    }
+
+    /// Chooses a light with `u_select` and a point on it with `u`, for next-event
+    /// estimation from `reference`. The pdf includes the selection probability.
+    #[inline]
+    pub fn sample(&self, reference: Vec3A, u_select: f32, u: Vec2) -> Option<LightSample> {
+        let table = self.selection.as_ref()?;
+        let (index, pmf) = table.sample(u_select);
+        let mut s = self.lights[index].sample(reference, u)?;
+        s.pdf *= pmf;
+        (s.pdf > 0.0 && s.pdf.is_finite() && s.distance > 0.0).then_some(s)
+    }
+
+    /// Density (solid angle, including selection) that [`Lights::sample`] gives
+    /// to the point `point` with normal `normal` on light `light`, as seen from
+    /// `reference`. Used for the MIS weight of BSDF-sampled hits on lights.
+    #[inline]
+    pub fn pdf(&self, light: u32, reference: Vec3A, point: Vec3A, normal: Vec3A) -> f32 {
+        match &self.selection {
+            Some(table) => table.pmf(light as usize) * self.lights[light as usize].pdf(reference, point, normal),
+            None => 0.0,
+        }
+    }
+}

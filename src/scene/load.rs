@@ -1,0 +1,263 @@
+//! Scene files: TOML in, a validated [`SceneInput`] out. Every error names the
+//! scene file and the line of the entry at fault (or the OBJ/MTL file and line).
+
+use super::description::*;
+use super::material::{Bsdf, Material};
+use super::obj::load_obj;
+use super::{Limits, SceneInput};
+use crate::accel::{NO_LIGHT, Sphere, TriangleInput};
+use crate::error::{Error, Result, line_of};
+use crate::math::Rgb;
+use crate::scene::camera::Camera;
+use crate::scene::light::Light;
+use glam::{EulerRot, Mat4, Quat, Vec3, Vec3A};
+use std::collections::HashMap;
+use std::path::Path;
+use toml::Spanned;
+
+/// Reads a scene file and everything it references.
+pub fn load_scene_file(path: &Path, limits: &Limits) -> Result<SceneInput> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::at(path, None, format!("cannot read scene file: {e}")))?;
+    parse_scene(path, &text, limits)
+}
+
+/// Parses scene text; `path` locates referenced files and names errors.
+pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInput> {
+    let file: SceneFile = toml::from_str(text).map_err(|e| {
+        let line = e.span().map(|s| line_of(text, s.start));
+        Error::at(path, line, e.message())
+    })?;
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let at = |span: std::ops::Range<usize>, msg: String| Error::at(path, Some(line_of(text, span.start)), msg);
+
+    let camera = build_camera(&file.camera, limits).map_err(|m| at(file.camera.span(), m))?;
+
+    // Materials named in the scene file come first; MTL materials of the
+    // same name are replaced by them.
+    let mut materials: Vec<Material> = Vec::new();
+    let mut by_name: HashMap<String, u32> = HashMap::new();
+    for (name, desc) in &file.materials {
+        let m = build_material(name, desc.get_ref()).map_err(|m| at(desc.span(), m))?;
+        by_name.insert(name.clone(), materials.len() as u32);
+        materials.push(m);
+    }
+    let lookup = |name: &str, span: std::ops::Range<usize>, by_name: &HashMap<String, u32>| {
+        by_name.get(name).copied().ok_or_else(|| {
+            let mut known: Vec<&String> = by_name.keys().collect();
+            known.sort();
+            at(span, format!("unknown material `{name}` (defined: {known:?})"))
+        })
+    };
+
+    let mut triangles: Vec<TriangleInput> = Vec::new();
+    for mesh in &file.mesh {
+        let desc = mesh.get_ref();
+        let obj_path = dir.join(&desc.file);
+        if !obj_path.is_file() {
+            return Err(at(mesh.span(), format!("mesh file `{}` not found (looked for {})", desc.file, obj_path.display())));
+        }
+        let transform = mesh_transform(desc).map_err(|m| at(mesh.span(), m))?;
+        let obj = load_obj(&obj_path)?;
+        let override_id = match &desc.material {
+            Some(name) => Some(lookup(name, mesh.span(), &by_name)?),
+            None => None,
+        };
+        // Ids of this OBJ's MTL materials in the scene's table.
+        let mut obj_ids = Vec::with_capacity(obj.materials.len());
+        for m in obj.materials {
+            let id = match by_name.get(&m.name) {
+                Some(&id) => id,
+                None => {
+                    by_name.insert(m.name.clone(), materials.len() as u32);
+                    materials.push(m);
+                    materials.len() as u32 - 1
+                }
+            };
+            obj_ids.push(id);
+        }
+        let mut default_id = None;
+        for (vertices, mtl) in obj.triangles {
+            let material = match (override_id, mtl) {
+                (Some(id), _) => id,
+                (None, Some(i)) if i < obj_ids.len() => obj_ids[i],
+                _ => *default_id.get_or_insert_with(|| {
+                    materials.push(default_material());
+                    materials.len() as u32 - 1
+                }),
+            };
+            let vertices = vertices.map(|v| transform.transform_point3a(v));
+            triangles.push(TriangleInput { vertices, material });
+            if triangles.len() > limits.max_triangles {
+                return Err(at(
+                    mesh.span(),
+                    format!("more than {} triangles (raise the limit with --max-triangles)", limits.max_triangles),
+                ));
+            }
+        }
+    }
+
+    for quad in &file.quad {
+        let q = quad.get_ref();
+        let material = lookup(&q.material, quad.span(), &by_name)?;
+        let (c, u, v) = (Vec3A::from(q.corner), Vec3A::from(q.u), Vec3A::from(q.v));
+        if !(c.is_finite() && u.is_finite() && v.is_finite()) {
+            return Err(at(quad.span(), "quad: `corner`, `u` and `v` must be finite".into()));
+        }
+        triangles.push(TriangleInput { vertices: [c, c + u, c + u + v], material });
+        triangles.push(TriangleInput { vertices: [c, c + u + v, c + v], material });
+    }
+
+    let mut spheres = Vec::new();
+    for sphere in &file.sphere {
+        let s = sphere.get_ref();
+        let material = lookup(&s.material, sphere.span(), &by_name)?;
+        let center = Vec3A::from(s.center);
+        if !center.is_finite() || !s.radius.is_finite() || s.radius < 0.0 {
+            return Err(at(sphere.span(), format!("sphere: `center` must be finite and `radius` >= 0, got {}", s.radius)));
+        }
+        spheres.push(Sphere { center, radius: s.radius, material, light: NO_LIGHT });
+    }
+
+    let mut point_lights = Vec::new();
+    for light in &file.point_light {
+        let l = light.get_ref();
+        let position = Vec3A::from(l.position);
+        let intensity = Rgb::from(l.intensity);
+        if !position.is_finite() || !intensity.is_finite() || intensity.min_element() < 0.0 {
+            return Err(at(light.span(), "point_light: `position` must be finite, `intensity` finite and >= 0".into()));
+        }
+        point_lights.push(Light::Point { position, intensity });
+    }
+
+    Ok(SceneInput {
+        camera,
+        materials,
+        triangles,
+        spheres,
+        point_lights,
+        sphere_sampling: file.lights.sphere_sampling,
+    })
+}
+
+fn finite3(name: &str, v: [f32; 3]) -> std::result::Result<Vec3A, String> {
+    let v3 = Vec3A::from(v);
+    if v3.is_finite() { Ok(v3) } else { Err(format!("`{name}` must be finite, got {v:?}")) }
+}
+
+fn build_camera(span: &Spanned<CameraDesc>, limits: &Limits) -> std::result::Result<Camera, String> {
+    let c = span.get_ref();
+    let eye = finite3("camera.eye", c.eye)?;
+    let look_at = finite3("camera.look_at", c.look_at)?;
+    let up = finite3("camera.up", c.up)?;
+    if (look_at - eye).length_squared() == 0.0 {
+        return Err("`camera.look_at` must differ from `camera.eye`".into());
+    }
+    if (look_at - eye).normalize().cross(up.normalize_or_zero()).length_squared() < 1e-12 {
+        return Err("`camera.up` must not be parallel to the view direction".into());
+    }
+    if !(c.fov_y > 0.0 && c.fov_y < 180.0) {
+        return Err(format!("`camera.fov_y` must be in (0, 180) degrees, got {}", c.fov_y));
+    }
+    limits.check_resolution(c.width, c.height).map_err(|e| format!("camera: {e}"))?;
+    if !(c.aperture_radius.is_finite() && c.aperture_radius >= 0.0) {
+        return Err(format!("`camera.aperture_radius` must be >= 0, got {}", c.aperture_radius));
+    }
+    let focus = c.focus_distance.unwrap_or((look_at - eye).length());
+    if !(focus.is_finite() && focus > 0.0) {
+        return Err(format!("`camera.focus_distance` must be > 0, got {focus}"));
+    }
+    Ok(Camera::look_at(eye, look_at, up, c.fov_y, c.width, c.height, c.aperture_radius, focus))
+}
+
+fn mesh_transform(m: &MeshDesc) -> std::result::Result<Mat4, String> {
+    let scale = match m.scale {
+        Scale::Uniform(s) => Vec3::splat(s),
+        Scale::PerAxis(s) => Vec3::from(s),
+    };
+    if !scale.is_finite() || scale.min_element().abs() == 0.0 {
+        return Err(format!("mesh `{}`: `scale` must be finite and non-zero", m.file));
+    }
+    let rotate = Vec3::from(m.rotate);
+    let translate = Vec3::from(m.translate);
+    if !rotate.is_finite() || !translate.is_finite() {
+        return Err(format!("mesh `{}`: `rotate` and `translate` must be finite", m.file));
+    }
+    // Rotation about x first, then y, then z.
+    let rotation = Quat::from_euler(
+        EulerRot::ZYX,
+        rotate.z.to_radians(),
+        rotate.y.to_radians(),
+        rotate.x.to_radians(),
+    );
+    Ok(Mat4::from_scale_rotation_translation(scale, rotation, translate))
+}
+
+fn default_material() -> Material {
+    Material {
+        name: "default".into(),
+        bsdf: Bsdf::Diffuse { albedo: Rgb::splat(0.8) },
+        emission: Rgb::ZERO,
+        two_sided_emission: false,
+    }
+}
+
+fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material, String> {
+    let colour = |field: &str, v: Option<[f32; 3]>, default: Rgb, max: f32| -> std::result::Result<Rgb, String> {
+        match v {
+            None => Ok(default),
+            Some(c) if c.iter().all(|x| x.is_finite() && *x >= 0.0 && *x <= max) => Ok(Rgb::from(c)),
+            Some(c) => Err(format!("material `{name}`: `{field}` must be in [0, {max}], got {c:?}")),
+        }
+    };
+    let allowed: &[&str] = match d.kind {
+        MaterialKind::Diffuse => &["albedo"],
+        MaterialKind::Glossy => &["albedo", "specular", "exponent"],
+        MaterialKind::Mirror => &["reflectance"],
+        MaterialKind::Dielectric => &["ior", "tint"],
+    };
+    let present = [
+        ("albedo", d.albedo.is_some()),
+        ("specular", d.specular.is_some()),
+        ("exponent", d.exponent.is_some()),
+        ("reflectance", d.reflectance.is_some()),
+        ("ior", d.ior.is_some()),
+        ("tint", d.tint.is_some()),
+    ];
+    for (field, is_present) in present {
+        if is_present && !allowed.contains(&field) {
+            return Err(format!(
+                "material `{name}`: field `{field}` does not apply to type {:?} (it takes {allowed:?})",
+                d.kind
+            ));
+        }
+    }
+    let bsdf = match d.kind {
+        MaterialKind::Diffuse => Bsdf::Diffuse { albedo: colour("albedo", d.albedo, Rgb::splat(0.8), 1.0)? },
+        MaterialKind::Glossy => {
+            let exponent = d.exponent.unwrap_or(50.0);
+            if !(exponent.is_finite() && exponent >= 0.0) {
+                return Err(format!("material `{name}`: `exponent` must be >= 0, got {exponent}"));
+            }
+            Bsdf::glossy(
+                colour("albedo", d.albedo, Rgb::splat(0.3), 1.0)?,
+                colour("specular", d.specular, Rgb::splat(0.5), 1.0)?,
+                exponent,
+            )
+        }
+        MaterialKind::Mirror => Bsdf::Mirror { reflectance: colour("reflectance", d.reflectance, Rgb::ONE, 1.0)? },
+        MaterialKind::Dielectric => {
+            let eta = d.ior.unwrap_or(1.5);
+            if !(eta.is_finite() && eta > 0.0) {
+                return Err(format!("material `{name}`: `ior` must be > 0, got {eta}"));
+            }
+            Bsdf::Dielectric { eta, tint: colour("tint", d.tint, Rgb::ONE, 1.0)? }
+        }
+    };
+    Ok(Material {
+        name: name.to_string(),
+        bsdf,
+        emission: colour("emission", d.emission, Rgb::ZERO, f32::MAX)?,
+        two_sided_emission: d.two_sided.unwrap_or(false),
+    })
+}

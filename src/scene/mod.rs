@@ -1,0 +1,150 @@
+//! Scenes: camera, geometry, materials and lights, loaded from TOML + OBJ/MTL
+//! and checked before anything renders.
+
+pub mod camera;
+pub mod description;
+pub mod light;
+pub mod load;
+pub mod material;
+pub mod obj;
+
+use crate::accel::{Geometry, Sphere, TriangleInput};
+use crate::error::{Error, Result};
+use camera::Camera;
+use light::{Light, Lights, SphereSampling};
+use material::Material;
+use std::path::Path;
+
+/// Sizes beyond which input is taken for a typo rather than a wish.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    pub max_resolution: u32,
+    pub max_triangles: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits { max_resolution: 16384, max_triangles: 50_000_000 }
+    }
+}
+
+impl Limits {
+    /// Checks an image size against the limits.
+    pub fn check_resolution(&self, width: u32, height: u32) -> std::result::Result<(), String> {
+        let max = self.max_resolution;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(format!("resolution {width}x{height} is outside 1..={max} per side"));
+        }
+        Ok(())
+    }
+}
+
+/// Everything a scene is made of, before acceleration structures are built.
+#[derive(Clone, Debug)]
+pub struct SceneInput {
+    pub camera: Camera,
+    pub materials: Vec<Material>,
+    pub triangles: Vec<TriangleInput>,
+    pub spheres: Vec<Sphere>,
+    pub point_lights: Vec<Light>,
+    pub sphere_sampling: SphereSampling,
+}
+
+/// A scene ready to render.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub camera: Camera,
+    pub geometry: Geometry,
+    pub materials: Vec<Material>,
+    pub lights: Lights,
+    /// Things the user should know that did not stop loading (dropped triangles, ...).
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// Loads a scene file with the default limits.
+    pub fn load(path: &Path) -> Result<Scene> {
+        Self::load_with_limits(path, &Limits::default())
+    }
+
+    /// Loads a scene file.
+    pub fn load_with_limits(path: &Path, limits: &Limits) -> Result<Scene> {
+        Scene::build(load::load_scene_file(path, limits)?)
+    }
+
+    /// Drops degenerate primitives (with a warning that counts them), builds
+    /// the BVHs and turns every emissive primitive into a light.
+    pub fn build(input: SceneInput) -> Result<Scene> {
+        let mut warnings = Vec::new();
+        let total = input.triangles.len();
+        let triangles: Vec<TriangleInput> = input
+            .triangles
+            .into_iter()
+            .filter(|t| {
+                let [a, b, c] = t.vertices;
+                let n = (b - a).cross(c - a);
+                // Zero or non-representable area: no normal, no hits, no light.
+                n.length_squared() > 0.0 && n.is_finite() && n.normalize().is_finite()
+            })
+            .collect();
+        let dropped = total - triangles.len();
+        if dropped > 0 {
+            let emitters_hint = "(zero-area emitters among them emit nothing)";
+            warnings.push(format!("dropped {dropped} degenerate triangle(s) of {total} {emitters_hint}"));
+        }
+        let sphere_total = input.spheres.len();
+        let spheres: Vec<Sphere> = input.spheres.into_iter().filter(|s| s.radius > 0.0).collect();
+        if spheres.len() < sphere_total {
+            warnings.push(format!("dropped {} sphere(s) of radius 0", sphere_total - spheres.len()));
+        }
+        if let Some(bad) = triangles.iter().find(|t| t.material as usize >= input.materials.len()) {
+            return Err(Error::new(format!("internal: triangle refers to material {}", bad.material)));
+        }
+
+        let mut geometry = Geometry::build(&triangles, spheres);
+        let mut lights = Vec::new();
+        for i in 0..geometry.triangle_count() {
+            let material = &input.materials[geometry.triangle_material(i) as usize];
+            if material.is_emissive() {
+                let [p0, p1, p2] = geometry.triangles()[i];
+                let (e1, e2) = (p1 - p0, p2 - p0);
+                let cross = e1.cross(e2);
+                geometry.set_triangle_light(i, lights.len() as u32);
+                lights.push(Light::Triangle {
+                    p0,
+                    e1,
+                    e2,
+                    normal: cross.normalize(),
+                    area: 0.5 * cross.length(),
+                    radiance: material.emission,
+                    two_sided: material.two_sided_emission,
+                });
+            }
+        }
+        for i in 0..geometry.spheres().len() {
+            let s = geometry.spheres()[i];
+            let material = &input.materials[s.material as usize];
+            if material.is_emissive() {
+                geometry.set_sphere_light(i, lights.len() as u32);
+                lights.push(Light::Sphere {
+                    center: s.center,
+                    radius: s.radius,
+                    radiance: material.emission,
+                    sampling: input.sphere_sampling,
+                });
+            }
+        }
+        lights.extend(input.point_lights);
+        let lights = Lights::new(lights);
+        if lights.is_empty() {
+            warnings.push("the scene has no light source: the image will be black".into());
+        }
+        Ok(Scene { camera: input.camera, geometry, materials: input.materials, lights, warnings })
+    }
+
+    /// Overrides the image size (keeping the field of view).
+    pub fn set_resolution(&mut self, width: u32, height: u32) {
+        self.camera.width = width;
+        self.camera.height = height;
+    }
+}
