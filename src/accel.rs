@@ -156,6 +156,16 @@ fn intersect_sphere(origin: Vec3A, direction: Vec3A, center: Vec3A, radius: f32,
 
 /// medium_build: PLOC with reinsertion; leaf size does not matter much here
 /// (measured on the Cornell box: within 5% from 1 to 3 triangles per leaf).
+/// The obvhs ray for `ray`. A direction component of -0.0 must become +0.0:
+/// obvhs takes the ray octant from `< 0.0` but the reciprocal's sign from the
+/// sign bit, and with the two disagreeing the traversal misses everything
+/// (found by `closest_of_sphere_and_triangle_wins`). Adding +0.0 maps -0.0 to
+/// +0.0 and leaves every other value unchanged.
+#[inline]
+fn bvh_ray(ray: &Ray, t_max: f32) -> obvhs::ray::Ray {
+    obvhs::ray::Ray::new(ray.origin, ray.direction + Vec3A::ZERO, 0.0, t_max)
+}
+
 fn build_params() -> BvhBuildParams {
     BvhBuildParams::medium_build()
 }
@@ -237,7 +247,7 @@ impl Geometry {
         let (mut best_b1, mut best_b2) = (0.0, 0.0);
         if let Some(bvh) = &self.tri_bvh {
             let sheared = ShearedRay::new(ray);
-            let bvh_ray = obvhs::ray::Ray::new(ray.origin, ray.direction, 0.0, best_t);
+            let bvh_ray = bvh_ray(ray, best_t);
             let mut hit = obvhs::ray::RayHit::none();
             bvh.ray_traverse(bvh_ray, &mut hit, |r, id| match sheared.intersect(&self.tri_vertices[id], r.tmax) {
                 Some((t, b1, b2)) => {
@@ -252,7 +262,7 @@ impl Geometry {
         }
         let mut best_sphere = u32::MAX;
         if let Some(bvh) = &self.sphere_bvh {
-            let bvh_ray = obvhs::ray::Ray::new(ray.origin, ray.direction, 0.0, best_t);
+            let bvh_ray = bvh_ray(ray, best_t);
             let mut hit = obvhs::ray::RayHit::none();
             bvh.ray_traverse(bvh_ray, &mut hit, |r, id| {
                 let s = &self.spheres[id];
@@ -294,7 +304,7 @@ impl Geometry {
     pub fn occluded(&self, ray: &Ray) -> bool {
         if let Some(bvh) = &self.tri_bvh {
             let sheared = ShearedRay::new(ray);
-            let bvh_ray = obvhs::ray::Ray::new(ray.origin, ray.direction, 0.0, ray.t_max);
+            let bvh_ray = bvh_ray(ray, ray.t_max);
             let miss = bvh.ray_traverse_miss(bvh_ray, |r, id| {
                 sheared.intersect(&self.tri_vertices[id], r.tmax).map_or(f32::INFINITY, |h| h.0)
             });
@@ -303,7 +313,7 @@ impl Geometry {
             }
         }
         if let Some(bvh) = &self.sphere_bvh {
-            let bvh_ray = obvhs::ray::Ray::new(ray.origin, ray.direction, 0.0, ray.t_max);
+            let bvh_ray = bvh_ray(ray, ray.t_max);
             let miss = bvh.ray_traverse_miss(bvh_ray, |r, id| {
                 let s = &self.spheres[id];
                 intersect_sphere(r.origin, r.direction, s.center, s.radius, r.tmax).unwrap_or(f32::INFINITY)
@@ -362,6 +372,17 @@ mod tests {
         let hit = g.intersect(&Ray::new(Vec3A::new(0.25, 0.5, 0.0), Vec3A::Z)).unwrap();
         assert!(hit.material <= 1);
         assert!((hit.normal - Vec3A::Z).length() < 1e-6);
+    }
+
+    #[test]
+    fn negative_zero_direction_components_still_hit() {
+        let sphere = Sphere { center: Vec3A::new(0.5, 0.5, 3.0), radius: 0.5, material: 0, light: NO_LIGHT };
+        let g = Geometry::build(&[], vec![sphere]);
+        for d in [Vec3A::new(-0.0, -0.0, -1.0), Vec3A::new(-0.0, 0.0, -1.0), Vec3A::new(1e-3, -0.0, -1.0)] {
+            let hit = g.intersect(&Ray::new(Vec3A::new(0.5, 0.5, 5.0), d.normalize()));
+            assert!(hit.is_some(), "{d:?}");
+            assert!(g.occluded(&Ray::new(Vec3A::new(0.5, 0.5, 5.0), d.normalize())));
+        }
     }
 
     #[test]
