@@ -6,7 +6,7 @@
 //! primitives are contiguous in memory and the traversal's primitive index
 //! addresses them directly (obvhs `primitive_indices` applied once at build).
 
-use crate::math::Ray;
+use crate::math::{Ray, gamma};
 use glam::{Mat3A, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
@@ -41,6 +41,8 @@ pub struct SurfaceHit {
     /// Hit point, computed from barycentrics (triangles) or re-projected onto
     /// the sphere, which is more accurate than `origin + t * direction`.
     pub point: Vec3A,
+    /// Per-component bound on the rounding error of `point`, for spawning rays.
+    pub error: Vec3A,
     /// Unit geometric normal: triangle winding order (counter-clockwise seen
     /// from the front) or outward for spheres. Not flipped towards the ray.
     pub normal: Vec3A,
@@ -123,7 +125,22 @@ impl ShearedRay {
             return None;
         }
         let inv_det = 1.0 / det;
-        Some((t_scaled * inv_det, e1 * inv_det, e2 * inv_det))
+        let t = t_scaled * inv_det;
+        // Reject hits whose t is not provably positive given the rounding of
+        // the computation (pbrt-v4, 6.8.4 "Conservative Ray-Triangle t").
+        let max_z = a.z.abs().max(b.z.abs()).max(c.z.abs());
+        let max_x = a.x.abs().max(b.x.abs()).max(c.x.abs());
+        let max_y = a.y.abs().max(b.y.abs()).max(c.y.abs());
+        let delta_z = gamma(3) * max_z;
+        let delta_x = gamma(5) * (max_x + max_z);
+        let delta_y = gamma(5) * (max_y + max_z);
+        let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+        let delta_t = 3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
+        if t <= delta_t {
+            return None;
+        }
+        Some((t, e1 * inv_det, e2 * inv_det))
     }
 }
 
@@ -276,9 +293,14 @@ impl Geometry {
         if best_sphere != u32::MAX {
             let s = &self.spheres[best_sphere as usize];
             let normal = (ray.at(best_t) - s.center).normalize();
+            let local = s.radius * normal;
+            let point = s.center + local;
             return Some(SurfaceHit {
                 t: best_t,
-                point: s.center + s.radius * normal,
+                point,
+                // Re-projection onto the sphere (gamma(5), pbrt-v4 6.8.5) plus
+                // the translation by the centre.
+                error: gamma(5) * local.abs() + gamma(1) * point.abs(),
                 normal,
                 material: s.material,
                 light: s.light,
@@ -289,10 +311,13 @@ impl Geometry {
         }
         let i = best_tri as usize;
         let [p0, p1, p2] = self.tri_vertices[i];
-        let point = (1.0 - best_b1 - best_b2) * p0 + best_b1 * p1 + best_b2 * p2;
+        let b0 = 1.0 - best_b1 - best_b2;
+        let point = b0 * p0 + best_b1 * p1 + best_b2 * p2;
         Some(SurfaceHit {
             t: best_t,
             point,
+            // Barycentric interpolation (pbrt-v4 6.8.4).
+            error: gamma(7) * ((b0 * p0).abs() + (best_b1 * p1).abs() + (best_b2 * p2).abs()),
             normal: (p1 - p0).cross(p2 - p0).normalize(),
             material: self.tri_material[i],
             light: self.tri_light[i],

@@ -67,29 +67,86 @@ impl Frame {
     }
 }
 
-/// Offsets a surface point along its geometric normal `n` (pointing to the
-/// side the new ray leaves from) so that the new ray cannot re-hit the surface
-/// it starts on. The offset is a fixed number of float ULPs, so it scales with
-/// the magnitude of the coordinates rather than being a magic epsilon
-/// (Wächter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection",
-/// Ray Tracing Gems, ch. 6). Near the origin, where ULPs become tiny, a small
-/// absolute offset takes over.
+/// Bound on the relative rounding error of `n` chained float operations:
+/// gamma(n) = n u / (1 - n u) with u = 2^-24 (Higham; pbrt-v4 3.9).
 #[inline]
-pub fn offset_ray_origin(p: Vec3A, n: Vec3A) -> Vec3A {
-    const ORIGIN: f32 = 1.0 / 32.0;
-    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
-    const INT_SCALE: f32 = 256.0;
-    let offset_component = |p: f32, n: f32| -> f32 {
-        let of_i = (INT_SCALE * n) as i32;
-        let bits = p.to_bits() as i32;
-        let moved = f32::from_bits((bits + if p < 0.0 { -of_i } else { of_i }) as u32);
-        if p.abs() < ORIGIN { p + FLOAT_SCALE * n } else { moved }
+pub const fn gamma(n: i32) -> f32 {
+    let u = f32::EPSILON * 0.5;
+    (n as f32 * u) / (1.0 - n as f32 * u)
+}
+
+/// The next float towards +infinity.
+#[inline]
+pub fn next_float_up(v: f32) -> f32 {
+    if v.is_infinite() && v > 0.0 {
+        return v;
+    }
+    let v = if v == -0.0 { 0.0 } else { v };
+    let bits = v.to_bits();
+    f32::from_bits(if v >= 0.0 { bits + 1 } else { bits - 1 })
+}
+
+/// The next float towards -infinity.
+#[inline]
+pub fn next_float_down(v: f32) -> f32 {
+    if v.is_infinite() && v < 0.0 {
+        return v;
+    }
+    let v = if v == 0.0 { -0.0 } else { v };
+    let bits = v.to_bits();
+    f32::from_bits(if v > 0.0 { bits - 1 } else { bits + 1 })
+}
+
+/// Origin for a ray leaving the surface point `p` in direction `w`.
+///
+/// `p_error` bounds, per component, how far the computed `p` may be from the
+/// true surface (each intersection routine derives it from the operations
+/// that produced `p`). Moving `p` along the geometric normal `n` by the
+/// projection of that box onto `n`, to the side `w` leaves from, and rounding
+/// away from `p`, puts the origin strictly on that side of the surface, so the
+/// new ray cannot hit the surface it starts on; no epsilon, at any scale
+/// (pbrt-v4, 6.8.6 "Robust Spawned Ray Origins").
+#[inline]
+pub fn offset_ray_origin(p: Vec3A, p_error: Vec3A, n: Vec3A, w: Vec3A) -> Vec3A {
+    let d = n.abs().dot(p_error);
+    let mut offset = d * n;
+    if w.dot(n) < 0.0 {
+        offset = -offset;
+    }
+    let po = p + offset;
+    let round = |po: f32, o: f32| {
+        if o > 0.0 {
+            next_float_up(po)
+        } else if o < 0.0 {
+            next_float_down(po)
+        } else {
+            po
+        }
     };
-    Vec3A::new(
-        offset_component(p.x, n.x),
-        offset_component(p.y, n.y),
-        offset_component(p.z, n.z),
-    )
+    Vec3A::new(round(po.x, offset.x), round(po.y, offset.y), round(po.z, offset.z))
+}
+
+/// Fraction of a segment's length left out at its far end, so that a shadow
+/// ray never reaches the surface of the point it aims at (pbrt's ShadowEpsilon).
+pub const SHADOW_EPSILON: f32 = 1e-4;
+
+/// A shadow ray between two surface points, each given with its error bound
+/// and geometric normal (a zero normal and error for points in free space).
+/// Both ends are moved off their surfaces towards each other.
+#[inline]
+pub fn ray_between(
+    from: Vec3A,
+    from_error: Vec3A,
+    from_normal: Vec3A,
+    to: Vec3A,
+    to_error: Vec3A,
+    to_normal: Vec3A,
+) -> Ray {
+    let origin = offset_ray_origin(from, from_error, from_normal, to - from);
+    let target = offset_ray_origin(to, to_error, to_normal, origin - to);
+    let d = target - origin;
+    let distance = d.length();
+    Ray { origin, direction: d / distance, t_max: distance * (1.0 - SHADOW_EPSILON) }
 }
 
 /// Mirror reflection of `w` about the normal `n` (both pointing away from the surface).
@@ -121,16 +178,25 @@ mod tests {
     }
 
     #[test]
-    fn offset_moves_to_the_normal_side_at_every_scale() {
+    fn offset_leaves_the_surface_by_its_error_bound_at_every_scale() {
         for scale in [1e-6f32, 1e-2, 1.0, 1e3, 1e5] {
             let p = Vec3A::new(0.7, -0.3, 0.2) * scale;
+            let error = p.abs() * gamma(7);
             let n = Vec3A::new(0.0, 1.0, 0.0);
-            let q = offset_ray_origin(p, n);
-            assert!(q.y > p.y, "scale {scale}: {q:?} not above {p:?}");
-            assert_eq!(q.x, p.x);
-            // The offset is tiny relative to the coordinate scale, with an
-            // absolute floor of 1/65536 near the origin.
-            assert!((q - p).length() <= (1e-4 * scale).max(2.0 / 65536.0));
+            let up = offset_ray_origin(p, error, n, Vec3A::new(0.3, 0.5, 0.0));
+            let down = offset_ray_origin(p, error, n, Vec3A::new(0.3, -0.5, 0.0));
+            assert!(up.y - p.y > error.y && p.y - down.y > error.y, "scale {scale}");
+            assert_eq!((up.x, up.z), (p.x, p.z));
+            // The offset is a few ULPs of the coordinates, not an absolute epsilon.
+            assert!(up.y - p.y < 1e-5 * scale);
         }
+    }
+
+    #[test]
+    fn next_float_steps_one_ulp() {
+        assert!(next_float_up(1.0) > 1.0 && next_float_down(1.0) < 1.0);
+        assert_eq!(next_float_up(-0.0), f32::from_bits(1));
+        assert_eq!(next_float_down(0.0), -f32::from_bits(1));
+        assert_eq!(next_float_down(next_float_up(3.5)), 3.5);
     }
 }

@@ -9,8 +9,9 @@
 //! where beta_k is the product of f cos / p_bsdf (and 1/q of roulette) so far.
 
 use super::{MisHeuristic, RayCounts};
-use crate::accel::NO_LIGHT;
-use crate::math::{Frame, Ray, Rgb, offset_ray_origin};
+use crate::accel::{NO_LIGHT, SurfaceHit};
+use crate::scene::light::LightSample;
+use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 
@@ -104,7 +105,7 @@ impl PathTracer {
                             self.mis.weight(ls.pdf, bsdf.pdf(wo, wi))
                         };
                         counts.shadow += 1;
-                        if !scene.geometry.occluded(&shadow_ray(hit.point, hit.normal, &ls)) {
+                        if !scene.geometry.occluded(&shadow_ray(&hit, &ls)) {
                             radiance += beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf);
                         }
                     }
@@ -132,27 +133,16 @@ impl PathTracer {
             }
 
             let wi_world = frame.to_world(sample.wi);
-            let side = if wi_world.dot(hit.normal) > 0.0 { hit.normal } else { -hit.normal };
-            ray = Ray::new(offset_ray_origin(hit.point, side), wi_world);
+            ray = Ray::new(offset_ray_origin(hit.point, hit.error, hit.normal, wi_world), wi_world);
             counts.bounce += 1;
         }
         radiance
     }
 }
 
-/// Shadow ray from a surface point to a sampled light point, both ends moved
-/// off their surfaces so that neither surface can occlude the ray.
+/// Shadow ray from a surface hit to a sampled light point, both ends moved
+/// off their surfaces by their error bounds.
 #[inline]
-pub fn shadow_ray(point: glam::Vec3A, normal: glam::Vec3A, ls: &crate::scene::light::LightSample) -> Ray {
-    let side = if ls.wi.dot(normal) > 0.0 { normal } else { -normal };
-    let origin = offset_ray_origin(point, side);
-    let target = if ls.delta {
-        ls.point
-    } else {
-        let light_side = if ls.normal.dot(ls.wi) < 0.0 { ls.normal } else { -ls.normal };
-        offset_ray_origin(ls.point, light_side)
-    };
-    let to_target = target - origin;
-    let distance = to_target.length();
-    Ray { origin, direction: to_target / distance, t_max: distance }
+pub fn shadow_ray(hit: &SurfaceHit, ls: &LightSample) -> Ray {
+    ray_between(hit.point, hit.error, hit.normal, ls.point, ls.error, ls.normal)
 }

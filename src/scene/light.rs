@@ -6,7 +6,7 @@
 //! solid angle they subtend. All densities are returned wrt. solid angle at
 //! the shading point, so the integrators can combine them with BSDF densities.
 
-use crate::math::{Frame, Rgb, luminance};
+use crate::math::{Frame, Rgb, gamma, luminance};
 use crate::sampling::AliasTable;
 use crate::sampling::warp::{
     square_to_uniform_cone, square_to_uniform_sphere, square_to_uniform_triangle, uniform_cone_pdf,
@@ -30,8 +30,8 @@ pub enum SphereSampling {
 pub enum Light {
     /// An emissive triangle `p0 + b1 e1 + b2 e2`.
     Triangle { p0: Vec3A, e1: Vec3A, e2: Vec3A, normal: Vec3A, area: f32, radiance: Rgb, two_sided: bool },
-    /// An emissive sphere, emitting outwards.
-    Sphere { center: Vec3A, radius: f32, radiance: Rgb, sampling: SphereSampling },
+    /// An emissive sphere, emitting outwards (and inwards when two-sided).
+    Sphere { center: Vec3A, radius: f32, radiance: Rgb, two_sided: bool, sampling: SphereSampling },
     /// An isotropic point light of `intensity` (W/sr per channel).
     Point { position: Vec3A, intensity: Rgb },
 }
@@ -41,6 +41,8 @@ pub enum Light {
 pub struct LightSample {
     /// Point on the light (for shadow rays).
     pub point: Vec3A,
+    /// Rounding error bound of `point` (zero for point lights).
+    pub error: Vec3A,
     /// Geometric normal at `point` (zero for point lights).
     pub normal: Vec3A,
     /// Unit direction from the shading point to `point`.
@@ -64,7 +66,9 @@ impl Light {
             Light::Triangle { area, radiance, two_sided, .. } => {
                 luminance(radiance) * area * PI * if two_sided { 2.0 } else { 1.0 }
             }
-            Light::Sphere { radius, radiance, .. } => luminance(radiance) * 4.0 * PI * radius * radius * PI,
+            Light::Sphere { radius, radiance, two_sided, .. } => {
+                luminance(radiance) * 4.0 * PI * radius * radius * PI * if two_sided { 2.0 } else { 1.0 }
+            }
             Light::Point { intensity, .. } => luminance(intensity) * 4.0 * PI,
         }
     }
@@ -76,6 +80,7 @@ impl Light {
             Light::Triangle { p0, e1, e2, normal, area, radiance, two_sided } => {
                 let b = square_to_uniform_triangle(u);
                 let point = p0 + b.x * e1 + b.y * e2;
+                let error = gamma(6) * (p0.abs() + (b.x * e1).abs() + (b.y * e2).abs());
                 let to_light = point - reference;
                 let dist2 = to_light.length_squared();
                 let distance = dist2.sqrt();
@@ -86,9 +91,9 @@ impl Light {
                 }
                 // Area density 1/A converted to solid angle: d^2 / (|cos| A).
                 let pdf = dist2 / (cos_light.abs() * area);
-                Some(LightSample { point, normal, wi, distance, radiance, pdf, delta: false })
+                Some(LightSample { point, error, normal, wi, distance, radiance, pdf, delta: false })
             }
-            Light::Sphere { center, radius, radiance, sampling } => {
+            Light::Sphere { center, radius, radiance, two_sided, sampling } => {
                 let to_center = center - reference;
                 let dc2 = to_center.length_squared();
                 let inside = dc2 <= radius * radius * (1.0 + 1e-4);
@@ -104,26 +109,31 @@ impl Light {
                     let perp2 = (to_center - b * wi).length_squared();
                     let half_chord = (radius * radius - perp2).max(0.0).sqrt();
                     let distance = (b - half_chord).max(0.0);
-                    let point = reference + distance * wi;
-                    let normal = (point - center).normalize();
+                    let normal = (reference + distance * wi - center).normalize();
+                    // Re-projected onto the sphere, as intersections are.
+                    let point = center + radius * normal;
+                    let error = gamma(5) * (radius * normal).abs() + gamma(1) * point.abs();
                     let pdf = uniform_cone_pdf(cos_max);
                     if !pdf.is_finite() {
                         return None;
                     }
-                    Some(LightSample { point, normal, wi, distance, radiance, pdf, delta: false })
+                    Some(LightSample { point, error, normal, wi, distance, radiance, pdf, delta: false })
                 } else {
                     let normal = square_to_uniform_sphere(u);
                     let point = center + radius * normal;
+                    let error = gamma(5) * (radius * normal).abs() + gamma(1) * point.abs();
                     let to_light = point - reference;
                     let dist2 = to_light.length_squared();
                     let distance = dist2.sqrt();
                     let wi = to_light / distance;
+                    // Seen from outside only the outer side emits; from inside
+                    // (two-sided emitters) the inner side.
                     let cos_light = -normal.dot(wi);
-                    if cos_light <= 0.0 {
+                    if !(cos_light > 0.0 || (two_sided && cos_light < 0.0)) {
                         return None;
                     }
-                    let pdf = dist2 / (cos_light * 4.0 * PI * radius * radius);
-                    Some(LightSample { point, normal, wi, distance, radiance, pdf, delta: false })
+                    let pdf = dist2 / (cos_light.abs() * 4.0 * PI * radius * radius);
+                    Some(LightSample { point, error, normal, wi, distance, radiance, pdf, delta: false })
                 }
             }
             Light::Point { position, intensity } => {
@@ -132,6 +142,7 @@ impl Light {
                 let distance = dist2.sqrt();
                 Some(LightSample {
                     point: position,
+                    error: Vec3A::ZERO,
                     normal: Vec3A::ZERO,
                     wi: to_light / distance,
                     distance,

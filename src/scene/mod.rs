@@ -130,6 +130,7 @@ impl Scene {
                     center: s.center,
                     radius: s.radius,
                     radiance: material.emission,
+                    two_sided: material.two_sided_emission,
                     sampling: input.sphere_sampling,
                 });
             }

@@ -1,0 +1,73 @@
+//! Helpers shared by the integration tests.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use tracelab::film::FilmSnapshot;
+use tracelab::image::Image;
+use tracelab::integrator::Integrator;
+use tracelab::render::{RenderSettings, RenderStats, Session};
+use tracelab::sampling::SamplerKind;
+use tracelab::scene::Scene;
+
+/// Path of a file in the repository.
+pub fn repo_path(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
+}
+
+/// The default Cornell box.
+pub fn cornell_box() -> Scene {
+    Scene::load(&repo_path("scenes/cornell_box.toml")).expect("default scene loads")
+}
+
+/// A reference image from tests/data.
+pub fn reference(name: &str) -> Image {
+    Image::read(&repo_path(&format!("tests/data/{name}"))).expect("reference image loads")
+}
+
+/// Renders `spp` samples per pixel in passes of `pass` samples.
+pub fn render_with(
+    scene: Scene,
+    integrator: Integrator,
+    sampler: SamplerKind,
+    spp: u32,
+    seed: u64,
+    threads: usize,
+    pass: u32,
+) -> (FilmSnapshot, RenderStats) {
+    let settings = RenderSettings { integrator, sampler, seed, planned_spp: spp, threads };
+    let session = Session::new(Arc::new(scene), settings).expect("session starts");
+    let mut done = 0;
+    while done < spp {
+        let k = pass.min(spp - done);
+        assert!(session.render_pass(k));
+        done += k;
+    }
+    (session.snapshot(), session.stats())
+}
+
+/// Renders with all cores in passes of 8 samples.
+pub fn render(scene: Scene, integrator: Integrator, sampler: SamplerKind, spp: u32, seed: u64) -> (FilmSnapshot, RenderStats) {
+    render_with(scene, integrator, sampler, spp, seed, 0, 8)
+}
+
+/// A fresh empty directory under the system temp dir.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tracelab-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+/// Mean of a per-channel quantity over an image and the standard error of
+/// that mean from per-pixel standard errors (pixels are independent).
+pub fn mean_and_standard_error(snapshot: &FilmSnapshot) -> ([f64; 3], [f64; 3]) {
+    let n = snapshot.image.pixels.len() as f64;
+    let mean = snapshot.image.mean();
+    let mut var = [0.0f64; 3];
+    for se in &snapshot.standard_error.pixels {
+        for c in 0..3 {
+            var[c] += (se[c] as f64).powi(2);
+        }
+    }
+    (mean, var.map(|v| v.sqrt() / n))
+}

@@ -1,0 +1,19 @@
+//! Integration tests, linked as one binary. Statistical tests use fixed seeds
+//! and tolerances derived from the estimator's own variance; each says how.
+
+mod common;
+
+// Agreement with the Mitsuba 3 reference renders in tests/data.
+mod reference;
+// White furnace: closed sphere with known radiance Le / (1 - albedo).
+mod furnace;
+// Chi-square goodness of fit of every sampling routine against its pdf.
+mod chi2;
+// BSDF energy conservation, reciprocity and sample/eval/pdf consistency.
+mod bsdf;
+// NEE on/off and MIS variants converge to the same image.
+mod strategies;
+// Same seed, same film, whatever the thread count or pass split.
+mod determinism;
+// The command line: renders, comparisons and every kind of bad input.
+mod cli;
