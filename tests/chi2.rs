@@ -1,1 +1,393 @@
+//! Chi-square goodness-of-fit tests of every sampling routine against the pdf
+//! it claims (after Nori's `chi2test` and Mitsuba's `ChiSquare`).
+//!
+//! Directions are histogrammed over the whole sphere in (cos theta, phi)
+//! cells; expected counts integrate the claimed pdf over each cell (dω =
+//! d cos theta d phi) with a fine midpoint rule. Cells expecting fewer than 5
+//! samples are pooled. The null hypothesis "samples follow the pdf" is
+//! rejected at significance 1%, Šidák-corrected for the number of tests in
+//! this file, so a correct sampler fails with probability < 1% overall
+//! (and, with fixed seeds, deterministically passes once it passes).
 
+use glam::{Vec2, Vec3A};
+use std::f64::consts::PI;
+use tracelab::accel::{Geometry, NO_LIGHT, TriangleInput};
+use tracelab::math::{Frame, Rgb};
+use tracelab::sampling::hash::{hash_combine, to_unit_float};
+use tracelab::sampling::warp::*;
+use tracelab::scene::light::{Light, Lights, SphereSampling};
+use tracelab::scene::material::{Bsdf, fresnel_dielectric};
+
+/// Number of `assert_fits` calls below.
+const TESTS_IN_FILE: f64 = 12.0;
+const COS_BINS: usize = 20;
+const PHI_BINS: usize = 40;
+const SUBDIVISIONS: usize = 16;
+const SAMPLES: u64 = 500_000;
+
+/// Uniform numbers for test `seed`, sample `i`.
+fn uniform(seed: u64, i: u64, dim: u64) -> f32 {
+    to_unit_float(hash_combine(hash_combine(seed, i), dim))
+}
+
+/// ln Γ(x) for x > 0 (Lanczos, g = 7).
+fn ln_gamma(x: f64) -> f64 {
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    if x < 0.5 {
+        return (PI / (PI * x).sin()).ln() - ln_gamma(1.0 - x);
+    }
+    let x = x - 1.0;
+    let mut a = C[0];
+    let t = x + 7.5;
+    for (i, c) in C.iter().enumerate().skip(1) {
+        a += c / (x + i as f64);
+    }
+    0.5 * (2.0 * PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
+}
+
+/// Regularised upper incomplete gamma Q(a, x): the chi-square survival
+/// function is Q(dof / 2, chi2 / 2). Series for x < a + 1, else Lentz's
+/// continued fraction.
+fn gamma_q(a: f64, x: f64) -> f64 {
+    let prefactor = (-x + a * x.ln() - ln_gamma(a)).exp();
+    if x < a + 1.0 {
+        let (mut term, mut sum, mut ap) = (1.0 / a, 1.0 / a, a);
+        for _ in 0..10_000 {
+            ap += 1.0;
+            term *= x / ap;
+            sum += term;
+            if term.abs() < sum.abs() * 1e-15 {
+                break;
+            }
+        }
+        1.0 - sum * prefactor
+    } else {
+        let tiny = 1e-300;
+        let mut b = x + 1.0 - a;
+        let mut c = 1.0 / tiny;
+        let mut d = 1.0 / b;
+        let mut h = d;
+        for i in 1..10_000 {
+            let an = -(i as f64) * (i as f64 - a);
+            b += 2.0;
+            d = an * d + b;
+            if d.abs() < tiny {
+                d = tiny;
+            }
+            c = b + an / c;
+            if c.abs() < tiny {
+                c = tiny;
+            }
+            d = 1.0 / d;
+            let delta = d * c;
+            h *= delta;
+            if (delta - 1.0).abs() < 1e-15 {
+                break;
+            }
+        }
+        prefactor * h
+    }
+}
+
+/// Chi-square test of observed against expected counts; pools small cells.
+fn assert_fits(name: &str, observed: &[f64], expected: &[f64]) {
+    let mut cells: Vec<(f64, f64)> = observed.iter().copied().zip(expected.iter().copied()).collect();
+    cells.sort_by(|a, b| a.1.partial_cmp(&b.1).unwrap());
+    let (mut chi2, mut dof) = (0.0, 0usize);
+    let (mut pooled_obs, mut pooled_exp) = (0.0, 0.0);
+    for (o, e) in cells {
+        if e < 5.0 {
+            pooled_obs += o;
+            pooled_exp += e;
+            continue;
+        }
+        chi2 += (o - e) * (o - e) / e;
+        dof += 1;
+    }
+    if pooled_exp >= 5.0 {
+        chi2 += (pooled_obs - pooled_exp).powi(2) / pooled_exp;
+        dof += 1;
+    } else {
+        // Samples where nothing should be: any one of them is a failure.
+        assert!(pooled_obs <= 2.0 + 3.0 * pooled_exp, "{name}: {pooled_obs} samples in cells expecting {pooled_exp:.2}");
+    }
+    let dof = dof.saturating_sub(1).max(1);
+    let p_value = gamma_q(dof as f64 / 2.0, chi2 / 2.0);
+    let alpha = 1.0 - (1.0 - 0.01f64).powf(1.0 / TESTS_IN_FILE);
+    eprintln!("{name}: chi2 {chi2:.1}, dof {dof}, p {p_value:.4}");
+    assert!(p_value > alpha, "{name}: chi2 = {chi2:.1} with {dof} dof, p = {p_value:.2e} < {alpha:.2e}");
+}
+
+fn cell_of(w: Vec3A) -> usize {
+    let cos_theta = w.z.clamp(-1.0, 1.0) as f64;
+    let mut phi = (w.y as f64).atan2(w.x as f64);
+    if phi < 0.0 {
+        phi += 2.0 * PI;
+    }
+    let i = (((cos_theta + 1.0) * 0.5 * COS_BINS as f64) as usize).min(COS_BINS - 1);
+    let j = ((phi / (2.0 * PI) * PHI_BINS as f64) as usize).min(PHI_BINS - 1);
+    i * PHI_BINS + j
+}
+
+/// Histograms `SAMPLES` directions from `sample` (None = sample lost) and
+/// compares them with `pdf` (solid angle) integrated over each cell.
+fn check_directions(name: &str, mut sample: impl FnMut(u64) -> Option<Vec3A>, pdf: impl Fn(Vec3A) -> f64) {
+    let cells = COS_BINS * PHI_BINS;
+    let mut observed = vec![0.0; cells];
+    for i in 0..SAMPLES {
+        if let Some(w) = sample(i) {
+            assert!(w.is_finite() && (w.length() - 1.0).abs() < 1e-4, "{name}: bad direction {w:?}");
+            observed[cell_of(w.normalize())] += 1.0;
+        }
+    }
+    let mut expected = vec![0.0; cells];
+    let (d_cos, d_phi) = (2.0 / COS_BINS as f64, 2.0 * PI / PHI_BINS as f64);
+    // Midpoint rule on a sub-grid.
+    let integrate = |i: usize, j: usize, subdivisions: usize| -> (f64, bool) {
+        let (mut integral, mut zeros) = (0.0, 0usize);
+        for a in 0..subdivisions {
+            for b in 0..subdivisions {
+                let cos_theta = -1.0 + d_cos * (i as f64 + (a as f64 + 0.5) / subdivisions as f64);
+                let phi = d_phi * (j as f64 + (b as f64 + 0.5) / subdivisions as f64);
+                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+                let w = Vec3A::new((sin_theta * phi.cos()) as f32, (sin_theta * phi.sin()) as f32, cos_theta as f32);
+                let p = pdf(w);
+                zeros += usize::from(p == 0.0);
+                integral += p;
+            }
+        }
+        let partial = zeros > 0 && zeros < subdivisions * subdivisions;
+        (integral * d_cos * d_phi / (subdivisions * subdivisions) as f64, partial)
+    };
+    let mut partial = vec![false; cells];
+    for i in 0..COS_BINS {
+        for j in 0..PHI_BINS {
+            let (integral, is_partial) = integrate(i, j, SUBDIVISIONS);
+            expected[i * PHI_BINS + j] = integral;
+            partial[i * PHI_BINS + j] = is_partial;
+        }
+    }
+    // Refine cells the pdf partly covers and empty cells next to covered ones
+    // (a silhouette may clip a corner between sub-grid points).
+    let covered = |i: isize, j: isize| -> bool {
+        i >= 0 && i < COS_BINS as isize && expected[i as usize * PHI_BINS + j.rem_euclid(PHI_BINS as isize) as usize] > 0.0
+    };
+    let mut refined = expected.clone();
+    for i in 0..COS_BINS {
+        for j in 0..PHI_BINS {
+            let k = i * PHI_BINS + j;
+            let (ii, jj) = (i as isize, j as isize);
+            let near_covered = (-1..=1).any(|di| (-1..=1).any(|dj| covered(ii + di, jj + dj)));
+            if partial[k] || (expected[k] == 0.0 && near_covered) {
+                refined[k] = integrate(i, j, 8 * SUBDIVISIONS).0;
+            }
+        }
+    }
+    let expected: Vec<f64> = refined.iter().map(|e| e * SAMPLES as f64).collect();
+    assert_fits(name, &observed, &expected);
+}
+
+#[test]
+fn cosine_hemisphere() {
+    check_directions(
+        "cosine hemisphere",
+        |i| Some(square_to_cosine_hemisphere(Vec2::new(uniform(1, i, 0), uniform(1, i, 1)))),
+        |w| cosine_hemisphere_pdf(w) as f64,
+    );
+}
+
+#[test]
+fn phong_lobe() {
+    let exponent = 12.0;
+    check_directions(
+        "phong lobe n=12",
+        |i| Some(square_to_phong_lobe(Vec2::new(uniform(2, i, 0), uniform(2, i, 1)), exponent)),
+        |w| phong_lobe_pdf(w.z, exponent) as f64,
+    );
+}
+
+#[test]
+fn uniform_cone() {
+    check_directions(
+        "uniform cone cos_max=0.8",
+        |i| Some(square_to_uniform_cone(Vec2::new(uniform(3, i, 0), uniform(3, i, 1)), 0.8)),
+        |w| if w.z >= 0.8 { uniform_cone_pdf(0.8) as f64 } else { 0.0 },
+    );
+}
+
+fn check_bsdf(name: &str, bsdf: Bsdf, wo: Vec3A, seed: u64) {
+    check_directions(
+        name,
+        |i| {
+            let s = bsdf.sample(wo, uniform(seed, i, 0), Vec2::new(uniform(seed, i, 1), uniform(seed, i, 2)))?;
+            // The sample's own pdf and weight must agree with pdf() and eval().
+            let pdf = bsdf.pdf(wo, s.wi);
+            assert!((s.pdf - pdf).abs() <= 1e-4 * pdf.max(1.0), "{name}: sample pdf {} vs pdf() {pdf}", s.pdf);
+            let weight = bsdf.eval(wo, s.wi) * s.wi.z.abs() / pdf;
+            assert!((s.weight - weight).abs().max_element() <= 1e-3 * weight.max_element().max(1.0), "{name}: weight");
+            Some(s.wi)
+        },
+        |w| bsdf.pdf(wo, w) as f64,
+    );
+}
+
+#[test]
+fn diffuse_bsdf_from_both_sides() {
+    let bsdf = Bsdf::Diffuse { albedo: Rgb::splat(0.5) };
+    check_bsdf("diffuse, wo above", bsdf, Vec3A::new(0.3, 0.2, 0.9).normalize(), 4);
+    check_bsdf("diffuse, wo below", bsdf, Vec3A::new(0.3, 0.2, -0.9).normalize(), 5);
+}
+
+#[test]
+fn glossy_bsdf() {
+    let bsdf = Bsdf::glossy(Rgb::splat(0.3), Rgb::splat(0.6), 20.0);
+    check_bsdf("glossy n=20 at 40 deg", bsdf, Vec3A::new(40f32.to_radians().sin(), 0.0, 40f32.to_radians().cos()), 6);
+    check_bsdf("glossy n=20 at 80 deg", bsdf, Vec3A::new(80f32.to_radians().sin(), 0.0, 80f32.to_radians().cos()), 7);
+}
+
+/// A reference point, a big emissive triangle above it, and the lights and
+/// geometry to find where a direction lands on it.
+fn triangle_light() -> (Vec3A, Lights, Geometry) {
+    let reference = Vec3A::new(0.2, -0.1, 0.0);
+    let [p0, p1, p2] = [Vec3A::new(-1.0, -1.5, 0.8), Vec3A::new(1.5, -0.5, 1.2), Vec3A::new(-0.5, 1.5, 0.5)];
+    let (e1, e2) = (p1 - p0, p2 - p0);
+    // Facing down, towards the reference point.
+    let normal = -e1.cross(e2).normalize() * e1.cross(e2).normalize().z.signum();
+    let light = Light::Triangle {
+        p0,
+        e1,
+        e2,
+        normal,
+        area: 0.5 * e1.cross(e2).length(),
+        radiance: Rgb::ONE,
+        two_sided: false,
+    };
+    let geometry = Geometry::build(&[TriangleInput { vertices: [p0, p1, p2], material: 0 }], vec![]);
+    (reference, Lights::new(vec![light]), geometry)
+}
+
+#[test]
+fn triangle_light_area_sampling_in_solid_angle() {
+    let (reference, lights, geometry) = triangle_light();
+    check_directions(
+        "triangle light",
+        |i| {
+            let s = lights.sample(reference, uniform(8, i, 0), Vec2::new(uniform(8, i, 1), uniform(8, i, 2)))?;
+            Some(s.wi)
+        },
+        |w| match geometry.intersect(&tracelab::math::Ray::new(reference, w.normalize())) {
+            Some(hit) => lights.pdf(0, reference, hit.point, hit.normal) as f64,
+            None => 0.0,
+        },
+    );
+}
+
+#[test]
+fn triangle_light_points_are_uniform_by_area() {
+    // Barycentric histogram: each of 10x10 cells of the (b1, b2) square
+    // below the diagonal gets samples in proportion to its area in the triangle.
+    let n = 400_000u64;
+    let cells = 10;
+    let mut observed = vec![0.0; cells * cells];
+    for i in 0..n {
+        let b = square_to_uniform_triangle(Vec2::new(uniform(9, i, 0), uniform(9, i, 1)));
+        assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
+        let (x, y) = (((b.x * cells as f32) as usize).min(cells - 1), ((b.y * cells as f32) as usize).min(cells - 1));
+        observed[y * cells + x] += 1.0;
+    }
+    // Area of cell (x, y) inside b1 + b2 <= 1: full, half (on the diagonal) or none.
+    let h = 1.0 / cells as f64;
+    let expected: Vec<f64> = (0..cells * cells)
+        .map(|k| {
+            let (x, y) = (k % cells, k / cells);
+            let area = if x + y + 1 < cells { h * h } else if x + y + 1 == cells { h * h / 2.0 } else { 0.0 };
+            area * 2.0 * n as f64
+        })
+        .collect();
+    assert_fits("triangle barycentrics", &observed, &expected);
+}
+
+#[test]
+fn sphere_light_solid_angle_sampling() {
+    // Seen from the origin, the sphere subtends the cone cos theta >= 0.825,
+    // whose rim crosses the middle of a row of cells.
+    let reference = Vec3A::ZERO;
+    let center = Vec3A::new(0.0, 0.0, 1.0);
+    let radius = (1.0f32 - 0.825 * 0.825).sqrt();
+    let (sampling, seed) = (SphereSampling::SolidAngle, 10);
+    let lights = Lights::new(vec![Light::Sphere { center, radius, radiance: Rgb::ONE, two_sided: false, sampling }]);
+    let geometry = Geometry::build(&[], vec![tracelab::accel::Sphere { center, radius, material: 0, light: NO_LIGHT }]);
+    check_directions(
+        "sphere light, solid angle",
+        |i| {
+            let s = lights.sample(reference, uniform(seed, i, 0), Vec2::new(uniform(seed, i, 1), uniform(seed, i, 2)))?;
+            Some(s.wi)
+        },
+        |w| match geometry.intersect(&tracelab::math::Ray::new(reference, w.normalize())) {
+            Some(hit) => lights.pdf(0, reference, hit.point, hit.normal) as f64,
+            None => 0.0,
+        },
+    );
+}
+
+#[test]
+fn sphere_light_area_sampling_is_uniform_over_the_sphere() {
+    // Area sampling picks the normal (and so the point) uniformly on the
+    // sphere; its conversion to solid angle, d^2 / (|cos| A), is the one the
+    // triangle test above checks, and the sphere furnace (area sampling from
+    // inside) checks it for spheres. In solid angle its density diverges at
+    // the silhouette, where a cell integral cannot be computed accurately.
+    check_directions(
+        "uniform sphere",
+        |i| Some(square_to_uniform_sphere(Vec2::new(uniform(11, i, 0), uniform(11, i, 1)))),
+        |_| UNIFORM_SPHERE_PDF as f64,
+    );
+}
+
+#[test]
+fn dielectric_chooses_reflection_with_fresnel_probability() {
+    // Discrete two-outcome test per incidence angle, from outside and inside.
+    let bsdf = Bsdf::Dielectric { eta: 1.5, tint: Rgb::ONE };
+    let n = 200_000u64;
+    let mut observed = Vec::new();
+    let mut expected = Vec::new();
+    for (k, cos_o) in [0.95f32, 0.7, 0.3, 0.1, -0.95, -0.8].into_iter().enumerate() {
+        let sin_o = (1.0 - cos_o * cos_o).sqrt();
+        let wo = Vec3A::new(sin_o, 0.0, cos_o);
+        let f = fresnel_dielectric(cos_o, 1.5).reflectance as f64;
+        let mut reflected = 0.0;
+        for i in 0..n {
+            let s = bsdf.sample(wo, uniform(12 + k as u64, i, 0), Vec2::ZERO).unwrap();
+            assert!(s.specular);
+            if s.wi.z * wo.z > 0.0 {
+                reflected += 1.0;
+            }
+        }
+        observed.extend([reflected, n as f64 - reflected]);
+        expected.extend([f * n as f64, (1.0 - f) * n as f64]);
+    }
+    assert_fits("dielectric reflect/refract", &observed, &expected);
+    // And the directions themselves obey the law of reflection and Snell's law.
+    let frame = Frame::from_normal(Vec3A::Z);
+    let wo = frame.to_local(Vec3A::new(0.5, 0.1, 0.7).normalize());
+    let reflected = bsdf.sample(wo, 0.0, Vec2::ZERO).unwrap().wi;
+    assert!((reflected - Vec3A::new(-wo.x, -wo.y, wo.z)).length() < 1e-6);
+}
+
+#[test]
+fn chi_square_survival_function_is_right() {
+    // Known values: Q(1, 1) = e^-1; chi2 with 10 dof at 18.307 has p = 0.05.
+    assert!((gamma_q(1.0, 1.0) - (-1.0f64).exp()).abs() < 1e-10);
+    assert!((gamma_q(5.0, 18.307 / 2.0) - 0.05).abs() < 1e-4);
+    assert!((gamma_q(50.0, 40.0) - 0.929_665).abs() < 1e-5);
+}
