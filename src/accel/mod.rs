@@ -6,8 +6,15 @@
 //! primitives are contiguous in memory and the traversal's primitive index
 //! addresses them directly (obvhs `primitive_indices` applied once at build).
 
+mod soup;
+mod sphere;
+mod triangle;
+
 use crate::math::{Ray, gamma};
-use glam::{Mat3A, Vec3A};
+use glam::Vec3A;
+use soup::TriangleSoup;
+use sphere::intersect_sphere;
+use triangle::ShearedRay;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
@@ -51,10 +58,37 @@ pub struct SurfaceHit {
     pub light: u32,
 }
 
+/// How triangles are searched.
+#[derive(Clone, Debug, Default)]
+enum TriangleIndex {
+    #[default]
+    Empty,
+    /// Every triangle tested, eight per instruction: faster below
+    /// [`SOUP_MAX_TRIANGLES`] triangles.
+    Soup(TriangleSoup),
+    /// obvhs CWBVH.
+    Bvh(CwBvh),
+}
+
+/// Which triangle index to build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum AccelChoice {
+    /// A soup for small meshes, a BVH otherwise.
+    #[default]
+    Auto,
+    Bvh,
+    Soup,
+}
+
+/// Largest mesh tested without a BVH. Measured with `cargo bench --bench
+/// rays` (closest-hit, incoherent): the soup wins clearly on the 36-triangle
+/// Cornell box and the two meet at about this size.
+pub const SOUP_MAX_TRIANGLES: usize = 64;
+
 /// The scene's geometry with its acceleration structures.
 #[derive(Clone, Debug, Default)]
 pub struct Geometry {
-    tri_bvh: Option<CwBvh>,
+    tri_index: TriangleIndex,
     /// Vertices in BVH order.
     tri_vertices: Vec<[Vec3A; 3]>,
     tri_material: Vec<u32>,
@@ -63,116 +97,6 @@ pub struct Geometry {
     spheres: Vec<Sphere>,
 }
 
-/// Per-ray constants of the watertight test (Woop, Benthin & Wald, JCGT 2013):
-/// a change of basis that permutes the ray's dominant axis to z and shears the
-/// ray onto +z. The edge functions are then exact in sign, so rays through a
-/// shared edge or vertex hit exactly one of the triangles (watertight). The
-/// permutation and shear are folded into one matrix, so each vertex costs one
-/// SIMD matrix-vector product instead of per-component indexing; the zero
-/// entries add exact zeros, so results equal the textbook formulation.
-#[derive(Clone, Copy)]
-struct ShearedRay {
-    origin: Vec3A,
-    shear: Mat3A,
-}
-
-impl ShearedRay {
-    #[inline]
-    fn new(ray: &Ray) -> Self {
-        let d = ray.direction;
-        let kz = d.abs().max_position();
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let (sx, sy, sz) = (d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
-        let axis = |k: usize| Vec3A::AXES[k];
-        // Rows: x' = v[kx] - sx v[kz], y' = v[ky] - sy v[kz], z' = sz v[kz].
-        let rows = [axis(kx) - sx * axis(kz), axis(ky) - sy * axis(kz), sz * axis(kz)];
-        ShearedRay { origin: ray.origin, shear: Mat3A::from_cols(rows[0], rows[1], rows[2]).transpose() }
-    }
-
-    /// Returns (t, b1, b2) of a hit in (0, t_max), or None.
-    #[inline(always)]
-    fn intersect(&self, v: &[Vec3A; 3], t_max: f32) -> Option<(f32, f32, f32)> {
-        let a = self.shear * (v[0] - self.origin);
-        let b = self.shear * (v[1] - self.origin);
-        let c = self.shear * (v[2] - self.origin);
-        let mut e0 = c.x * b.y - c.y * b.x;
-        let mut e1 = a.x * c.y - a.y * c.x;
-        let mut e2 = b.x * a.y - b.y * a.x;
-        // Exactly zero edge functions are ambiguous in single precision:
-        // redo them in double so that shared edges are never missed.
-        if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-            let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
-            e0 = (c.x * b.y - c.y * b.x) as f32;
-            e1 = (a.x * c.y - a.y * c.x) as f32;
-            e2 = (b.x * a.y - b.y * a.x) as f32;
-        }
-        if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
-            return None;
-        }
-        let det = e0 + e1 + e2;
-        if det == 0.0 {
-            return None;
-        }
-        let t_scaled = e0 * a.z + e1 * b.z + e2 * c.z;
-        // Compare t * det against (0, t_max * det) without dividing.
-        let sign = det.signum();
-        let (t_abs, det_abs) = (t_scaled * sign, det.abs());
-        if t_abs <= 0.0 || t_abs >= t_max * det_abs {
-            return None;
-        }
-        let inv_det = 1.0 / det;
-        let t = t_scaled * inv_det;
-        // Reject hits whose t is not provably positive given the rounding of
-        // the computation (pbrt-v4, 6.8.4 "Conservative Ray-Triangle t").
-        let max_z = a.z.abs().max(b.z.abs()).max(c.z.abs());
-        let max_x = a.x.abs().max(b.x.abs()).max(c.x.abs());
-        let max_y = a.y.abs().max(b.y.abs()).max(c.y.abs());
-        let delta_z = gamma(3) * max_z;
-        let delta_x = gamma(5) * (max_x + max_z);
-        let delta_y = gamma(5) * (max_y + max_z);
-        let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-        let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-        let delta_t = 3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
-        if t <= delta_t {
-            return None;
-        }
-        Some((t, e1 * inv_det, e2 * inv_det))
-    }
-}
-
-/// Nearest sphere intersection in (0, t_max) for a unit-length direction.
-/// The discriminant is computed from the perpendicular distance to the centre
-/// (pbrt-v4, 6.8.1), which stays accurate when the sphere is small and far away.
-#[inline(always)]
-fn intersect_sphere(origin: Vec3A, direction: Vec3A, center: Vec3A, radius: f32, t_max: f32) -> Option<f32> {
-    let f = origin - center;
-    let b = f.dot(direction);
-    let perp = f - b * direction;
-    let discriminant = radius * radius - perp.length_squared();
-    if discriminant < 0.0 {
-        return None;
-    }
-    let c = f.length_squared() - radius * radius;
-    let q = -b - discriminant.sqrt().copysign(b);
-    let (mut t0, mut t1) = (c / q, q);
-    if t0 > t1 {
-        std::mem::swap(&mut t0, &mut t1);
-    }
-    if t0 > 0.0 && t0 < t_max {
-        Some(t0)
-    } else if t1 > 0.0 && t1 < t_max {
-        Some(t1)
-    } else {
-        None
-    }
-}
-
-/// medium_build: PLOC with reinsertion; leaf size does not matter much here
-/// (measured on the Cornell box: within 5% from 1 to 3 triangles per leaf).
 /// The obvhs ray for `ray`. A direction component of -0.0 must become +0.0:
 /// obvhs takes the ray octant from `< 0.0` but the reciprocal's sign from the
 /// sign bit, and with the two disagreeing the traversal misses everything
@@ -190,8 +114,25 @@ fn build_params() -> BvhBuildParams {
 impl Geometry {
     /// Builds the BVHs and stores the triangles in leaf order.
     pub fn build(triangles: &[TriangleInput], spheres: Vec<Sphere>) -> Self {
+        Self::build_with(triangles, spheres, AccelChoice::Auto)
+    }
+
+    /// Builds with a chosen triangle index (for tests and benchmarks).
+    pub fn build_with(triangles: &[TriangleInput], spheres: Vec<Sphere>, choice: AccelChoice) -> Self {
         let mut geometry = Geometry::default();
-        if !triangles.is_empty() {
+        let use_soup = match choice {
+            AccelChoice::Auto => triangles.len() <= SOUP_MAX_TRIANGLES,
+            AccelChoice::Bvh => false,
+            AccelChoice::Soup => true,
+        };
+        if !triangles.is_empty() && use_soup {
+            for t in triangles {
+                geometry.tri_vertices.push(t.vertices);
+                geometry.tri_material.push(t.material);
+                geometry.tri_light.push(NO_LIGHT);
+            }
+            geometry.tri_index = TriangleIndex::Soup(TriangleSoup::new(&geometry.tri_vertices));
+        } else if !triangles.is_empty() {
             let aabbs: Vec<Aabb> = triangles.iter().map(|t| Aabb::from_points(&t.vertices)).collect();
             let bvh = build_cwbvh(&aabbs, build_params(), &mut Duration::default());
             for &i in &bvh.primitive_indices {
@@ -200,7 +141,7 @@ impl Geometry {
                 geometry.tri_material.push(t.material);
                 geometry.tri_light.push(NO_LIGHT);
             }
-            geometry.tri_bvh = Some(bvh);
+            geometry.tri_index = TriangleIndex::Bvh(bvh);
         }
         if !spheres.is_empty() {
             let aabbs: Vec<Aabb> = spheres
@@ -247,8 +188,8 @@ impl Geometry {
     /// Bounding box of everything.
     pub fn bounds(&self) -> Aabb {
         let mut b = Aabb::empty();
-        if let Some(bvh) = &self.tri_bvh {
-            b = b.union(&bvh.total_aabb);
+        for t in &self.tri_vertices {
+            b = b.union(&Aabb::from_points(t));
         }
         if let Some(bvh) = &self.sphere_bvh {
             b = b.union(&bvh.total_aabb);
@@ -260,28 +201,35 @@ impl Geometry {
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
         let mut best_t = ray.t_max;
-        let mut best_tri = u32::MAX;
-        let (mut best_b1, mut best_b2) = (0.0, 0.0);
-        if let Some(bvh) = &self.tri_bvh {
-            let sheared = ShearedRay::new(ray);
-            let bvh_ray = bvh_ray(ray, best_t);
-            let mut hit = obvhs::ray::RayHit::none();
-            bvh.ray_traverse(bvh_ray, &mut hit, |r, id| match sheared.intersect(&self.tri_vertices[id], r.tmax) {
-                Some((t, b1, b2)) => {
-                    best_b1 = b1;
-                    best_b2 = b2;
-                    best_tri = id as u32;
-                    t
+        let (mut best_tri, mut best_b1, mut best_b2) = (u32::MAX, 0.0, 0.0);
+        match &self.tri_index {
+            TriangleIndex::Empty => {}
+            TriangleIndex::Soup(soup) => {
+                if let Some((i, t, b1, b2)) = soup.closest(ray, best_t, &self.tri_vertices) {
+                    (best_tri, best_t, best_b1, best_b2) = (i as u32, t, b1, b2);
                 }
-                None => f32::INFINITY,
-            });
-            best_t = best_t.min(hit.t);
+            }
+            TriangleIndex::Bvh(bvh) => {
+                let sheared = ShearedRay::new(ray);
+                let mut hit = obvhs::ray::RayHit::none();
+                bvh.ray_traverse(bvh_ray(ray, best_t), &mut hit, |r, id| {
+                    match sheared.intersect(&self.tri_vertices[id], r.tmax) {
+                        Some((t, b1, b2)) => {
+                            best_b1 = b1;
+                            best_b2 = b2;
+                            best_tri = id as u32;
+                            t
+                        }
+                        None => f32::INFINITY,
+                    }
+                });
+                best_t = best_t.min(hit.t);
+            }
         }
         let mut best_sphere = u32::MAX;
         if let Some(bvh) = &self.sphere_bvh {
-            let bvh_ray = bvh_ray(ray, best_t);
             let mut hit = obvhs::ray::RayHit::none();
-            bvh.ray_traverse(bvh_ray, &mut hit, |r, id| {
+            bvh.ray_traverse(bvh_ray(ray, best_t), &mut hit, |r, id| {
                 let s = &self.spheres[id];
                 intersect_sphere(r.origin, r.direction, s.center, s.radius, r.tmax).unwrap_or(f32::INFINITY)
             });
@@ -327,19 +275,21 @@ impl Geometry {
     /// True when anything blocks `ray` in (0, ray.t_max) (shadow rays).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        if let Some(bvh) = &self.tri_bvh {
-            let sheared = ShearedRay::new(ray);
-            let bvh_ray = bvh_ray(ray, ray.t_max);
-            let miss = bvh.ray_traverse_miss(bvh_ray, |r, id| {
-                sheared.intersect(&self.tri_vertices[id], r.tmax).map_or(f32::INFINITY, |h| h.0)
-            });
-            if !miss {
-                return true;
+        let triangle_blocks = match &self.tri_index {
+            TriangleIndex::Empty => false,
+            TriangleIndex::Soup(soup) => soup.any(ray, ray.t_max, &self.tri_vertices),
+            TriangleIndex::Bvh(bvh) => {
+                let sheared = ShearedRay::new(ray);
+                !bvh.ray_traverse_miss(bvh_ray(ray, ray.t_max), |r, id| {
+                    sheared.intersect(&self.tri_vertices[id], r.tmax).map_or(f32::INFINITY, |h| h.0)
+                })
             }
+        };
+        if triangle_blocks {
+            return true;
         }
         if let Some(bvh) = &self.sphere_bvh {
-            let bvh_ray = bvh_ray(ray, ray.t_max);
-            let miss = bvh.ray_traverse_miss(bvh_ray, |r, id| {
+            let miss = bvh.ray_traverse_miss(bvh_ray(ray, ray.t_max), |r, id| {
                 let s = &self.spheres[id];
                 intersect_sphere(r.origin, r.direction, s.center, s.radius, r.tmax).unwrap_or(f32::INFINITY)
             });
