@@ -58,6 +58,23 @@ pub struct SurfaceHit {
     pub light: u32,
 }
 
+/// Per-triangle data read once per hit.
+#[derive(Clone, Copy, Debug)]
+struct TriangleShading {
+    /// Unit geometric normal, precomputed: saves a cross product and a
+    /// normalisation per hit.
+    normal: Vec3A,
+    material: u32,
+    light: u32,
+}
+
+impl TriangleShading {
+    fn new(t: &TriangleInput) -> Self {
+        let [p0, p1, p2] = t.vertices;
+        TriangleShading { normal: (p1 - p0).cross(p2 - p0).normalize(), material: t.material, light: NO_LIGHT }
+    }
+}
+
 /// How triangles are searched.
 #[derive(Clone, Debug, Default)]
 enum TriangleIndex {
@@ -91,8 +108,8 @@ pub struct Geometry {
     tri_index: TriangleIndex,
     /// Vertices in BVH order.
     tri_vertices: Vec<[Vec3A; 3]>,
-    tri_material: Vec<u32>,
-    tri_light: Vec<u32>,
+    /// What a hit needs besides the position, one cache line per triangle.
+    tri_shading: Vec<TriangleShading>,
     sphere_bvh: Option<CwBvh>,
     spheres: Vec<Sphere>,
 }
@@ -128,8 +145,7 @@ impl Geometry {
         if !triangles.is_empty() && use_soup {
             for t in triangles {
                 geometry.tri_vertices.push(t.vertices);
-                geometry.tri_material.push(t.material);
-                geometry.tri_light.push(NO_LIGHT);
+                geometry.tri_shading.push(TriangleShading::new(t));
             }
             geometry.tri_index = TriangleIndex::Soup(TriangleSoup::new(&geometry.tri_vertices));
         } else if !triangles.is_empty() {
@@ -138,8 +154,7 @@ impl Geometry {
             for &i in &bvh.primitive_indices {
                 let t = &triangles[i as usize];
                 geometry.tri_vertices.push(t.vertices);
-                geometry.tri_material.push(t.material);
-                geometry.tri_light.push(NO_LIGHT);
+                geometry.tri_shading.push(TriangleShading::new(t));
             }
             geometry.tri_index = TriangleIndex::Bvh(bvh);
         }
@@ -167,7 +182,7 @@ impl Geometry {
 
     /// Material of triangle `i` (BVH order).
     pub fn triangle_material(&self, i: usize) -> u32 {
-        self.tri_material[i]
+        self.tri_shading[i].material
     }
 
     /// Spheres in BVH order.
@@ -177,7 +192,7 @@ impl Geometry {
 
     /// Marks triangle `i` (BVH order) as light `light`.
     pub fn set_triangle_light(&mut self, i: usize, light: u32) {
-        self.tri_light[i] = light;
+        self.tri_shading[i].light = light;
     }
 
     /// Marks sphere `i` (BVH order) as light `light`.
@@ -259,6 +274,7 @@ impl Geometry {
         }
         let i = best_tri as usize;
         let [p0, p1, p2] = self.tri_vertices[i];
+        let shading = self.tri_shading[i];
         let b0 = 1.0 - best_b1 - best_b2;
         let point = b0 * p0 + best_b1 * p1 + best_b2 * p2;
         Some(SurfaceHit {
@@ -266,9 +282,9 @@ impl Geometry {
             point,
             // Barycentric interpolation (pbrt-v4 6.8.4).
             error: gamma(7) * ((b0 * p0).abs() + (best_b1 * p1).abs() + (best_b2 * p2).abs()),
-            normal: (p1 - p0).cross(p2 - p0).normalize(),
-            material: self.tri_material[i],
-            light: self.tri_light[i],
+            normal: shading.normal,
+            material: shading.material,
+            light: shading.light,
         })
     }
 
