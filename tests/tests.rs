@@ -15,5 +15,7 @@ mod bsdf;
 mod strategies;
 // Same seed, same film, whatever the thread count or pass split.
 mod determinism;
+// Every scene in scenes/ renders without non-finite samples.
+mod scenes;
 // The command line: renders, comparisons and every kind of bad input.
 mod cli;

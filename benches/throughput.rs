@@ -1,0 +1,131 @@
+//! Throughput benchmarks (a benchmark, never a test): `cargo bench --bench throughput`.
+//!
+//! 1. Camera paths/s: the Cornell box, 256x256, up to 8 bounces, NEE + MIS,
+//!    independent sampler, with 1 and 2 threads (median of 5 renders).
+//! 2. Incoherent closest-hit and any-hit rays/s on UV spheres of about 100k
+//!    and 1M triangles (CWBVH), 1 and 2 threads: rays start on a sphere of
+//!    radius 2 around the mesh and aim at uniform points inside the unit
+//!    ball, so neighbouring rays share nothing.
+//! 3. The same on the Cornell box, with its 8-wide triangle soup and with a BVH.
+
+use glam::{Vec2, Vec3A};
+use rayon::prelude::*;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+use tracelab::accel::{AccelChoice, Geometry, TriangleInput};
+use tracelab::integrator::{Integrator, PathTracer};
+use tracelab::math::Ray;
+use tracelab::render::{RenderSettings, Session};
+use tracelab::sampling::SamplerKind;
+use tracelab::sampling::hash::{hash_combine, to_unit_float};
+use tracelab::sampling::warp::square_to_uniform_sphere;
+use tracelab::scene::Scene;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    v[v.len() / 2]
+}
+
+fn paths_per_second(threads: usize) -> f64 {
+    let scene = Arc::new(Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml")).unwrap());
+    let runs = (0..5)
+        .map(|seed| {
+            let settings = RenderSettings {
+                integrator: Integrator::Path(PathTracer::default()),
+                sampler: SamplerKind::Independent,
+                seed,
+                planned_spp: 32,
+                threads,
+            };
+            let session = Session::new(scene.clone(), settings).unwrap();
+            for _ in 0..4 {
+                session.render_pass(8);
+            }
+            let stats = session.stats();
+            stats.samples as f64 / stats.render_time.as_secs_f64()
+        })
+        .collect();
+    median(runs)
+}
+
+/// UV sphere of radius 1 with about `2 * n * n` triangles.
+fn uv_sphere(n: usize) -> Vec<TriangleInput> {
+    let point = |i: usize, j: usize| {
+        let theta = std::f32::consts::PI * i as f32 / n as f32;
+        let phi = 2.0 * std::f32::consts::PI * j as f32 / n as f32;
+        Vec3A::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+    };
+    let mut triangles = Vec::with_capacity(2 * n * n);
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1));
+            triangles.push(TriangleInput { vertices: [a, b, c], material: 0 });
+            triangles.push(TriangleInput { vertices: [a, c, d], material: 0 });
+        }
+    }
+    triangles
+}
+
+fn incoherent_rays(count: u64, radius: f32, center: Vec3A, spread: f32) -> Vec<Ray> {
+    (0..count)
+        .map(|i| {
+            let u = |k| to_unit_float(hash_combine(k, i));
+            let origin = center + radius * square_to_uniform_sphere(Vec2::new(u(1), u(2)));
+            let target = center + spread * u(5).cbrt() * square_to_uniform_sphere(Vec2::new(u(3), u(4)));
+            Ray::new(origin, (target - origin).normalize())
+        })
+        .collect()
+}
+
+/// Rays per second of `trace` over `rays` with `threads` threads (median of 3).
+fn rays_per_second(rays: &[Ray], threads: usize, trace: impl Fn(&Ray) -> bool + Sync) -> f64 {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    let runs = (0..3)
+        .map(|_| {
+            let start = Instant::now();
+            let hits: usize = pool.install(|| rays.par_chunks(4096).map(|c| c.iter().filter(|r| trace(r)).count()).sum());
+            std::hint::black_box(hits);
+            rays.len() as f64 / start.elapsed().as_secs_f64()
+        })
+        .collect();
+    median(runs)
+}
+
+fn report_geometry(name: &str, geometry: &Geometry, rays: &[Ray], build: Duration) {
+    for threads in [1, 2] {
+        let closest = rays_per_second(rays, threads, |r| geometry.intersect(r).is_some());
+        let any = rays_per_second(rays, threads, |r| geometry.occluded(r));
+        println!(
+            "{name:<34} {threads} thread(s): closest hit {:6.2} M rays/s, any hit {:6.2} M rays/s (build {:.0} ms)",
+            closest * 1e-6,
+            any * 1e-6,
+            build.as_secs_f64() * 1e3
+        );
+    }
+}
+
+fn main() {
+    println!("machine: {} logical CPUs", std::thread::available_parallelism().map_or(0, |n| n.get()));
+    for threads in [1, 2] {
+        println!("Cornell box 256x256, path tracing (8 bounces, NEE+MIS), {threads} thread(s): {:.3} M paths/s", paths_per_second(threads) * 1e-6);
+    }
+    let cornell = Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml")).unwrap();
+    let cornell_tris: Vec<TriangleInput> = (0..cornell.geometry.triangle_count())
+        .map(|i| TriangleInput { vertices: cornell.geometry.triangles()[i], material: 0 })
+        .collect();
+    let rays = incoherent_rays(2_000_000, 250.0, Vec3A::new(278.0, 274.0, 280.0), 250.0);
+    for (name, choice) in [("Cornell box (36 tris), soup", AccelChoice::Soup), ("Cornell box (36 tris), CWBVH", AccelChoice::Bvh)] {
+        let start = Instant::now();
+        let g = Geometry::build_with(&cornell_tris, vec![], choice);
+        report_geometry(name, &g, &rays, start.elapsed());
+    }
+    for n in [224, 708] {
+        let triangles = uv_sphere(n);
+        let start = Instant::now();
+        let g = Geometry::build_with(&triangles, vec![], AccelChoice::Bvh);
+        let build = start.elapsed();
+        let rays = incoherent_rays(2_000_000, 2.0, Vec3A::ZERO, 1.0);
+        report_geometry(&format!("UV sphere ({} tris), CWBVH", triangles.len()), &g, &rays, build);
+    }
+}

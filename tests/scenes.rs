@@ -1,0 +1,29 @@
+//! Every scene shipped in `scenes/` loads without warnings and renders
+//! without a single non-finite sample.
+
+use crate::common::{render, repo_path};
+use tracelab::integrator::{Integrator, PathTracer};
+use tracelab::sampling::SamplerKind;
+use tracelab::scene::Scene;
+
+#[test]
+fn every_shipped_scene_renders_cleanly() {
+    let mut count = 0;
+    for entry in std::fs::read_dir(repo_path("scenes")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let mut scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert!(scene.warnings.is_empty(), "{}: {:?}", path.display(), scene.warnings);
+        scene.set_resolution(40, 30);
+        for nee in [true, false] {
+            let tracer = PathTracer { nee, ..Default::default() };
+            let (snapshot, stats) = render(scene.clone(), Integrator::Path(tracer), SamplerKind::Stratified, 16, 1);
+            assert_eq!(stats.non_finite, 0, "{}", path.display());
+            assert!(snapshot.image.mean().iter().all(|&m| m > 0.0), "{} renders black", path.display());
+        }
+        count += 1;
+    }
+    assert!(count >= 3);
+}
