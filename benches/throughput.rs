@@ -7,6 +7,7 @@
 //!    radius 2 around the mesh and aim at uniform points inside the unit
 //!    ball, so neighbouring rays share nothing.
 //! 3. The same on the Cornell box, with its 8-wide triangle soup and with a BVH.
+//! 4. Coherent rays (one origin, a scanline grid of directions) on the spheres.
 
 use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
@@ -78,6 +79,19 @@ fn incoherent_rays(count: u64, radius: f32, center: Vec3A, spread: f32) -> Vec<R
         .collect()
 }
 
+/// Primary-ray-like rays: one origin at distance 3, directions through a
+/// square grid covering the unit sphere, in scanline order.
+fn coherent_rays(side: u64) -> Vec<Ray> {
+    let origin = Vec3A::new(0.0, 0.0, 3.0);
+    (0..side * side)
+        .map(|i| {
+            let (x, y) = ((i % side) as f32 / side as f32, (i / side) as f32 / side as f32);
+            let target = Vec3A::new(2.2 * x - 1.1, 1.1 - 2.2 * y, 0.0);
+            Ray::new(origin, (target - origin).normalize())
+        })
+        .collect()
+}
+
 /// Rays per second of `trace` over `rays` with `threads` threads (median of 3).
 fn rays_per_second(rays: &[Ray], threads: usize, trace: impl Fn(&Ray) -> bool + Sync) -> f64 {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
@@ -126,6 +140,8 @@ fn main() {
         let g = Geometry::build_with(&triangles, vec![], AccelChoice::Bvh);
         let build = start.elapsed();
         let rays = incoherent_rays(2_000_000, 2.0, Vec3A::ZERO, 1.0);
-        report_geometry(&format!("UV sphere ({} tris), CWBVH", triangles.len()), &g, &rays, build);
+        report_geometry(&format!("UV sphere ({} tris), incoherent", triangles.len()), &g, &rays, build);
+        let rays = coherent_rays(1414);
+        report_geometry(&format!("UV sphere ({} tris), coherent", triangles.len()), &g, &rays, build);
     }
 }

@@ -43,7 +43,8 @@ pub const DEFAULT_BATCH: u32 = 64;
 pub struct Sampler {
     kind: SamplerKind,
     seed_key: u64,
-    pixel_key: u64,
+    /// Key of (seed, pixel, batch): seeds the per-dimension strata permutations.
+    batch_key: u64,
     sample_key: u64,
     sample_index: u32,
     dimension: u32,
@@ -69,7 +70,7 @@ impl Sampler {
         Sampler {
             kind,
             seed_key: mix64(seed ^ 0x5851_f42d_4c95_7f2d),
-            pixel_key: 0,
+            batch_key: 0,
             sample_key: 0,
             sample_index: 0,
             dimension: 0,
@@ -87,8 +88,9 @@ impl Sampler {
     /// Positions the sampler at dimension 0 of sample `sample_index` of `pixel`.
     #[inline]
     pub fn start(&mut self, pixel: u32, sample_index: u32) {
-        self.pixel_key = hash_combine(self.seed_key, pixel as u64);
-        self.sample_key = hash_combine(self.pixel_key, sample_index as u64);
+        let pixel_key = hash_combine(self.seed_key, pixel as u64);
+        self.sample_key = hash_combine(pixel_key, sample_index as u64);
+        self.batch_key = hash_combine(pixel_key, 0x8000_0000_0000_0000 | (sample_index / self.batch) as u64);
         self.sample_index = sample_index;
         self.dimension = 0;
     }
@@ -108,8 +110,7 @@ impl Sampler {
     /// Permutation seed shared by all samples of one batch in one dimension.
     #[inline]
     fn stratum(&self, dim: u32) -> u32 {
-        let batch_index = self.sample_index / self.batch;
-        let key = hash_combine(hash_combine(self.pixel_key, 0x8000_0000_0000_0000 | dim as u64), batch_index as u64);
+        let key = hash_combine(self.batch_key, dim as u64);
         permute(self.sample_index % self.batch, self.batch, key as u32)
     }
 
