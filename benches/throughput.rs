@@ -29,7 +29,10 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn paths_per_second(threads: usize) -> f64 {
-    let scene = Arc::new(Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml")).unwrap());
+    let scene = Arc::new(
+        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml"))
+            .unwrap(),
+    );
     let runs = (0..5)
         .map(|seed| {
             let settings = RenderSettings {
@@ -55,14 +58,29 @@ fn uv_sphere(n: usize) -> Vec<TriangleInput> {
     let point = |i: usize, j: usize| {
         let theta = std::f32::consts::PI * i as f32 / n as f32;
         let phi = 2.0 * std::f32::consts::PI * j as f32 / n as f32;
-        Vec3A::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+        Vec3A::new(
+            theta.sin() * phi.cos(),
+            theta.cos(),
+            theta.sin() * phi.sin(),
+        )
     };
     let mut triangles = Vec::with_capacity(2 * n * n);
     for i in 0..n {
         for j in 0..n {
-            let (a, b, c, d) = (point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1));
-            triangles.push(TriangleInput { vertices: [a, b, c], material: 0 });
-            triangles.push(TriangleInput { vertices: [a, c, d], material: 0 });
+            let (a, b, c, d) = (
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            );
+            triangles.push(TriangleInput {
+                vertices: [a, b, c],
+                material: 0,
+            });
+            triangles.push(TriangleInput {
+                vertices: [a, c, d],
+                material: 0,
+            });
         }
     }
     triangles
@@ -73,7 +91,8 @@ fn incoherent_rays(count: u64, radius: f32, center: Vec3A, spread: f32) -> Vec<R
         .map(|i| {
             let u = |k| to_unit_float(hash_combine(k, i));
             let origin = center + radius * square_to_uniform_sphere(Vec2::new(u(1), u(2)));
-            let target = center + spread * u(5).cbrt() * square_to_uniform_sphere(Vec2::new(u(3), u(4)));
+            let target =
+                center + spread * u(5).cbrt() * square_to_uniform_sphere(Vec2::new(u(3), u(4)));
             Ray::new(origin, (target - origin).normalize())
         })
         .collect()
@@ -85,7 +104,10 @@ fn coherent_rays(side: u64) -> Vec<Ray> {
     let origin = Vec3A::new(0.0, 0.0, 3.0);
     (0..side * side)
         .map(|i| {
-            let (x, y) = ((i % side) as f32 / side as f32, (i / side) as f32 / side as f32);
+            let (x, y) = (
+                (i % side) as f32 / side as f32,
+                (i / side) as f32 / side as f32,
+            );
             let target = Vec3A::new(2.2 * x - 1.1, 1.1 - 2.2 * y, 0.0);
             Ray::new(origin, (target - origin).normalize())
         })
@@ -94,11 +116,18 @@ fn coherent_rays(side: u64) -> Vec<Ray> {
 
 /// Rays per second of `trace` over `rays` with `threads` threads (median of 3).
 fn rays_per_second(rays: &[Ray], threads: usize, trace: impl Fn(&Ray) -> bool + Sync) -> f64 {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
     let runs = (0..3)
         .map(|_| {
             let start = Instant::now();
-            let hits: usize = pool.install(|| rays.par_chunks(4096).map(|c| c.iter().filter(|r| trace(r)).count()).sum());
+            let hits: usize = pool.install(|| {
+                rays.par_chunks(4096)
+                    .map(|c| c.iter().filter(|r| trace(r)).count())
+                    .sum()
+            });
             std::hint::black_box(hits);
             rays.len() as f64 / start.elapsed().as_secs_f64()
         })
@@ -120,16 +149,30 @@ fn report_geometry(name: &str, geometry: &Geometry, rays: &[Ray], build: Duratio
 }
 
 fn main() {
-    println!("machine: {} logical CPUs", std::thread::available_parallelism().map_or(0, |n| n.get()));
+    println!(
+        "machine: {} logical CPUs",
+        std::thread::available_parallelism().map_or(0, |n| n.get())
+    );
     for threads in [1, 2] {
-        println!("Cornell box 256x256, path tracing (8 bounces, NEE+MIS), {threads} thread(s): {:.3} M paths/s", paths_per_second(threads) * 1e-6);
+        println!(
+            "Cornell box 256x256, path tracing (8 bounces, NEE+MIS), {threads} thread(s): {:.3} M paths/s",
+            paths_per_second(threads) * 1e-6
+        );
     }
-    let cornell = Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml")).unwrap();
+    let cornell =
+        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml"))
+            .unwrap();
     let cornell_tris: Vec<TriangleInput> = (0..cornell.geometry.triangle_count())
-        .map(|i| TriangleInput { vertices: cornell.geometry.triangles()[i], material: 0 })
+        .map(|i| TriangleInput {
+            vertices: cornell.geometry.triangles()[i],
+            material: 0,
+        })
         .collect();
     let rays = incoherent_rays(2_000_000, 250.0, Vec3A::new(278.0, 274.0, 280.0), 250.0);
-    for (name, choice) in [("Cornell box (36 tris), soup", AccelChoice::Soup), ("Cornell box (36 tris), CWBVH", AccelChoice::Bvh)] {
+    for (name, choice) in [
+        ("Cornell box (36 tris), soup", AccelChoice::Soup),
+        ("Cornell box (36 tris), CWBVH", AccelChoice::Bvh),
+    ] {
         let start = Instant::now();
         let g = Geometry::build_with(&cornell_tris, vec![], choice);
         report_geometry(name, &g, &rays, start.elapsed());
@@ -140,8 +183,18 @@ fn main() {
         let g = Geometry::build_with(&triangles, vec![], AccelChoice::Bvh);
         let build = start.elapsed();
         let rays = incoherent_rays(2_000_000, 2.0, Vec3A::ZERO, 1.0);
-        report_geometry(&format!("UV sphere ({} tris), incoherent", triangles.len()), &g, &rays, build);
+        report_geometry(
+            &format!("UV sphere ({} tris), incoherent", triangles.len()),
+            &g,
+            &rays,
+            build,
+        );
         let rays = coherent_rays(1414);
-        report_geometry(&format!("UV sphere ({} tris), coherent", triangles.len()), &g, &rays, build);
+        report_geometry(
+            &format!("UV sphere ({} tris), coherent", triangles.len()),
+            &g,
+            &rays,
+            build,
+        );
     }
 }

@@ -113,10 +113,20 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Render(args)) => render(&args),
         Some(Command::Compare { image, reference }) => compare(&image, &reference),
         None => {
-            eprintln!("tracelab: no command given; rendering the default Cornell box (see `tracelab --help`).");
+            eprintln!(
+                "tracelab: no command given; rendering the default Cornell box (see `tracelab --help`)."
+            );
             let scene = default_scene_path();
             let scene = scene.to_string_lossy().into_owned();
-            let argv = ["tracelab", "render", scene.as_str(), "--spp", "256", "--out", "cornell_box.png"];
+            let argv = [
+                "tracelab",
+                "render",
+                scene.as_str(),
+                "--spp",
+                "256",
+                "--out",
+                "cornell_box.png",
+            ];
             let cli = Cli::try_parse_from(argv).map_err(|e| Error::new(e.to_string()))?;
             run(cli)
         }
@@ -125,7 +135,11 @@ pub fn run(cli: Cli) -> Result<()> {
 
 fn default_scene_path() -> PathBuf {
     let local = PathBuf::from("scenes/cornell_box.toml");
-    if local.is_file() { local } else { Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml") }
+    if local.is_file() {
+        local
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml")
+    }
 }
 
 enum OutputFormat {
@@ -134,10 +148,19 @@ enum OutputFormat {
 }
 
 fn output_format(path: &Path) -> Result<OutputFormat> {
-    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
         Some("exr") => Ok(OutputFormat::Exr),
         Some("png") => Ok(OutputFormat::Png),
-        _ => Err(Error::at(path, None, "output must end in .exr (linear float) or .png (tone-mapped sRGB)")),
+        _ => Err(Error::at(
+            path,
+            None,
+            "output must end in .exr (linear float) or .png (tone-mapped sRGB)",
+        )),
     }
 }
 
@@ -146,18 +169,28 @@ fn render(args: &RenderArgs) -> Result<()> {
     check_writable(&args.out)?;
     if let Some(t) = args.time {
         if !(t.is_finite() && t > 0.0) {
-            return Err(Error::new(format!("--time must be a positive number of seconds, got {t}")));
+            return Err(Error::new(format!(
+                "--time must be a positive number of seconds, got {t}"
+            )));
         }
     }
     if args.spp == Some(0) {
         return Err(Error::new("--spp must be at least 1"));
     }
-    let limits = Limits { max_resolution: args.max_resolution, max_triangles: args.max_triangles };
+    let limits = Limits {
+        max_resolution: args.max_resolution,
+        max_triangles: args.max_triangles,
+    };
     let load_start = Instant::now();
     let mut scene = Scene::load_with_limits(&args.scene, &limits)?;
     if args.width.is_some() || args.height.is_some() {
-        let (w, h) = (args.width.unwrap_or(scene.camera.width), args.height.unwrap_or(scene.camera.height));
-        limits.check_resolution(w, h).map_err(|e| Error::new(format!("--width/--height: {e}")))?;
+        let (w, h) = (
+            args.width.unwrap_or(scene.camera.width),
+            args.height.unwrap_or(scene.camera.height),
+        );
+        limits
+            .check_resolution(w, h)
+            .map_err(|e| Error::new(format!("--width/--height: {e}")))?;
         scene.set_resolution(w, h);
     }
     for w in &scene.warnings {
@@ -182,7 +215,11 @@ fn render(args: &RenderArgs) -> Result<()> {
         SamplerArg::Independent => SamplerKind::Independent,
         SamplerArg::Stratified => SamplerKind::Stratified,
     };
-    let target_spp = if args.time.is_some() { None } else { Some(args.spp.unwrap_or(64)) };
+    let target_spp = if args.time.is_some() {
+        None
+    } else {
+        Some(args.spp.unwrap_or(64))
+    };
     let settings = RenderSettings {
         integrator,
         sampler,
@@ -210,8 +247,11 @@ fn progress_bar(len: u64, unit: &str) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::new(len);
-    let template = format!("{{elapsed_precise}} [{{bar:40}}] {{pos}}/{{len}} {unit} ({{eta}} left)");
-    bar.set_style(ProgressStyle::with_template(&template).unwrap_or_else(|_| ProgressStyle::default_bar()));
+    let template =
+        format!("{{elapsed_precise}} [{{bar:40}}] {{pos}}/{{len}} {unit} ({{eta}} left)");
+    bar.set_style(
+        ProgressStyle::with_template(&template).unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
     bar
 }
 
@@ -288,12 +328,29 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
 fn compare(image: &Path, reference: &Path) -> Result<()> {
     let a = Image::read(image)?;
     let b = Image::read(reference)?;
-    let m = a.compare(&b).map_err(|e| Error::new(format!("{} vs {}: {e}", image.display(), reference.display())))?;
+    let m = a.compare(&b).map_err(|e| {
+        Error::new(format!(
+            "{} vs {}: {e}",
+            image.display(),
+            reference.display()
+        ))
+    })?;
     let (ma, mb) = (a.mean(), b.mean());
-    println!("RMSE {:.6} | relative MSE {:.6} | mean relative error {:.6}", m.rmse, m.relative_mse, m.mean_relative_error);
+    println!(
+        "RMSE {:.6} | relative MSE {:.6} | mean relative error {:.6}",
+        m.rmse, m.relative_mse, m.mean_relative_error
+    );
     println!(
         "mean RGB {:.6} {:.6} {:.6} vs {:.6} {:.6} {:.6} (ratio {:.4} {:.4} {:.4})",
-        ma[0], ma[1], ma[2], mb[0], mb[1], mb[2], ma[0] / mb[0], ma[1] / mb[1], ma[2] / mb[2]
+        ma[0],
+        ma[1],
+        ma[2],
+        mb[0],
+        mb[1],
+        mb[2],
+        ma[0] / mb[0],
+        ma[1] / mb[1],
+        ma[2] / mb[2]
     );
     Ok(())
 }

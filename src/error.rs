@@ -16,7 +16,9 @@ pub type Result<T> = std::result::Result<T, Error>;
 impl Error {
     /// An error without a location.
     pub fn new(message: impl Into<String>) -> Self {
-        Error { message: message.into() }
+        Error {
+            message: message.into(),
+        }
     }
 
     /// An error located in `file` (and at `line` when known, 1-based).
@@ -44,5 +46,9 @@ impl std::error::Error for Error {}
 
 /// 1-based line number of byte offset `offset` in `text`.
 pub fn line_of(text: &str, offset: usize) -> usize {
-    text.as_bytes()[..offset.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1
+    text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
 }

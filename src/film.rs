@@ -46,7 +46,11 @@ impl PixelSums {
             return [0.0; 3];
         }
         let n = self.count as f64;
-        [(self.sum[0] / n) as f32, (self.sum[1] / n) as f32, (self.sum[2] / n) as f32]
+        [
+            (self.sum[0] / n) as f32,
+            (self.sum[1] / n) as f32,
+            (self.sum[2] / n) as f32,
+        ]
     }
 
     /// Standard error of the mean from the unbiased sample variance
@@ -112,7 +116,11 @@ impl Film {
                 }));
             }
         }
-        Film { width, height, tiles }
+        Film {
+            width,
+            height,
+            tiles,
+        }
     }
 
     pub fn width(&self) -> u32 {
@@ -149,7 +157,12 @@ impl Film {
                 }
             }
         }
-        FilmSnapshot { image, standard_error, samples, non_finite }
+        FilmSnapshot {
+            image,
+            standard_error,
+            samples,
+            non_finite,
+        }
     }
 }
 
@@ -176,10 +189,14 @@ mod tests {
     #[test]
     fn tiles_cover_odd_sizes_exactly() {
         let film = Film::new(37, 20);
-        let area: u32 = film.tiles().iter().map(|t| {
-            let t = t.lock().unwrap();
-            t.width * t.height
-        }).sum();
+        let area: u32 = film
+            .tiles()
+            .iter()
+            .map(|t| {
+                let t = t.lock().unwrap();
+                t.width * t.height
+            })
+            .sum();
         assert_eq!(area, 37 * 20);
         assert_eq!(film.snapshot().samples.len(), 37 * 20);
     }

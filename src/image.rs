@@ -29,7 +29,11 @@ pub struct ErrorMetrics {
 impl Image {
     /// A black image.
     pub fn new(width: u32, height: u32) -> Self {
-        Image { width, height, pixels: vec![[0.0; 3]; (width * height) as usize] }
+        Image {
+            width,
+            height,
+            pixels: vec![[0.0; 3]; (width * height) as usize],
+        }
     }
 
     /// Mean of each channel.
@@ -45,11 +49,16 @@ impl Image {
 
     /// Reads an EXR (or any format the image crate knows) as linear float RGB.
     pub fn read(path: &Path) -> Result<Image> {
-        let img = image::open(path).map_err(|e| Error::at(path, None, format!("cannot read image: {e}")))?;
+        let img = image::open(path)
+            .map_err(|e| Error::at(path, None, format!("cannot read image: {e}")))?;
         let rgb = img.into_rgb32f();
         let (width, height) = rgb.dimensions();
         let pixels = rgb.pixels().map(|p| p.0).collect();
-        Ok(Image { width, height, pixels })
+        Ok(Image {
+            width,
+            height,
+            pixels,
+        })
     }
 
     /// Writes linear float32 RGB EXR.
@@ -57,20 +66,32 @@ impl Image {
         let data: Vec<f32> = self.pixels.iter().flatten().copied().collect();
         let buffer = Rgb32FImage::from_raw(self.width, self.height, data)
             .ok_or_else(|| Error::new("internal: image buffer size mismatch"))?;
-        write_atomically(path, |tmp| buffer.save_with_format(tmp, ImageFormat::OpenExr).map_err(|e| e.to_string()))
+        write_atomically(path, |tmp| {
+            buffer
+                .save_with_format(tmp, ImageFormat::OpenExr)
+                .map_err(|e| e.to_string())
+        })
     }
 
     /// Writes an 8-bit sRGB PNG: radiance times 2^exposure, clamped, sRGB-encoded.
     pub fn write_png(&self, path: &Path, exposure: f32) -> Result<()> {
         let buffer = self.to_srgb8(exposure);
-        write_atomically(path, |tmp| buffer.save_with_format(tmp, ImageFormat::Png).map_err(|e| e.to_string()))
+        write_atomically(path, |tmp| {
+            buffer
+                .save_with_format(tmp, ImageFormat::Png)
+                .map_err(|e| e.to_string())
+        })
     }
 
     /// Tone-mapped 8-bit sRGB copy.
     pub fn to_srgb8(&self, exposure: f32) -> RgbImage {
         let scale = exposure.exp2();
-        let data: Vec<u8> =
-            self.pixels.iter().flatten().map(|&v| (linear_to_srgb(v * scale) * 255.0 + 0.5) as u8).collect();
+        let data: Vec<u8> = self
+            .pixels
+            .iter()
+            .flatten()
+            .map(|&v| (linear_to_srgb(v * scale) * 255.0 + 0.5) as u8)
+            .collect();
         RgbImage::from_raw(self.width, self.height, data).expect("buffer matches its dimensions")
     }
 
@@ -93,19 +114,30 @@ impl Image {
             }
         }
         let n = (self.pixels.len() * 3).max(1) as f64;
-        Ok(ErrorMetrics { rmse: (se / n).sqrt(), relative_mse: rel_se / n, mean_relative_error: rel_ae / n })
+        Ok(ErrorMetrics {
+            rmse: (se / n).sqrt(),
+            relative_mse: rel_se / n,
+            mean_relative_error: rel_ae / n,
+        })
     }
 }
 
 /// sRGB transfer function with clamping to [0, 1]; NaN maps to 0.
 pub fn linear_to_srgb(v: f32) -> f32 {
     let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
-    if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 }
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
 }
 
 /// Temporary path next to `path`, so that the final rename stays on one file system.
 fn temporary_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
@@ -143,7 +175,11 @@ mod tests {
     #[test]
     fn metrics_of_a_known_difference() {
         let mut a = Image::new(2, 1);
-        let b = Image { width: 2, height: 1, pixels: vec![[1.0; 3], [0.0; 3]] };
+        let b = Image {
+            width: 2,
+            height: 1,
+            pixels: vec![[1.0; 3], [0.0; 3]],
+        };
         a.pixels = vec![[1.1; 3], [0.1; 3]];
         let m = a.compare(&b).unwrap();
         assert!((m.rmse - 0.1).abs() < 1e-6);
@@ -157,7 +193,11 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("tracelab-img-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("a.exr");
-        let img = Image { width: 3, height: 2, pixels: (0..6).map(|i| [i as f32 * 0.37, 1e-4, 123.5]).collect() };
+        let img = Image {
+            width: 3,
+            height: 2,
+            pixels: (0..6).map(|i| [i as f32 * 0.37, 1e-4, 123.5]).collect(),
+        };
         img.write_exr(&path).unwrap();
         assert_eq!(Image::read(&path).unwrap(), img);
         // No temporary file is left next to it.

@@ -24,7 +24,11 @@ impl Ray {
     /// A ray without an upper bound.
     #[inline]
     pub fn new(origin: Vec3A, direction: Vec3A) -> Self {
-        Ray { origin, direction, t_max: f32::INFINITY }
+        Ray {
+            origin,
+            direction,
+            t_max: f32::INFINITY,
+        }
     }
 
     /// Point at parameter `t`.
@@ -123,7 +127,11 @@ pub fn offset_ray_origin(p: Vec3A, p_error: Vec3A, n: Vec3A, w: Vec3A) -> Vec3A 
             po
         }
     };
-    Vec3A::new(round(po.x, offset.x), round(po.y, offset.y), round(po.z, offset.z))
+    Vec3A::new(
+        round(po.x, offset.x),
+        round(po.y, offset.y),
+        round(po.z, offset.z),
+    )
 }
 
 /// Fraction of a segment's length left out at its far end, so that a shadow
@@ -146,7 +154,11 @@ pub fn ray_between(
     let target = offset_ray_origin(to, to_error, to_normal, origin - to);
     let d = target - origin;
     let distance = d.length();
-    Ray { origin, direction: d / distance, t_max: distance * (1.0 - SHADOW_EPSILON) }
+    Ray {
+        origin,
+        direction: d / distance,
+        t_max: distance * (1.0 - SHADOW_EPSILON),
+    }
 }
 
 /// Mirror reflection of `w` about the normal `n` (both pointing away from the surface).
@@ -171,7 +183,9 @@ mod tests {
             let f = Frame::from_normal(n);
             assert!((f.s.length() - 1.0).abs() < 1e-5);
             assert!((f.t.length() - 1.0).abs() < 1e-5);
-            assert!(f.s.dot(f.t).abs() < 1e-5 && f.s.dot(n).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5);
+            assert!(
+                f.s.dot(f.t).abs() < 1e-5 && f.s.dot(n).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5
+            );
             let v = Vec3A::new(0.3, -0.2, 0.9);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
         }
@@ -185,7 +199,10 @@ mod tests {
             let n = Vec3A::new(0.0, 1.0, 0.0);
             let up = offset_ray_origin(p, error, n, Vec3A::new(0.3, 0.5, 0.0));
             let down = offset_ray_origin(p, error, n, Vec3A::new(0.3, -0.5, 0.0));
-            assert!(up.y - p.y > error.y && p.y - down.y > error.y, "scale {scale}");
+            assert!(
+                up.y - p.y > error.y && p.y - down.y > error.y,
+                "scale {scale}"
+            );
             assert_eq!((up.x, up.z), (p.x, p.z));
             // The offset is a few ULPs of the coordinates, not an absolute epsilon.
             assert!(up.y - p.y < 1e-5 * scale);

@@ -118,7 +118,8 @@ impl Session {
                     return;
                 }
                 let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
-                let mut sampler = Sampler::new(settings.sampler, settings.seed, settings.planned_spp);
+                let mut sampler =
+                    Sampler::new(settings.sampler, settings.seed, settings.planned_spp);
                 let mut counts = RayCounts::default();
                 let mut non_finite = 0u64;
                 let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
@@ -131,7 +132,10 @@ impl Session {
                         let lens = sampler.next_2d();
                         let ray = scene.camera.generate_ray(film_point, lens);
                         counts.camera += 1;
-                        let value = settings.integrator.radiance(scene, ray, &mut sampler, &mut counts);
+                        let value =
+                            settings
+                                .integrator
+                                .radiance(scene, ray, &mut sampler, &mut counts);
                         non_finite += u64::from(!value.is_finite());
                         pixel.add(value);
                     }
@@ -144,7 +148,8 @@ impl Session {
                 self.non_finite.fetch_add(non_finite, Ordering::Relaxed);
             });
         });
-        self.render_nanos.fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        self.render_nanos
+            .fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
         if self.cancelled.load(Ordering::Relaxed) {
             return false;
         }

@@ -19,12 +19,32 @@ fn uniform(seed: u64, i: u64, dim: u64) -> f32 {
 fn bsdfs() -> Vec<(&'static str, Bsdf)> {
     vec![
         ("white diffuse", Bsdf::Diffuse { albedo: Rgb::ONE }),
-        ("glossy n=1", Bsdf::glossy(Rgb::splat(0.5), Rgb::splat(0.5), 1.0)),
-        ("glossy n=30", Bsdf::glossy(Rgb::splat(0.2), Rgb::splat(0.8), 30.0)),
+        (
+            "glossy n=1",
+            Bsdf::glossy(Rgb::splat(0.5), Rgb::splat(0.5), 1.0),
+        ),
+        (
+            "glossy n=30",
+            Bsdf::glossy(Rgb::splat(0.2), Rgb::splat(0.8), 30.0),
+        ),
         ("glossy n=1000", Bsdf::glossy(Rgb::ZERO, Rgb::ONE, 1000.0)),
-        ("glossy, too bright", Bsdf::glossy(Rgb::splat(0.9), Rgb::splat(0.9), 10.0)),
-        ("mirror", Bsdf::Mirror { reflectance: Rgb::ONE }),
-        ("glass", Bsdf::Dielectric { eta: 1.5, tint: Rgb::ONE }),
+        (
+            "glossy, too bright",
+            Bsdf::glossy(Rgb::splat(0.9), Rgb::splat(0.9), 10.0),
+        ),
+        (
+            "mirror",
+            Bsdf::Mirror {
+                reflectance: Rgb::ONE,
+            },
+        ),
+        (
+            "glass",
+            Bsdf::Dielectric {
+                eta: 1.5,
+                tint: Rgb::ONE,
+            },
+        ),
     ]
 }
 
@@ -43,7 +63,11 @@ fn no_bsdf_reflects_more_than_it_receives() {
                     Some(s) => {
                         // Refraction carries radiance scaled by (eta_i/eta_t)^2; energy
                         // (flux) is the weight without that factor.
-                        let radiance_scale = if s.specular && s.wi.z * wo.z < 0.0 { 1.0 / 1.5f64.powi(2) } else { 1.0 };
+                        let radiance_scale = if s.specular && s.wi.z * wo.z < 0.0 {
+                            1.0 / 1.5f64.powi(2)
+                        } else {
+                            1.0
+                        };
                         s.weight.max_element() as f64 / radiance_scale
                     }
                     None => 0.0,
@@ -53,7 +77,10 @@ fn no_bsdf_reflects_more_than_it_receives() {
             }
             let mean = sum / n as f64;
             let se = ((sum_sq / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
-            assert!(mean <= 1.0 + 4.0 * se + 1e-5, "{name} at {theta} deg: albedo {mean} (se {se})");
+            assert!(
+                mean <= 1.0 + 4.0 * se + 1e-5,
+                "{name} at {theta} deg: albedo {mean} (se {se})"
+            );
         }
     }
 }
@@ -65,7 +92,10 @@ fn bsdfs_are_reciprocal() {
             let a = square_to_uniform_sphere(Vec2::new(uniform(1, i, 0), uniform(1, i, 1)));
             let b = square_to_uniform_sphere(Vec2::new(uniform(1, i, 2), uniform(1, i, 3)));
             let (fab, fba) = (bsdf.eval(a, b), bsdf.eval(b, a));
-            assert!((fab - fba).abs().max_element() <= 1e-5 * fab.max_element().max(1.0), "{name}: {fab} vs {fba} for {a} {b}");
+            assert!(
+                (fab - fba).abs().max_element() <= 1e-5 * fab.max_element().max(1.0),
+                "{name}: {fab} vs {fba} for {a} {b}"
+            );
         }
     }
 }
@@ -78,12 +108,19 @@ fn glossy_lobe_integrates_to_its_albedo_at_normal_incidence() {
     let n = 400_000u64;
     let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
     for i in 0..n {
-        let s = bsdf.sample(Vec3A::Z, uniform(9, i, 0), Vec2::new(uniform(9, i, 1), uniform(9, i, 2)));
+        let s = bsdf.sample(
+            Vec3A::Z,
+            uniform(9, i, 0),
+            Vec2::new(uniform(9, i, 1), uniform(9, i, 2)),
+        );
         let w = s.map_or(0.0, |s| s.weight.x as f64);
         sum += w;
         sum_sq += w * w;
     }
     let mean = sum / n as f64;
     let se = ((sum_sq / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
-    assert!((mean - 0.7).abs() < 4.0 * se + 1e-6, "albedo {mean} (se {se})");
+    assert!(
+        (mean - 0.7).abs() < 4.0 * se + 1e-6,
+        "albedo {mean} (se {se})"
+    );
 }

@@ -101,7 +101,11 @@ fn gamma_q(a: f64, x: f64) -> f64 {
 
 /// Chi-square test of observed against expected counts; pools small cells.
 fn assert_fits(name: &str, observed: &[f64], expected: &[f64]) {
-    let mut cells: Vec<(f64, f64)> = observed.iter().copied().zip(expected.iter().copied()).collect();
+    let mut cells: Vec<(f64, f64)> = observed
+        .iter()
+        .copied()
+        .zip(expected.iter().copied())
+        .collect();
     cells.sort_by(|a, b| a.1.partial_cmp(&b.1).unwrap());
     let (mut chi2, mut dof) = (0.0, 0usize);
     let (mut pooled_obs, mut pooled_exp) = (0.0, 0.0);
@@ -119,13 +123,19 @@ fn assert_fits(name: &str, observed: &[f64], expected: &[f64]) {
         dof += 1;
     } else {
         // Samples where nothing should be: any one of them is a failure.
-        assert!(pooled_obs <= 2.0 + 3.0 * pooled_exp, "{name}: {pooled_obs} samples in cells expecting {pooled_exp:.2}");
+        assert!(
+            pooled_obs <= 2.0 + 3.0 * pooled_exp,
+            "{name}: {pooled_obs} samples in cells expecting {pooled_exp:.2}"
+        );
     }
     let dof = dof.saturating_sub(1).max(1);
     let p_value = gamma_q(dof as f64 / 2.0, chi2 / 2.0);
     let alpha = 1.0 - (1.0 - 0.01f64).powf(1.0 / TESTS_IN_FILE);
     eprintln!("{name}: chi2 {chi2:.1}, dof {dof}, p {p_value:.4}");
-    assert!(p_value > alpha, "{name}: chi2 = {chi2:.1} with {dof} dof, p = {p_value:.2e} < {alpha:.2e}");
+    assert!(
+        p_value > alpha,
+        "{name}: chi2 = {chi2:.1} with {dof} dof, p = {p_value:.2e} < {alpha:.2e}"
+    );
 }
 
 fn cell_of(w: Vec3A) -> usize {
@@ -141,12 +151,19 @@ fn cell_of(w: Vec3A) -> usize {
 
 /// Histograms `SAMPLES` directions from `sample` (None = sample lost) and
 /// compares them with `pdf` (solid angle) integrated over each cell.
-fn check_directions(name: &str, mut sample: impl FnMut(u64) -> Option<Vec3A>, pdf: impl Fn(Vec3A) -> f64) {
+fn check_directions(
+    name: &str,
+    mut sample: impl FnMut(u64) -> Option<Vec3A>,
+    pdf: impl Fn(Vec3A) -> f64,
+) {
     let cells = COS_BINS * PHI_BINS;
     let mut observed = vec![0.0; cells];
     for i in 0..SAMPLES {
         if let Some(w) = sample(i) {
-            assert!(w.is_finite() && (w.length() - 1.0).abs() < 1e-4, "{name}: bad direction {w:?}");
+            assert!(
+                w.is_finite() && (w.length() - 1.0).abs() < 1e-4,
+                "{name}: bad direction {w:?}"
+            );
             observed[cell_of(w.normalize())] += 1.0;
         }
     }
@@ -160,14 +177,21 @@ fn check_directions(name: &str, mut sample: impl FnMut(u64) -> Option<Vec3A>, pd
                 let cos_theta = -1.0 + d_cos * (i as f64 + (a as f64 + 0.5) / subdivisions as f64);
                 let phi = d_phi * (j as f64 + (b as f64 + 0.5) / subdivisions as f64);
                 let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-                let w = Vec3A::new((sin_theta * phi.cos()) as f32, (sin_theta * phi.sin()) as f32, cos_theta as f32);
+                let w = Vec3A::new(
+                    (sin_theta * phi.cos()) as f32,
+                    (sin_theta * phi.sin()) as f32,
+                    cos_theta as f32,
+                );
                 let p = pdf(w);
                 zeros += usize::from(p == 0.0);
                 integral += p;
             }
         }
         let partial = zeros > 0 && zeros < subdivisions * subdivisions;
-        (integral * d_cos * d_phi / (subdivisions * subdivisions) as f64, partial)
+        (
+            integral * d_cos * d_phi / (subdivisions * subdivisions) as f64,
+            partial,
+        )
     };
     let mut partial = vec![false; cells];
     for i in 0..COS_BINS {
@@ -180,7 +204,9 @@ fn check_directions(name: &str, mut sample: impl FnMut(u64) -> Option<Vec3A>, pd
     // Refine cells the pdf partly covers and empty cells next to covered ones
     // (a silhouette may clip a corner between sub-grid points).
     let covered = |i: isize, j: isize| -> bool {
-        i >= 0 && i < COS_BINS as isize && expected[i as usize * PHI_BINS + j.rem_euclid(PHI_BINS as isize) as usize] > 0.0
+        i >= 0
+            && i < COS_BINS as isize
+            && expected[i as usize * PHI_BINS + j.rem_euclid(PHI_BINS as isize) as usize] > 0.0
     };
     let mut refined = expected.clone();
     for i in 0..COS_BINS {
@@ -201,7 +227,12 @@ fn check_directions(name: &str, mut sample: impl FnMut(u64) -> Option<Vec3A>, pd
 fn cosine_hemisphere() {
     check_directions(
         "cosine hemisphere",
-        |i| Some(square_to_cosine_hemisphere(Vec2::new(uniform(1, i, 0), uniform(1, i, 1)))),
+        |i| {
+            Some(square_to_cosine_hemisphere(Vec2::new(
+                uniform(1, i, 0),
+                uniform(1, i, 1),
+            )))
+        },
         |w| cosine_hemisphere_pdf(w) as f64,
     );
 }
@@ -211,7 +242,12 @@ fn phong_lobe() {
     let exponent = 12.0;
     check_directions(
         "phong lobe n=12",
-        |i| Some(square_to_phong_lobe(Vec2::new(uniform(2, i, 0), uniform(2, i, 1)), exponent)),
+        |i| {
+            Some(square_to_phong_lobe(
+                Vec2::new(uniform(2, i, 0), uniform(2, i, 1)),
+                exponent,
+            ))
+        },
         |w| phong_lobe_pdf(w.z, exponent) as f64,
     );
 }
@@ -220,8 +256,19 @@ fn phong_lobe() {
 fn uniform_cone() {
     check_directions(
         "uniform cone cos_max=0.8",
-        |i| Some(square_to_uniform_cone(Vec2::new(uniform(3, i, 0), uniform(3, i, 1)), 0.8)),
-        |w| if w.z >= 0.8 { uniform_cone_pdf(0.8) as f64 } else { 0.0 },
+        |i| {
+            Some(square_to_uniform_cone(
+                Vec2::new(uniform(3, i, 0), uniform(3, i, 1)),
+                0.8,
+            ))
+        },
+        |w| {
+            if w.z >= 0.8 {
+                uniform_cone_pdf(0.8) as f64
+            } else {
+                0.0
+            }
+        },
     );
 }
 
@@ -229,12 +276,23 @@ fn check_bsdf(name: &str, bsdf: Bsdf, wo: Vec3A, seed: u64) {
     check_directions(
         name,
         |i| {
-            let s = bsdf.sample(wo, uniform(seed, i, 0), Vec2::new(uniform(seed, i, 1), uniform(seed, i, 2)))?;
+            let s = bsdf.sample(
+                wo,
+                uniform(seed, i, 0),
+                Vec2::new(uniform(seed, i, 1), uniform(seed, i, 2)),
+            )?;
             // The sample's own pdf and weight must agree with pdf() and eval().
             let pdf = bsdf.pdf(wo, s.wi);
-            assert!((s.pdf - pdf).abs() <= 1e-4 * pdf.max(1.0), "{name}: sample pdf {} vs pdf() {pdf}", s.pdf);
+            assert!(
+                (s.pdf - pdf).abs() <= 1e-4 * pdf.max(1.0),
+                "{name}: sample pdf {} vs pdf() {pdf}",
+                s.pdf
+            );
             let weight = bsdf.eval(wo, s.wi) * s.wi.z.abs() / pdf;
-            assert!((s.weight - weight).abs().max_element() <= 1e-3 * weight.max_element().max(1.0), "{name}: weight");
+            assert!(
+                (s.weight - weight).abs().max_element() <= 1e-3 * weight.max_element().max(1.0),
+                "{name}: weight"
+            );
             Some(s.wi)
         },
         |w| bsdf.pdf(wo, w) as f64,
@@ -243,23 +301,49 @@ fn check_bsdf(name: &str, bsdf: Bsdf, wo: Vec3A, seed: u64) {
 
 #[test]
 fn diffuse_bsdf_from_both_sides() {
-    let bsdf = Bsdf::Diffuse { albedo: Rgb::splat(0.5) };
-    check_bsdf("diffuse, wo above", bsdf, Vec3A::new(0.3, 0.2, 0.9).normalize(), 4);
-    check_bsdf("diffuse, wo below", bsdf, Vec3A::new(0.3, 0.2, -0.9).normalize(), 5);
+    let bsdf = Bsdf::Diffuse {
+        albedo: Rgb::splat(0.5),
+    };
+    check_bsdf(
+        "diffuse, wo above",
+        bsdf,
+        Vec3A::new(0.3, 0.2, 0.9).normalize(),
+        4,
+    );
+    check_bsdf(
+        "diffuse, wo below",
+        bsdf,
+        Vec3A::new(0.3, 0.2, -0.9).normalize(),
+        5,
+    );
 }
 
 #[test]
 fn glossy_bsdf() {
     let bsdf = Bsdf::glossy(Rgb::splat(0.3), Rgb::splat(0.6), 20.0);
-    check_bsdf("glossy n=20 at 40 deg", bsdf, Vec3A::new(40f32.to_radians().sin(), 0.0, 40f32.to_radians().cos()), 6);
-    check_bsdf("glossy n=20 at 80 deg", bsdf, Vec3A::new(80f32.to_radians().sin(), 0.0, 80f32.to_radians().cos()), 7);
+    check_bsdf(
+        "glossy n=20 at 40 deg",
+        bsdf,
+        Vec3A::new(40f32.to_radians().sin(), 0.0, 40f32.to_radians().cos()),
+        6,
+    );
+    check_bsdf(
+        "glossy n=20 at 80 deg",
+        bsdf,
+        Vec3A::new(80f32.to_radians().sin(), 0.0, 80f32.to_radians().cos()),
+        7,
+    );
 }
 
 /// A reference point, a big emissive triangle above it, and the lights and
 /// geometry to find where a direction lands on it.
 fn triangle_light() -> (Vec3A, Lights, Geometry) {
     let reference = Vec3A::new(0.2, -0.1, 0.0);
-    let [p0, p1, p2] = [Vec3A::new(-1.0, -1.5, 0.8), Vec3A::new(1.5, -0.5, 1.2), Vec3A::new(-0.5, 1.5, 0.5)];
+    let [p0, p1, p2] = [
+        Vec3A::new(-1.0, -1.5, 0.8),
+        Vec3A::new(1.5, -0.5, 1.2),
+        Vec3A::new(-0.5, 1.5, 0.5),
+    ];
     let (e1, e2) = (p1 - p0, p2 - p0);
     // Facing down, towards the reference point.
     let normal = -e1.cross(e2).normalize() * e1.cross(e2).normalize().z.signum();
@@ -272,7 +356,13 @@ fn triangle_light() -> (Vec3A, Lights, Geometry) {
         radiance: Rgb::ONE,
         two_sided: false,
     };
-    let geometry = Geometry::build(&[TriangleInput { vertices: [p0, p1, p2], material: 0 }], vec![]);
+    let geometry = Geometry::build(
+        &[TriangleInput {
+            vertices: [p0, p1, p2],
+            material: 0,
+        }],
+        vec![],
+    );
     (reference, Lights::new(vec![light]), geometry)
 }
 
@@ -282,7 +372,11 @@ fn triangle_light_area_sampling_in_solid_angle() {
     check_directions(
         "triangle light",
         |i| {
-            let s = lights.sample(reference, uniform(8, i, 0), Vec2::new(uniform(8, i, 1), uniform(8, i, 2)))?;
+            let s = lights.sample(
+                reference,
+                uniform(8, i, 0),
+                Vec2::new(uniform(8, i, 1), uniform(8, i, 2)),
+            )?;
             Some(s.wi)
         },
         |w| match geometry.intersect(&tracelab::math::Ray::new(reference, w.normalize())) {
@@ -302,7 +396,10 @@ fn triangle_light_points_are_uniform_by_area() {
     for i in 0..n {
         let b = square_to_uniform_triangle(Vec2::new(uniform(9, i, 0), uniform(9, i, 1)));
         assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
-        let (x, y) = (((b.x * cells as f32) as usize).min(cells - 1), ((b.y * cells as f32) as usize).min(cells - 1));
+        let (x, y) = (
+            ((b.x * cells as f32) as usize).min(cells - 1),
+            ((b.y * cells as f32) as usize).min(cells - 1),
+        );
         observed[y * cells + x] += 1.0;
     }
     // Area of cell (x, y) inside b1 + b2 <= 1: full, half (on the diagonal) or none.
@@ -310,7 +407,13 @@ fn triangle_light_points_are_uniform_by_area() {
     let expected: Vec<f64> = (0..cells * cells)
         .map(|k| {
             let (x, y) = (k % cells, k / cells);
-            let area = if x + y + 1 < cells { h * h } else if x + y + 1 == cells { h * h / 2.0 } else { 0.0 };
+            let area = if x + y + 1 < cells {
+                h * h
+            } else if x + y + 1 == cells {
+                h * h / 2.0
+            } else {
+                0.0
+            };
             area * 2.0 * n as f64
         })
         .collect();
@@ -325,12 +428,30 @@ fn sphere_light_solid_angle_sampling() {
     let center = Vec3A::new(0.0, 0.0, 1.0);
     let radius = (1.0f32 - 0.825 * 0.825).sqrt();
     let (sampling, seed) = (SphereSampling::SolidAngle, 10);
-    let lights = Lights::new(vec![Light::Sphere { center, radius, radiance: Rgb::ONE, two_sided: false, sampling }]);
-    let geometry = Geometry::build(&[], vec![tracelab::accel::Sphere { center, radius, material: 0, light: NO_LIGHT }]);
+    let lights = Lights::new(vec![Light::Sphere {
+        center,
+        radius,
+        radiance: Rgb::ONE,
+        two_sided: false,
+        sampling,
+    }]);
+    let geometry = Geometry::build(
+        &[],
+        vec![tracelab::accel::Sphere {
+            center,
+            radius,
+            material: 0,
+            light: NO_LIGHT,
+        }],
+    );
     check_directions(
         "sphere light, solid angle",
         |i| {
-            let s = lights.sample(reference, uniform(seed, i, 0), Vec2::new(uniform(seed, i, 1), uniform(seed, i, 2)))?;
+            let s = lights.sample(
+                reference,
+                uniform(seed, i, 0),
+                Vec2::new(uniform(seed, i, 1), uniform(seed, i, 2)),
+            )?;
             Some(s.wi)
         },
         |w| match geometry.intersect(&tracelab::math::Ray::new(reference, w.normalize())) {
@@ -349,7 +470,12 @@ fn sphere_light_area_sampling_is_uniform_over_the_sphere() {
     // the silhouette, where a cell integral cannot be computed accurately.
     check_directions(
         "uniform sphere",
-        |i| Some(square_to_uniform_sphere(Vec2::new(uniform(11, i, 0), uniform(11, i, 1)))),
+        |i| {
+            Some(square_to_uniform_sphere(Vec2::new(
+                uniform(11, i, 0),
+                uniform(11, i, 1),
+            )))
+        },
         |_| UNIFORM_SPHERE_PDF as f64,
     );
 }
@@ -357,17 +483,25 @@ fn sphere_light_area_sampling_is_uniform_over_the_sphere() {
 #[test]
 fn dielectric_chooses_reflection_with_fresnel_probability() {
     // Discrete two-outcome test per incidence angle, from outside and inside.
-    let bsdf = Bsdf::Dielectric { eta: 1.5, tint: Rgb::ONE };
+    let bsdf = Bsdf::Dielectric {
+        eta: 1.5,
+        tint: Rgb::ONE,
+    };
     let n = 200_000u64;
     let mut observed = Vec::new();
     let mut expected = Vec::new();
-    for (k, cos_o) in [0.95f32, 0.7, 0.3, 0.1, -0.95, -0.8].into_iter().enumerate() {
+    for (k, cos_o) in [0.95f32, 0.7, 0.3, 0.1, -0.95, -0.8]
+        .into_iter()
+        .enumerate()
+    {
         let sin_o = (1.0 - cos_o * cos_o).sqrt();
         let wo = Vec3A::new(sin_o, 0.0, cos_o);
         let f = fresnel_dielectric(cos_o, 1.5).reflectance as f64;
         let mut reflected = 0.0;
         for i in 0..n {
-            let s = bsdf.sample(wo, uniform(12 + k as u64, i, 0), Vec2::ZERO).unwrap();
+            let s = bsdf
+                .sample(wo, uniform(12 + k as u64, i, 0), Vec2::ZERO)
+                .unwrap();
             assert!(s.specular);
             if s.wi.z * wo.z > 0.0 {
                 reflected += 1.0;

@@ -6,7 +6,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn tracelab(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tracelab")).args(args).output().expect("binary runs")
+    Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(args)
+        .output()
+        .expect("binary runs")
 }
 
 fn stderr(o: &Output) -> String {
@@ -23,7 +26,8 @@ fn assert_fails(o: &Output, code: i32, needles: &[&str]) {
     }
 }
 
-const CAMERA: &str = "[camera]\neye = [0, 1, -3]\nlook_at = [0, 1, 0]\nfov_y = 40\nwidth = 16\nheight = 16\n";
+const CAMERA: &str =
+    "[camera]\neye = [0, 1, -3]\nlook_at = [0, 1, 0]\nfov_y = 40\nwidth = 16\nheight = 16\n";
 
 /// Writes `files` into a fresh directory and returns the directory.
 fn scene_dir(name: &str, files: &[(&str, &str)]) -> PathBuf {
@@ -37,7 +41,14 @@ fn scene_dir(name: &str, files: &[(&str, &str)]) -> PathBuf {
 fn render_scene(dir: &Path, extra: &[&str]) -> Output {
     let scene = dir.join("scene.toml");
     let out = dir.join("out.exr");
-    let mut args = vec!["render", scene.to_str().unwrap(), "--spp", "2", "--out", out.to_str().unwrap()];
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "--spp",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ];
     args.extend_from_slice(extra);
     tracelab(&args)
 }
@@ -50,29 +61,83 @@ fn renders_the_cornell_box_and_compares_images() {
     let exr = dir.join("cb.exr");
     let png = dir.join("cb.png");
     let scene = repo_path("scenes/cornell_box.toml");
-    let o = tracelab(&["render", scene.to_str().unwrap(), "--spp", "4", "--width", "32", "--height", "32", "--out", exr.to_str().unwrap()]);
+    let o = tracelab(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--spp",
+        "4",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--out",
+        exr.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let summary = String::from_utf8_lossy(&o.stdout);
-    assert!(summary.starts_with("spp 4 |") && summary.contains("non-finite 0") && summary.contains("M paths/s"), "{summary}");
-    let o = tracelab(&["render", scene.to_str().unwrap(), "--spp", "4", "--width", "32", "--height", "32", "--sampler", "stratified", "--out", png.to_str().unwrap()]);
+    assert!(
+        summary.starts_with("spp 4 |")
+            && summary.contains("non-finite 0")
+            && summary.contains("M paths/s"),
+        "{summary}"
+    );
+    let o = tracelab(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--spp",
+        "4",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--sampler",
+        "stratified",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(image::open(&png).unwrap().width() == 32);
 
     let o = tracelab(&["compare", exr.to_str().unwrap(), exr.to_str().unwrap()]);
     assert!(o.status.success());
-    assert!(String::from_utf8_lossy(&o.stdout).starts_with("RMSE 0.000000 | relative MSE 0.000000 | mean relative error 0.000000"));
+    assert!(
+        String::from_utf8_lossy(&o.stdout)
+            .starts_with("RMSE 0.000000 | relative MSE 0.000000 | mean relative error 0.000000")
+    );
     // Different sizes and missing files are errors, not panics.
     let reference = repo_path("tests/data/cornell_box_path_ref.exr");
-    assert_fails(&tracelab(&["compare", exr.to_str().unwrap(), reference.to_str().unwrap()]), 1, &["images differ in size: 32x32 vs 256x256"]);
-    assert_fails(&tracelab(&["compare", "nowhere.exr", exr.to_str().unwrap()]), 1, &["nowhere.exr", "cannot read image"]);
+    assert_fails(
+        &tracelab(&[
+            "compare",
+            exr.to_str().unwrap(),
+            reference.to_str().unwrap(),
+        ]),
+        1,
+        &["images differ in size: 32x32 vs 256x256"],
+    );
+    assert_fails(
+        &tracelab(&["compare", "nowhere.exr", exr.to_str().unwrap()]),
+        1,
+        &["nowhere.exr", "cannot read image"],
+    );
     let garbage = dir.join("garbage.exr");
     std::fs::write(&garbage, "not an image").unwrap();
-    assert_fails(&tracelab(&["compare", garbage.to_str().unwrap(), exr.to_str().unwrap()]), 1, &["garbage.exr"]);
+    assert_fails(
+        &tracelab(&["compare", garbage.to_str().unwrap(), exr.to_str().unwrap()]),
+        1,
+        &["garbage.exr"],
+    );
 }
 
 #[test]
 fn malformed_toml_names_file_and_line() {
-    let dir = scene_dir("cli-toml", &[("scene.toml", "[camera]\neye == [0, 1, -3]\nlook_at = [0, 0, 0]\n")]);
+    let dir = scene_dir(
+        "cli-toml",
+        &[(
+            "scene.toml",
+            "[camera]\neye == [0, 1, -3]\nlook_at = [0, 0, 0]\n",
+        )],
+    );
     assert_fails(&render_scene(&dir, &[]), 1, &["scene.toml:2:"]);
 }
 
@@ -80,17 +145,30 @@ fn malformed_toml_names_file_and_line() {
 fn unknown_keys_are_rejected_with_their_line() {
     let text = format!("{CAMERA}colour = \"red\"\n");
     let dir = scene_dir("cli-unknown-key", &[("scene.toml", &text)]);
-    assert_fails(&render_scene(&dir, &[]), 1, &["scene.toml:7:", "unknown field `colour`"]);
+    assert_fails(
+        &render_scene(&dir, &[]),
+        1,
+        &["scene.toml:7:", "unknown field `colour`"],
+    );
     let text = format!("{CAMERA}\n[materials.glass]\ntype = \"dielectric\"\nalbedo = [1, 1, 1]\n");
     let dir = scene_dir("cli-wrong-field", &[("scene.toml", &text)]);
-    assert_fails(&render_scene(&dir, &[]), 1, &["scene.toml:8:", "field `albedo` does not apply"]);
+    assert_fails(
+        &render_scene(&dir, &[]),
+        1,
+        &["scene.toml:8:", "field `albedo` does not apply"],
+    );
 }
 
 #[test]
 fn unknown_material_names_the_entry() {
-    let text = format!("{CAMERA}\n[[sphere]]\ncenter = [0, 1, 0]\nradius = 0.5\nmaterial = \"gold\"\n");
+    let text =
+        format!("{CAMERA}\n[[sphere]]\ncenter = [0, 1, 0]\nradius = 0.5\nmaterial = \"gold\"\n");
     let dir = scene_dir("cli-material", &[("scene.toml", &text)]);
-    assert_fails(&render_scene(&dir, &[]), 1, &["scene.toml:8:", "unknown material `gold`"]);
+    assert_fails(
+        &render_scene(&dir, &[]),
+        1,
+        &["scene.toml:8:", "unknown material `gold`"],
+    );
 }
 
 #[test]
@@ -104,35 +182,70 @@ fn bad_camera_values_are_explained() {
 fn non_finite_obj_vertex_names_the_line() {
     let obj = "v 0 0 0\nv 1 0 0\nv 0 nan 1\nf 1 2 3\n";
     let dir = scene_dir("cli-nan", &[("scene.toml", MESH_SCENE), ("mesh.obj", obj)]);
-    assert_fails(&render_scene(&dir, &[]), 1, &["mesh.obj:3: vertex coordinate `nan` is not finite"]);
+    assert_fails(
+        &render_scene(&dir, &[]),
+        1,
+        &["mesh.obj:3: vertex coordinate `nan` is not finite"],
+    );
     let obj = "v 0 0 0\nv 1 0 inf\nv 0 1 1\nf 1 2 3\n";
     let dir = scene_dir("cli-inf", &[("scene.toml", MESH_SCENE), ("mesh.obj", obj)]);
-    assert_fails(&render_scene(&dir, &[]), 1, &["mesh.obj:2: vertex coordinate `inf` is not finite"]);
+    assert_fails(
+        &render_scene(&dir, &[]),
+        1,
+        &["mesh.obj:2: vertex coordinate `inf` is not finite"],
+    );
 }
 
 #[test]
 fn out_of_range_face_index_names_the_line() {
     let obj = "v 0 0 0\nv 1 0 0\nv 0 1 1\n\nf 1 2 9\n";
     let dir = scene_dir("cli-face", &[("scene.toml", MESH_SCENE), ("mesh.obj", obj)]);
-    assert_fails(&render_scene(&dir, &[]), 1, &["mesh.obj:5: face index 9 is out of range"]);
+    assert_fails(
+        &render_scene(&dir, &[]),
+        1,
+        &["mesh.obj:5: face index 9 is out of range"],
+    );
 }
 
 #[test]
 fn missing_obj_and_mtl_are_named() {
     let dir = scene_dir("cli-missing-obj", &[("scene.toml", MESH_SCENE)]);
-    assert_fails(&render_scene(&dir, &[]), 1, &["scene.toml:8:", "mesh file `mesh.obj` not found"]);
+    assert_fails(
+        &render_scene(&dir, &[]),
+        1,
+        &["scene.toml:8:", "mesh file `mesh.obj` not found"],
+    );
     let obj = "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 1\nf 1 2 3\n";
-    let dir = scene_dir("cli-missing-mtl", &[("scene.toml", MESH_SCENE), ("mesh.obj", obj)]);
-    assert_fails(&render_scene(&dir, &[]), 1, &["mesh.obj:1: material library `gone.mtl` not found"]);
-    assert_fails(&tracelab(&["render", "no/such/scene.toml", "--out", "x.exr"]), 1, &["no/such/scene.toml", "cannot read scene file"]);
+    let dir = scene_dir(
+        "cli-missing-mtl",
+        &[("scene.toml", MESH_SCENE), ("mesh.obj", obj)],
+    );
+    assert_fails(
+        &render_scene(&dir, &[]),
+        1,
+        &["mesh.obj:1: material library `gone.mtl` not found"],
+    );
+    assert_fails(
+        &tracelab(&["render", "no/such/scene.toml", "--out", "x.exr"]),
+        1,
+        &["no/such/scene.toml", "cannot read scene file"],
+    );
 }
 
 #[test]
 fn unknown_integrator_or_sampler_is_a_usage_error() {
     let scene = repo_path("scenes/cornell_box.toml");
     let s = scene.to_str().unwrap();
-    assert_fails(&tracelab(&["render", s, "--integrator", "magic", "--out", "x.exr"]), 2, &["invalid value 'magic'", "path"]);
-    assert_fails(&tracelab(&["render", s, "--sampler", "perfect", "--out", "x.exr"]), 2, &["invalid value 'perfect'", "stratified"]);
+    assert_fails(
+        &tracelab(&["render", s, "--integrator", "magic", "--out", "x.exr"]),
+        2,
+        &["invalid value 'magic'", "path"],
+    );
+    assert_fails(
+        &tracelab(&["render", s, "--sampler", "perfect", "--out", "x.exr"]),
+        2,
+        &["invalid value 'perfect'", "stratified"],
+    );
 }
 
 #[test]
@@ -141,11 +254,23 @@ fn absurd_resolutions_are_refused() {
     let dir = temp_dir("cli-res");
     let out = dir.join("x.exr");
     let (s, o) = (scene.to_str().unwrap(), out.to_str().unwrap());
-    assert_fails(&tracelab(&["render", s, "--width", "0", "--out", o]), 1, &["resolution 0x256 is outside 1..=16384"]);
-    assert_fails(&tracelab(&["render", s, "--width", "1000000", "--out", o]), 1, &["resolution 1000000x256 is outside"]);
+    assert_fails(
+        &tracelab(&["render", s, "--width", "0", "--out", o]),
+        1,
+        &["resolution 0x256 is outside 1..=16384"],
+    );
+    assert_fails(
+        &tracelab(&["render", s, "--width", "1000000", "--out", o]),
+        1,
+        &["resolution 1000000x256 is outside"],
+    );
     let text = CAMERA.replace("width = 16", "width = 0");
     let dir = scene_dir("cli-res-scene", &[("scene.toml", &text)]);
-    assert_fails(&render_scene(&dir, &[]), 1, &["scene.toml:1:", "resolution 0x16"]);
+    assert_fails(
+        &render_scene(&dir, &[]),
+        1,
+        &["scene.toml:1:", "resolution 0x16"],
+    );
     assert!(!out.exists());
 }
 
@@ -153,8 +278,16 @@ fn absurd_resolutions_are_refused() {
 fn unwritable_output_fails_before_rendering() {
     let scene = repo_path("scenes/cornell_box.toml");
     let s = scene.to_str().unwrap();
-    assert_fails(&tracelab(&["render", s, "--out", "/nonexistent-dir/x.exr"]), 1, &["/nonexistent-dir/x.exr", "cannot write output"]);
-    assert_fails(&tracelab(&["render", s, "--out", "x.jpg"]), 1, &["x.jpg", "must end in .exr"]);
+    assert_fails(
+        &tracelab(&["render", s, "--out", "/nonexistent-dir/x.exr"]),
+        1,
+        &["/nonexistent-dir/x.exr", "cannot write output"],
+    );
+    assert_fails(
+        &tracelab(&["render", s, "--out", "x.jpg"]),
+        1,
+        &["x.jpg", "must end in .exr"],
+    );
 }
 
 #[test]
@@ -163,9 +296,21 @@ fn degenerate_triangles_and_zero_area_emitters_are_dropped_with_a_count() {
     let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\n\
                usemtl white\nf 1 2 3\nf 1 2 4\n\
                usemtl lamp\nf 1 1 3\nf 2 3 3\n";
-    let dir = scene_dir("cli-degenerate", &[("scene.toml", MESH_SCENE), ("mesh.obj", obj), ("m.mtl", mtl)]);
+    let dir = scene_dir(
+        "cli-degenerate",
+        &[
+            ("scene.toml", MESH_SCENE),
+            ("mesh.obj", obj),
+            ("m.mtl", mtl),
+        ],
+    );
     let o = render_scene(&dir, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stderr(&o).contains("warning:") && stderr(&o).contains("dropped 3 degenerate triangle(s) of 4"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("warning:")
+            && stderr(&o).contains("dropped 3 degenerate triangle(s) of 4"),
+        "{}",
+        stderr(&o)
+    );
     assert!(stderr(&o).contains("no light source"), "{}", stderr(&o));
 }

@@ -34,7 +34,13 @@ pub fn render_with(
     threads: usize,
     pass: u32,
 ) -> (FilmSnapshot, RenderStats) {
-    let settings = RenderSettings { integrator, sampler, seed, planned_spp: spp, threads };
+    let settings = RenderSettings {
+        integrator,
+        sampler,
+        seed,
+        planned_spp: spp,
+        threads,
+    };
     let session = Session::new(Arc::new(scene), settings).expect("session starts");
     let mut done = 0;
     while done < spp {
@@ -46,7 +52,13 @@ pub fn render_with(
 }
 
 /// Renders with all cores in passes of 8 samples.
-pub fn render(scene: Scene, integrator: Integrator, sampler: SamplerKind, spp: u32, seed: u64) -> (FilmSnapshot, RenderStats) {
+pub fn render(
+    scene: Scene,
+    integrator: Integrator,
+    sampler: SamplerKind,
+    spp: u32,
+    seed: u64,
+) -> (FilmSnapshot, RenderStats) {
     render_with(scene, integrator, sampler, spp, seed, 0, 8)
 }
 

@@ -8,7 +8,15 @@ use tracelab::sampling::SamplerKind;
 fn film(sampler: SamplerKind, threads: usize, pass: u32, seed: u64) -> Vec<[f32; 3]> {
     let mut scene = cornell_box();
     scene.set_resolution(48, 40);
-    let (snapshot, _) = render_with(scene, Integrator::Path(PathTracer::default()), sampler, 16, seed, threads, pass);
+    let (snapshot, _) = render_with(
+        scene,
+        Integrator::Path(PathTracer::default()),
+        sampler,
+        16,
+        seed,
+        threads,
+        pass,
+    );
     // Bit patterns, so that -0.0 vs 0.0 or NaN payloads would count as different.
     assert!(snapshot.samples.iter().all(|&n| n == 16));
     snapshot.image.pixels
@@ -20,9 +28,21 @@ fn same_seed_gives_a_bit_identical_film_with_one_and_two_threads() {
         let one = film(sampler, 1, 16, 5);
         let two = film(sampler, 2, 16, 5);
         let split = film(sampler, 2, 3, 5);
-        let bits = |v: &Vec<[f32; 3]>| v.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+        let bits = |v: &Vec<[f32; 3]>| {
+            v.iter()
+                .flat_map(|p| p.map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
         assert_eq!(bits(&one), bits(&two), "{sampler:?}: 1 vs 2 threads");
-        assert_eq!(bits(&one), bits(&split), "{sampler:?}: one pass vs passes of 3");
-        assert_ne!(bits(&one), bits(&film(sampler, 2, 16, 6)), "{sampler:?}: the seed must matter");
+        assert_eq!(
+            bits(&one),
+            bits(&split),
+            "{sampler:?}: one pass vs passes of 3"
+        );
+        assert_ne!(
+            bits(&one),
+            bits(&film(sampler, 2, 16, 6)),
+            "{sampler:?}: the seed must matter"
+        );
     }
 }

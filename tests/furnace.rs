@@ -31,7 +31,16 @@ fn furnace_material() -> Material {
 }
 
 fn camera() -> Camera {
-    Camera::look_at(Vec3A::new(0.1, 0.2, 0.0), Vec3A::new(0.3, 0.1, 1.0), Vec3A::Y, 90.0, 16, 16, 0.0, 1.0)
+    Camera::look_at(
+        Vec3A::new(0.1, 0.2, 0.0),
+        Vec3A::new(0.3, 0.1, 1.0),
+        Vec3A::Y,
+        90.0,
+        16,
+        16,
+        0.0,
+        1.0,
+    )
 }
 
 fn sphere_furnace() -> Scene {
@@ -39,7 +48,12 @@ fn sphere_furnace() -> Scene {
         camera: camera(),
         materials: vec![furnace_material()],
         triangles: vec![],
-        spheres: vec![Sphere { center: Vec3A::ZERO, radius: 1.0, material: 0, light: NO_LIGHT }],
+        spheres: vec![Sphere {
+            center: Vec3A::ZERO,
+            radius: 1.0,
+            material: 0,
+            light: NO_LIGHT,
+        }],
         point_lights: vec![],
         sphere_sampling: SphereSampling::SolidAngle,
     })
@@ -48,13 +62,32 @@ fn sphere_furnace() -> Scene {
 
 fn cube_furnace() -> Scene {
     // The 12 triangles of the cube [-1, 1]^3.
-    let corner = |i: usize| Vec3A::new(if i & 1 != 0 { 1.0 } else { -1.0 }, if i & 2 != 0 { 1.0 } else { -1.0 }, if i & 4 != 0 { 1.0 } else { -1.0 });
-    let faces = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]];
+    let corner = |i: usize| {
+        Vec3A::new(
+            if i & 1 != 0 { 1.0 } else { -1.0 },
+            if i & 2 != 0 { 1.0 } else { -1.0 },
+            if i & 4 != 0 { 1.0 } else { -1.0 },
+        )
+    };
+    let faces = [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ];
     let mut triangles = Vec::new();
     for f in faces {
         let [a, b, c, d] = f.map(corner);
-        triangles.push(TriangleInput { vertices: [a, b, c], material: 0 });
-        triangles.push(TriangleInput { vertices: [a, c, d], material: 0 });
+        triangles.push(TriangleInput {
+            vertices: [a, b, c],
+            material: 0,
+        });
+        triangles.push(TriangleInput {
+            vertices: [a, c, d],
+            material: 0,
+        });
     }
     Scene::build(SceneInput {
         camera: camera(),
@@ -68,14 +101,24 @@ fn cube_furnace() -> Scene {
 }
 
 fn check_furnace(scene: Scene, nee: bool, mis: MisHeuristic) {
-    let integrator = Integrator::Path(PathTracer { max_depth: u32::MAX, nee, mis, ..Default::default() });
+    let integrator = Integrator::Path(PathTracer {
+        max_depth: u32::MAX,
+        nee,
+        mis,
+        ..Default::default()
+    });
     let (snapshot, stats) = render(scene, integrator, SamplerKind::Independent, 256, 7);
     assert_eq!(stats.non_finite, 0);
     let (mean, se) = mean_and_standard_error(&snapshot);
     for c in 0..3 {
         let expected = (EMISSION[c] / (1.0 - ALBEDO[c])) as f64;
         let z = (mean[c] - expected) / se[c];
-        assert!(z.abs() < 3.0, "channel {c}: {} vs {expected} ({z:.2} standard errors of {})", mean[c], se[c]);
+        assert!(
+            z.abs() < 3.0,
+            "channel {c}: {} vs {expected} ({z:.2} standard errors of {})",
+            mean[c],
+            se[c]
+        );
     }
 }
 
@@ -108,13 +151,21 @@ fn cube_furnace_without_nee() {
 fn truncated_furnace_sums_the_geometric_series() {
     // Without roulette and with at most 2 bounces, L = Le (1 + a + a^2) exactly
     // in expectation; this checks the bounce count against its definition.
-    let integrator = Integrator::Path(PathTracer { max_depth: 2, russian_roulette: false, ..Default::default() });
+    let integrator = Integrator::Path(PathTracer {
+        max_depth: 2,
+        russian_roulette: false,
+        ..Default::default()
+    });
     let (snapshot, _) = render(cube_furnace(), integrator, SamplerKind::Independent, 256, 3);
     let (mean, se) = mean_and_standard_error(&snapshot);
     for c in 0..3 {
         let a = ALBEDO[c] as f64;
         let expected = EMISSION[c] as f64 * (1.0 + a + a * a);
         let z = (mean[c] - expected) / se[c];
-        assert!(z.abs() < 3.0, "channel {c}: {} vs {expected} ({z:.2} standard errors)", mean[c]);
+        assert!(
+            z.abs() < 3.0,
+            "channel {c}: {} vs {expected} ({z:.2} standard errors)",
+            mean[c]
+        );
     }
 }

@@ -14,7 +14,10 @@ use tracelab::integrator::{Integrator, PathTracer};
 use tracelab::sampling::SamplerKind;
 
 fn check_against_reference(max_depth: u32, reference_name: &str, variance_name: &str) {
-    let integrator = Integrator::Path(PathTracer { max_depth, ..Default::default() });
+    let integrator = Integrator::Path(PathTracer {
+        max_depth,
+        ..Default::default()
+    });
     let (snapshot, stats) = render(cornell_box(), integrator, SamplerKind::Independent, 64, 1);
     assert_eq!(stats.non_finite, 0);
     let reference = reference(reference_name);
@@ -22,7 +25,12 @@ fn check_against_reference(max_depth: u32, reference_name: &str, variance_name: 
     let measured = snapshot.image.compare(&reference).unwrap().rmse;
 
     let mut expected_mse = 0.0f64;
-    for (se, var_ref) in snapshot.standard_error.pixels.iter().zip(&reference_variance.pixels) {
+    for (se, var_ref) in snapshot
+        .standard_error
+        .pixels
+        .iter()
+        .zip(&reference_variance.pixels)
+    {
         for c in 0..3 {
             expected_mse += (se[c] as f64).powi(2) + var_ref[c] as f64;
         }
@@ -30,22 +38,38 @@ fn check_against_reference(max_depth: u32, reference_name: &str, variance_name: 
     expected_mse /= (snapshot.image.pixels.len() * 3) as f64;
     let expected = expected_mse.sqrt();
     eprintln!("{reference_name}: RMSE {measured:.5}, expected from variances {expected:.5}");
-    assert!(measured <= 1.10 * expected, "RMSE {measured:.5} vs expected {expected:.5} from the variances");
+    assert!(
+        measured <= 1.10 * expected,
+        "RMSE {measured:.5} vs expected {expected:.5} from the variances"
+    );
 
     let (mean, se_mean) = mean_and_standard_error(&snapshot);
     let ref_mean = reference.mean();
     for c in 0..3 {
         let z = (mean[c] - ref_mean[c]) / se_mean[c];
-        assert!(z.abs() < 4.0, "channel {c}: mean {} vs reference {} ({z:.2} standard errors)", mean[c], ref_mean[c]);
+        assert!(
+            z.abs() < 4.0,
+            "channel {c}: mean {} vs reference {} ({z:.2} standard errors)",
+            mean[c],
+            ref_mean[c]
+        );
     }
 }
 
 #[test]
 fn path_tracing_matches_mitsuba_on_the_cornell_box() {
-    check_against_reference(8, "cornell_box_path_ref.exr", "cornell_box_path_ref_var.exr");
+    check_against_reference(
+        8,
+        "cornell_box_path_ref.exr",
+        "cornell_box_path_ref_var.exr",
+    );
 }
 
 #[test]
 fn direct_lighting_matches_mitsuba_on_the_cornell_box() {
-    check_against_reference(1, "cornell_box_direct_ref.exr", "cornell_box_direct_ref_var.exr");
+    check_against_reference(
+        1,
+        "cornell_box_direct_ref.exr",
+        "cornell_box_direct_ref_var.exr",
+    );
 }

@@ -15,13 +15,31 @@ fn every_shipped_scene_renders_cleanly() {
             continue;
         }
         let mut scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
-        assert!(scene.warnings.is_empty(), "{}: {:?}", path.display(), scene.warnings);
+        assert!(
+            scene.warnings.is_empty(),
+            "{}: {:?}",
+            path.display(),
+            scene.warnings
+        );
         scene.set_resolution(40, 30);
         for nee in [true, false] {
-            let tracer = PathTracer { nee, ..Default::default() };
-            let (snapshot, stats) = render(scene.clone(), Integrator::Path(tracer), SamplerKind::Stratified, 16, 1);
+            let tracer = PathTracer {
+                nee,
+                ..Default::default()
+            };
+            let (snapshot, stats) = render(
+                scene.clone(),
+                Integrator::Path(tracer),
+                SamplerKind::Stratified,
+                16,
+                1,
+            );
             assert_eq!(stats.non_finite, 0, "{}", path.display());
-            assert!(snapshot.image.mean().iter().all(|&m| m > 0.0), "{} renders black", path.display());
+            assert!(
+                snapshot.image.mean().iter().all(|&m| m > 0.0),
+                "{} renders black",
+                path.display()
+            );
         }
         count += 1;
     }

@@ -20,7 +20,13 @@ const BLOCK: u32 = 8;
 fn render_small(tracer: PathTracer, spp: u32, seed: u64) -> FilmSnapshot {
     let mut scene = cornell_box();
     scene.set_resolution(SIZE, SIZE);
-    let (snapshot, stats) = render(scene, Integrator::Path(tracer), SamplerKind::Independent, spp, seed);
+    let (snapshot, stats) = render(
+        scene,
+        Integrator::Path(tracer),
+        SamplerKind::Independent,
+        spp,
+        seed,
+    );
     assert_eq!(stats.non_finite, 0);
     snapshot
 }
@@ -40,7 +46,9 @@ fn blocks(s: &FilmSnapshot) -> Vec<([f64; 3], [f64; 3])> {
         }
     }
     let n = (BLOCK * BLOCK) as f64;
-    out.into_iter().map(|(m, v)| (m.map(|x| x / n), v.map(|x| x / (n * n)))).collect()
+    out.into_iter()
+        .map(|(m, v)| (m.map(|x| x / n), v.map(|x| x / (n * n))))
+        .collect()
 }
 
 fn assert_agree(name: &str, a: &FilmSnapshot, b: &FilmSnapshot) {
@@ -52,7 +60,10 @@ fn assert_agree(name: &str, a: &FilmSnapshot, b: &FilmSnapshot) {
         }
     }
     eprintln!("{name}: largest block z-score {worst:.2}");
-    assert!(worst < 4.5, "{name}: a block differs by {worst:.2} standard errors");
+    assert!(
+        worst < 4.5,
+        "{name}: a block differs by {worst:.2} standard errors"
+    );
 }
 
 #[test]
@@ -60,10 +71,35 @@ fn nee_and_mis_variants_converge_to_the_same_image() {
     let base = PathTracer::default();
     let reference = render_small(base, 256, 1);
     let variants = [
-        ("balance heuristic", PathTracer { mis: MisHeuristic::Balance, ..base }, 256),
-        ("light sampling only for direct light", PathTracer { mis: MisHeuristic::None, ..base }, 256),
-        ("BSDF sampling only (no NEE)", PathTracer { nee: false, ..base }, 1024),
-        ("no Russian roulette", PathTracer { russian_roulette: false, ..base }, 256),
+        (
+            "balance heuristic",
+            PathTracer {
+                mis: MisHeuristic::Balance,
+                ..base
+            },
+            256,
+        ),
+        (
+            "light sampling only for direct light",
+            PathTracer {
+                mis: MisHeuristic::None,
+                ..base
+            },
+            256,
+        ),
+        (
+            "BSDF sampling only (no NEE)",
+            PathTracer { nee: false, ..base },
+            1024,
+        ),
+        (
+            "no Russian roulette",
+            PathTracer {
+                russian_roulette: false,
+                ..base
+            },
+            256,
+        ),
     ];
     for (k, (name, tracer, spp)) in variants.into_iter().enumerate() {
         let image = render_small(tracer, spp, 10 + k as u64);
@@ -85,7 +121,12 @@ fn a_wrong_estimator_is_caught() {
     let worst = blocks(&a)
         .iter()
         .zip(blocks(&b).iter())
-        .flat_map(|(x, y)| (0..3).map(move |c| ((x.0[c] - y.0[c]) / (x.1[c] + y.1[c]).sqrt()).abs()))
+        .flat_map(|(x, y)| {
+            (0..3).map(move |c| ((x.0[c] - y.0[c]) / (x.1[c] + y.1[c]).sqrt()).abs())
+        })
         .fold(0.0f64, f64::max);
-    assert!(worst > 4.5, "a 3% bias went unnoticed (largest z {worst:.2})");
+    assert!(
+        worst > 4.5,
+        "a 3% bias went unnoticed (largest z {worst:.2})"
+    );
 }

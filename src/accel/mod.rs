@@ -12,14 +12,14 @@ mod triangle;
 
 use crate::math::{Ray, gamma};
 use glam::Vec3A;
-use soup::TriangleSoup;
-use sphere::intersect_sphere;
-use triangle::ShearedRay;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::builder::build_cwbvh;
+use soup::TriangleSoup;
+use sphere::intersect_sphere;
 use std::time::Duration;
+use triangle::ShearedRay;
 
 /// Marks a primitive that is not a light.
 pub const NO_LIGHT: u32 = u32::MAX;
@@ -71,7 +71,11 @@ struct TriangleShading {
 impl TriangleShading {
     fn new(t: &TriangleInput) -> Self {
         let [p0, p1, p2] = t.vertices;
-        TriangleShading { normal: (p1 - p0).cross(p2 - p0).normalize(), material: t.material, light: NO_LIGHT }
+        TriangleShading {
+            normal: (p1 - p0).cross(p2 - p0).normalize(),
+            material: t.material,
+            light: NO_LIGHT,
+        }
     }
 }
 
@@ -135,7 +139,11 @@ impl Geometry {
     }
 
     /// Builds with a chosen triangle index (for tests and benchmarks).
-    pub fn build_with(triangles: &[TriangleInput], spheres: Vec<Sphere>, choice: AccelChoice) -> Self {
+    pub fn build_with(
+        triangles: &[TriangleInput],
+        spheres: Vec<Sphere>,
+        choice: AccelChoice,
+    ) -> Self {
         let mut geometry = Geometry::default();
         let use_soup = match choice {
             AccelChoice::Auto => triangles.len() <= SOUP_MAX_TRIANGLES,
@@ -149,7 +157,10 @@ impl Geometry {
             }
             geometry.tri_index = TriangleIndex::Soup(TriangleSoup::new(&geometry.tri_vertices));
         } else if !triangles.is_empty() {
-            let aabbs: Vec<Aabb> = triangles.iter().map(|t| Aabb::from_points(&t.vertices)).collect();
+            let aabbs: Vec<Aabb> = triangles
+                .iter()
+                .map(|t| Aabb::from_points(&t.vertices))
+                .collect();
             let bvh = build_cwbvh(&aabbs, build_params(), &mut Duration::default());
             for &i in &bvh.primitive_indices {
                 let t = &triangles[i as usize];
@@ -161,10 +172,19 @@ impl Geometry {
         if !spheres.is_empty() {
             let aabbs: Vec<Aabb> = spheres
                 .iter()
-                .map(|s| Aabb::new(s.center - Vec3A::splat(s.radius), s.center + Vec3A::splat(s.radius)))
+                .map(|s| {
+                    Aabb::new(
+                        s.center - Vec3A::splat(s.radius),
+                        s.center + Vec3A::splat(s.radius),
+                    )
+                })
                 .collect();
             let bvh = build_cwbvh(&aabbs, build_params(), &mut Duration::default());
-            geometry.spheres = bvh.primitive_indices.iter().map(|&i| spheres[i as usize]).collect();
+            geometry.spheres = bvh
+                .primitive_indices
+                .iter()
+                .map(|&i| spheres[i as usize])
+                .collect();
             geometry.sphere_bvh = Some(bvh);
         }
         geometry
@@ -246,7 +266,8 @@ impl Geometry {
             let mut hit = obvhs::ray::RayHit::none();
             bvh.ray_traverse(bvh_ray(ray, best_t), &mut hit, |r, id| {
                 let s = &self.spheres[id];
-                intersect_sphere(r.origin, r.direction, s.center, s.radius, r.tmax).unwrap_or(f32::INFINITY)
+                intersect_sphere(r.origin, r.direction, s.center, s.radius, r.tmax)
+                    .unwrap_or(f32::INFINITY)
             });
             if hit.t < best_t {
                 best_t = hit.t;
@@ -297,7 +318,9 @@ impl Geometry {
             TriangleIndex::Bvh(bvh) => {
                 let sheared = ShearedRay::new(ray);
                 !bvh.ray_traverse_miss(bvh_ray(ray, ray.t_max), |r, id| {
-                    sheared.intersect(&self.tri_vertices[id], r.tmax).map_or(f32::INFINITY, |h| h.0)
+                    sheared
+                        .intersect(&self.tri_vertices[id], r.tmax)
+                        .map_or(f32::INFINITY, |h| h.0)
                 })
             }
         };
@@ -307,7 +330,8 @@ impl Geometry {
         if let Some(bvh) = &self.sphere_bvh {
             let miss = bvh.ray_traverse_miss(bvh_ray(ray, ray.t_max), |r, id| {
                 let s = &self.spheres[id];
-                intersect_sphere(r.origin, r.direction, s.center, s.radius, r.tmax).unwrap_or(f32::INFINITY)
+                intersect_sphere(r.origin, r.direction, s.center, s.radius, r.tmax)
+                    .unwrap_or(f32::INFINITY)
             });
             if !miss {
                 return true;
@@ -330,8 +354,14 @@ mod tests {
             Vec3A::new(0.0, 1.0, 1.0),
         ];
         vec![
-            TriangleInput { vertices: [p[0], p[1], p[2]], material: 0 },
-            TriangleInput { vertices: [p[0], p[2], p[3]], material: 1 },
+            TriangleInput {
+                vertices: [p[0], p[1], p[2]],
+                material: 0,
+            },
+            TriangleInput {
+                vertices: [p[0], p[2], p[3]],
+                material: 1,
+            },
         ]
     }
 
@@ -351,25 +381,45 @@ mod tests {
 
     #[test]
     fn closest_of_sphere_and_triangle_wins() {
-        let sphere = Sphere { center: Vec3A::new(0.5, 0.5, 3.0), radius: 0.5, material: 7, light: NO_LIGHT };
+        let sphere = Sphere {
+            center: Vec3A::new(0.5, 0.5, 3.0),
+            radius: 0.5,
+            material: 7,
+            light: NO_LIGHT,
+        };
         let g = Geometry::build(&quad_mesh(), vec![sphere]);
-        let hit = g.intersect(&Ray::new(Vec3A::new(0.5, 0.5, 5.0), -Vec3A::Z)).unwrap();
+        let hit = g
+            .intersect(&Ray::new(Vec3A::new(0.5, 0.5, 5.0), -Vec3A::Z))
+            .unwrap();
         assert_eq!(hit.material, 7);
         assert!((hit.t - 1.5).abs() < 1e-5);
         assert!((hit.normal - Vec3A::Z).length() < 1e-5);
         // From inside the sphere the far side is hit.
-        let hit = g.intersect(&Ray::new(Vec3A::new(0.5, 0.5, 3.0), Vec3A::Z)).unwrap();
+        let hit = g
+            .intersect(&Ray::new(Vec3A::new(0.5, 0.5, 3.0), Vec3A::Z))
+            .unwrap();
         assert!((hit.t - 0.5).abs() < 1e-5);
-        let hit = g.intersect(&Ray::new(Vec3A::new(0.25, 0.5, 0.0), Vec3A::Z)).unwrap();
+        let hit = g
+            .intersect(&Ray::new(Vec3A::new(0.25, 0.5, 0.0), Vec3A::Z))
+            .unwrap();
         assert!(hit.material <= 1);
         assert!((hit.normal - Vec3A::Z).length() < 1e-6);
     }
 
     #[test]
     fn negative_zero_direction_components_still_hit() {
-        let sphere = Sphere { center: Vec3A::new(0.5, 0.5, 3.0), radius: 0.5, material: 0, light: NO_LIGHT };
+        let sphere = Sphere {
+            center: Vec3A::new(0.5, 0.5, 3.0),
+            radius: 0.5,
+            material: 0,
+            light: NO_LIGHT,
+        };
         let g = Geometry::build(&[], vec![sphere]);
-        for d in [Vec3A::new(-0.0, -0.0, -1.0), Vec3A::new(-0.0, 0.0, -1.0), Vec3A::new(1e-3, -0.0, -1.0)] {
+        for d in [
+            Vec3A::new(-0.0, -0.0, -1.0),
+            Vec3A::new(-0.0, 0.0, -1.0),
+            Vec3A::new(1e-3, -0.0, -1.0),
+        ] {
             let hit = g.intersect(&Ray::new(Vec3A::new(0.5, 0.5, 5.0), d.normalize()));
             assert!(hit.is_some(), "{d:?}");
             assert!(g.occluded(&Ray::new(Vec3A::new(0.5, 0.5, 5.0), d.normalize())));

@@ -44,7 +44,10 @@ impl TriangleSoup {
                         }
                     }
                 }
-                Block { v: v.map(|vertex| vertex.map(f32x8::new)), lanes: (1u32 << chunk.len()) - 1 }
+                Block {
+                    v: v.map(|vertex| vertex.map(f32x8::new)),
+                    lanes: (1u32 << chunk.len()) - 1,
+                }
             })
             .collect();
         TriangleSoup { blocks }
@@ -57,7 +60,9 @@ impl TriangleSoup {
         let mut best: Option<SoupHit> = None;
         let mut best_t = t_max;
         for (b, block) in self.blocks.iter().enumerate() {
-            let Some(hits) = block_hits(block, &axes, best_t) else { continue };
+            let Some(hits) = block_hits(block, &axes, best_t) else {
+                continue;
+            };
             let (ts, b1s, b2s) = (hits.t.to_array(), hits.b1.to_array(), hits.b2.to_array());
             let mut lanes = hits.mask;
             while lanes != 0 {
@@ -74,7 +79,8 @@ impl TriangleSoup {
                 let lane = lanes.trailing_zeros() as usize;
                 lanes &= lanes - 1;
                 let index = b * LANES + lane;
-                if let Some((t, b1, b2)) = ShearedRay::new(ray).intersect(&triangles[index], best_t) {
+                if let Some((t, b1, b2)) = ShearedRay::new(ray).intersect(&triangles[index], best_t)
+                {
                     best_t = t;
                     best = Some((index, t, b1, b2));
                 }
@@ -96,7 +102,10 @@ impl TriangleSoup {
                 while lanes != 0 {
                     let lane = lanes.trailing_zeros() as usize;
                     lanes &= lanes - 1;
-                    if ShearedRay::new(ray).intersect(&triangles[b * LANES + lane], t_max).is_some() {
+                    if ShearedRay::new(ray)
+                        .intersect(&triangles[b * LANES + lane], t_max)
+                        .is_some()
+                    {
                         return true;
                     }
                 }
@@ -132,7 +141,11 @@ impl Axes {
             kx,
             ky,
             kz,
-            origin: [f32x8::splat(o[kx]), f32x8::splat(o[ky]), f32x8::splat(o[kz])],
+            origin: [
+                f32x8::splat(o[kx]),
+                f32x8::splat(o[ky]),
+                f32x8::splat(o[kz]),
+            ],
             sx: f32x8::splat(d[kx] / d[kz]),
             sy: f32x8::splat(d[ky] / d[kz]),
             sz: f32x8::splat(1.0 / d[kz]),
@@ -174,14 +187,17 @@ fn block_hits(block: &Block, axes: &Axes, t_max: f32) -> Option<BlockHits> {
     let zero = f32x8::splat(0.0);
     let any_negative = e0.simd_lt(zero) | e1.simd_lt(zero) | e2.simd_lt(zero);
     let any_positive = e0.simd_gt(zero) | e1.simd_gt(zero) | e2.simd_gt(zero);
-    let ambiguous = (e0.simd_eq(zero) | e1.simd_eq(zero) | e2.simd_eq(zero)).to_bitmask() & block.lanes;
+    let ambiguous =
+        (e0.simd_eq(zero) | e1.simd_eq(zero) | e2.simd_eq(zero)).to_bitmask() & block.lanes;
     let det = e0 + e1 + e2;
     let t_scaled = e0 * az + e1 * bz + e2 * cz;
     // t * det within (0, t_max * det), compared without dividing.
     let t_abs = det.simd_lt(zero).select(-t_scaled, t_scaled);
     let det_abs = det.abs();
-    let in_range = t_abs.simd_gt(zero) & t_abs.simd_lt(f32x8::splat(t_max) * det_abs) & det_abs.simd_gt(zero);
-    let mut mask = (in_range & !(any_negative & any_positive)).to_bitmask() & block.lanes & !ambiguous;
+    let in_range =
+        t_abs.simd_gt(zero) & t_abs.simd_lt(f32x8::splat(t_max) * det_abs) & det_abs.simd_gt(zero);
+    let mut mask =
+        (in_range & !(any_negative & any_positive)).to_bitmask() & block.lanes & !ambiguous;
     if mask == 0 && ambiguous == 0 {
         return None;
     }
@@ -195,13 +211,21 @@ fn block_hits(block: &Block, axes: &Axes, t_max: f32) -> Option<BlockHits> {
         let delta_z = f32x8::splat(gamma(3)) * max_z;
         let delta_x = f32x8::splat(gamma(5)) * (max_x + max_z);
         let delta_y = f32x8::splat(gamma(5)) * (max_y + max_z);
-        let delta_e = f32x8::splat(2.0) * (f32x8::splat(gamma(2)) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let delta_e = f32x8::splat(2.0)
+            * (f32x8::splat(gamma(2)) * max_x * max_y + delta_y * max_x + delta_x * max_y);
         let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-        let delta_t =
-            f32x8::splat(3.0) * (f32x8::splat(gamma(3)) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
+        let delta_t = f32x8::splat(3.0)
+            * (f32x8::splat(gamma(3)) * max_e * max_z + delta_e * max_z + delta_z * max_e)
+            * inv_det.abs();
         mask &= t.simd_gt(delta_t).to_bitmask();
     }
-    Some(BlockHits { t, b1: e1 * inv_det, b2: e2 * inv_det, mask, ambiguous })
+    Some(BlockHits {
+        t,
+        b1: e1 * inv_det,
+        b2: e2 * inv_det,
+        mask,
+        ambiguous,
+    })
 }
 
 #[cfg(test)]
@@ -231,8 +255,16 @@ mod tests {
                     expected = Some((k, t, b1, b2));
                 }
             }
-            assert_eq!(soup.closest(&ray, f32::INFINITY, &triangles), expected, "ray {i}");
-            assert_eq!(soup.any(&ray, 1.0, &triangles), expected.is_some_and(|h| h.1 < 1.0), "ray {i}");
+            assert_eq!(
+                soup.closest(&ray, f32::INFINITY, &triangles),
+                expected,
+                "ray {i}"
+            );
+            assert_eq!(
+                soup.any(&ray, 1.0, &triangles),
+                expected.is_some_and(|h| h.1 < 1.0),
+                "ray {i}"
+            );
         }
     }
 }

@@ -6,7 +6,13 @@ use glam::Vec3A;
 /// The discriminant is computed from the perpendicular distance to the centre
 /// (pbrt-v4, 6.8.1), which stays accurate when the sphere is small and far away.
 #[inline(always)]
-pub fn intersect_sphere(origin: Vec3A, direction: Vec3A, center: Vec3A, radius: f32, t_max: f32) -> Option<f32> {
+pub fn intersect_sphere(
+    origin: Vec3A,
+    direction: Vec3A,
+    center: Vec3A,
+    radius: f32,
+    t_max: f32,
+) -> Option<f32> {
     let f = origin - center;
     let b = f.dot(direction);
     let perp = f - b * direction;

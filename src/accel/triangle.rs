@@ -29,8 +29,15 @@ impl ShearedRay {
         let (sx, sy, sz) = (d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
         let axis = |k: usize| Vec3A::AXES[k];
         // Rows: x' = v[kx] - sx v[kz], y' = v[ky] - sy v[kz], z' = sz v[kz].
-        let rows = [axis(kx) - sx * axis(kz), axis(ky) - sy * axis(kz), sz * axis(kz)];
-        ShearedRay { origin: ray.origin, shear: Mat3A::from_cols(rows[0], rows[1], rows[2]).transpose() }
+        let rows = [
+            axis(kx) - sx * axis(kz),
+            axis(ky) - sy * axis(kz),
+            sz * axis(kz),
+        ];
+        ShearedRay {
+            origin: ray.origin,
+            shear: Mat3A::from_cols(rows[0], rows[1], rows[2]).transpose(),
+        }
     }
 
     /// Returns (t, b1, b2) of a hit in (0, t_max), or None.
@@ -76,11 +83,11 @@ impl ShearedRay {
         let delta_y = gamma(5) * (max_y + max_z);
         let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
         let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-        let delta_t = 3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
+        let delta_t =
+            3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
         if t <= delta_t {
             return None;
         }
         Some((t, e1 * inv_det, e2 * inv_det))
     }
 }
-

@@ -44,7 +44,13 @@ impl Integrator {
     /// One radiance sample along the camera ray `ray`. Counts the rays it
     /// casts after the camera ray into `counts`.
     #[inline]
-    pub fn radiance(&self, scene: &Scene, ray: Ray, sampler: &mut Sampler, counts: &mut RayCounts) -> Rgb {
+    pub fn radiance(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
         match self {
             Integrator::Path(p) => p.radiance(scene, ray, sampler, counts),
         }

@@ -10,10 +10,10 @@
 
 use super::{MisHeuristic, RayCounts};
 use crate::accel::{NO_LIGHT, SurfaceHit};
-use crate::scene::light::LightSample;
 use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
+use crate::scene::light::LightSample;
 
 /// Settings of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -33,7 +33,13 @@ pub struct PathTracer {
 
 impl Default for PathTracer {
     fn default() -> Self {
-        PathTracer { max_depth: 8, rr_depth: 5, russian_roulette: true, nee: true, mis: MisHeuristic::Power }
+        PathTracer {
+            max_depth: 8,
+            rr_depth: 5,
+            russian_roulette: true,
+            nee: true,
+            mis: MisHeuristic::Power,
+        }
     }
 }
 
@@ -45,12 +51,22 @@ impl PathTracer {
             self.max_depth,
             if self.nee { "on" } else { "off" },
             self.mis,
-            if self.russian_roulette { format!("from {}", self.rr_depth) } else { "off".into() }
+            if self.russian_roulette {
+                format!("from {}", self.rr_depth)
+            } else {
+                "off".into()
+            }
         )
     }
 
     /// One radiance sample along `ray`.
-    pub fn radiance(&self, scene: &Scene, mut ray: Ray, sampler: &mut Sampler, counts: &mut RayCounts) -> Rgb {
+    pub fn radiance(
+        &self,
+        scene: &Scene,
+        mut ray: Ray,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
         let mut radiance = Rgb::ZERO;
         let mut beta = Rgb::ONE;
         // The camera ray behaves like a specular bounce: emission it finds is
@@ -60,7 +76,9 @@ impl PathTracer {
         let mut prev_point = ray.origin;
         let mut bounces = 0;
         loop {
-            let Some(hit) = scene.geometry.intersect(&ray) else { break };
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                break;
+            };
             let wo_world = -ray.direction;
             let material = &scene.materials[hit.material as usize];
 
@@ -73,7 +91,9 @@ impl PathTracer {
                         // Light sampling alone accounts for this path.
                         0.0
                     } else {
-                        let light_pdf = scene.lights.pdf(hit.light, prev_point, hit.point, hit.normal);
+                        let light_pdf = scene
+                            .lights
+                            .pdf(hit.light, prev_point, hit.point, hit.normal);
                         self.mis.weight(prev_bsdf_pdf, light_pdf)
                     };
                     radiance += beta * emitted * weight;
@@ -112,7 +132,9 @@ impl PathTracer {
                 }
             }
 
-            let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else { break };
+            let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
+                break;
+            };
             beta *= sample.weight;
             specular_bounce = sample.specular;
             prev_bsdf_pdf = sample.pdf;
@@ -133,7 +155,10 @@ impl PathTracer {
             }
 
             let wi_world = frame.to_world(sample.wi);
-            ray = Ray::new(offset_ray_origin(hit.point, hit.error, hit.normal, wi_world), wi_world);
+            ray = Ray::new(
+                offset_ray_origin(hit.point, hit.error, hit.normal, wi_world),
+                wi_world,
+            );
             counts.bounce += 1;
         }
         radiance
@@ -144,5 +169,7 @@ impl PathTracer {
 /// off their surfaces by their error bounds.
 #[inline]
 pub fn shadow_ray(hit: &SurfaceHit, ls: &LightSample) -> Ray {
-    ray_between(hit.point, hit.error, hit.normal, ls.point, ls.error, ls.normal)
+    ray_between(
+        hit.point, hit.error, hit.normal, ls.point, ls.error, ls.normal,
+    )
 }

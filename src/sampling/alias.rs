@@ -21,17 +21,29 @@ impl AliasTable {
     /// weights are empty, contain a non-finite value or sum to zero.
     pub fn new(weights: &[f32]) -> Option<Self> {
         let total: f64 = weights.iter().map(|&w| w as f64).sum();
-        if weights.is_empty() || !total.is_finite() || total <= 0.0 || weights.iter().any(|&w| w < 0.0) {
+        if weights.is_empty()
+            || !total.is_finite()
+            || total <= 0.0
+            || weights.iter().any(|&w| w < 0.0)
+        {
             return None;
         }
         let n = weights.len();
-        let mut scaled: Vec<f64> = weights.iter().map(|&w| w as f64 / total * n as f64).collect();
+        let mut scaled: Vec<f64> = weights
+            .iter()
+            .map(|&w| w as f64 / total * n as f64)
+            .collect();
         let mut bins: Vec<Bin> = weights
             .iter()
             .enumerate()
-            .map(|(i, &w)| Bin { threshold: 1.0, alias: i as u32, pmf: (w as f64 / total) as f32 })
+            .map(|(i, &w)| Bin {
+                threshold: 1.0,
+                alias: i as u32,
+                pmf: (w as f64 / total) as f32,
+            })
             .collect();
-        let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
+        let (mut small, mut large): (Vec<usize>, Vec<usize>) =
+            (0..n).partition(|&i| scaled[i] < 1.0);
         while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
             bins[s].threshold = scaled[s] as f32;
             bins[s].alias = l as u32;
@@ -72,7 +84,11 @@ impl AliasTable {
         let column = (scaled as usize).min(n - 1);
         let remainder = scaled - column as f32;
         let bin = self.bins[column];
-        let i = if remainder < bin.threshold { column } else { bin.alias as usize };
+        let i = if remainder < bin.threshold {
+            column
+        } else {
+            bin.alias as usize
+        };
         (i, self.bins[i].pmf)
     }
 }
@@ -96,7 +112,10 @@ mod tests {
         let total: f32 = weights.iter().sum();
         for i in 0..5 {
             let expected = weights[i] / total;
-            assert!((counts[i] as f32 / n as f32 - expected).abs() < 1e-3, "{counts:?}");
+            assert!(
+                (counts[i] as f32 / n as f32 - expected).abs() < 1e-3,
+                "{counts:?}"
+            );
             assert!((table.pmf(i) - expected).abs() < 1e-6);
         }
     }

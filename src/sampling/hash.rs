@@ -17,7 +17,12 @@ pub fn mix64(mut k: u64) -> u64 {
 /// Combines a running key with one more coordinate.
 #[inline]
 pub fn hash_combine(key: u64, value: u64) -> u64 {
-    mix64(key ^ value.wrapping_add(0x9e37_79b9_7f4a_7c15).wrapping_add(key << 6).wrapping_add(key >> 2))
+    mix64(
+        key ^ value
+            .wrapping_add(0x9e37_79b9_7f4a_7c15)
+            .wrapping_add(key << 6)
+            .wrapping_add(key >> 2),
+    )
 }
 
 /// Maps the high 24 bits of a hash to a float in [0, 1).

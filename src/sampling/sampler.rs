@@ -61,7 +61,11 @@ pub struct Sampler {
 impl Sampler {
     /// A sampler for a render with `planned_spp` samples per pixel (0 = unknown).
     pub fn new(kind: SamplerKind, seed: u64, planned_spp: u32) -> Self {
-        let batch = if planned_spp == 0 { DEFAULT_BATCH } else { planned_spp.min(1 << 20) };
+        let batch = if planned_spp == 0 {
+            DEFAULT_BATCH
+        } else {
+            planned_spp.min(1 << 20)
+        };
         // The most square factorisation batch = grid_x * grid_y.
         let mut grid_x = (batch as f64).sqrt() as u32;
         while batch % grid_x != 0 {
@@ -90,7 +94,10 @@ impl Sampler {
     pub fn start(&mut self, pixel: u32, sample_index: u32) {
         let pixel_key = hash_combine(self.seed_key, pixel as u64);
         self.sample_key = hash_combine(pixel_key, sample_index as u64);
-        self.batch_key = hash_combine(pixel_key, 0x8000_0000_0000_0000 | (sample_index / self.batch) as u64);
+        self.batch_key = hash_combine(
+            pixel_key,
+            0x8000_0000_0000_0000 | (sample_index / self.batch) as u64,
+        );
         self.sample_index = sample_index;
         self.dimension = 0;
     }

@@ -82,7 +82,11 @@ pub fn square_to_phong_lobe(u: Vec2, exponent: f32) -> Vec3A {
 /// Density wrt. solid angle: (n + 1) / (2 pi) cos^n(alpha) for cos(alpha) > 0.
 #[inline]
 pub fn phong_lobe_pdf(cos_alpha: f32, exponent: f32) -> f32 {
-    if cos_alpha > 0.0 { (exponent + 1.0) / (2.0 * PI) * cos_alpha.powf(exponent) } else { 0.0 }
+    if cos_alpha > 0.0 {
+        (exponent + 1.0) / (2.0 * PI) * cos_alpha.powf(exponent)
+    } else {
+        0.0
+    }
 }
 
 #[cfg(test)]

@@ -59,7 +59,11 @@ impl Camera {
         let ndc_x = 2.0 * film.x / self.width as f32 - 1.0;
         let ndc_y = 1.0 - 2.0 * film.y / self.height as f32;
         // Direction to the point on the image plane at unit distance.
-        let local = Vec3A::new(ndc_x * self.tan_half_fov_y * aspect, ndc_y * self.tan_half_fov_y, 1.0);
+        let local = Vec3A::new(
+            ndc_x * self.tan_half_fov_y * aspect,
+            ndc_y * self.tan_half_fov_y,
+            1.0,
+        );
         if self.aperture_radius <= 0.0 {
             let direction = (self.right * local.x + self.up * local.y + self.forward).normalize();
             return Ray::new(self.eye, direction);

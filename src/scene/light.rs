@@ -29,9 +29,23 @@ pub enum SphereSampling {
 #[derive(Clone, Copy, Debug)]
 pub enum Light {
     /// An emissive triangle `p0 + b1 e1 + b2 e2`.
-    Triangle { p0: Vec3A, e1: Vec3A, e2: Vec3A, normal: Vec3A, area: f32, radiance: Rgb, two_sided: bool },
+    Triangle {
+        p0: Vec3A,
+        e1: Vec3A,
+        e2: Vec3A,
+        normal: Vec3A,
+        area: f32,
+        radiance: Rgb,
+        two_sided: bool,
+    },
     /// An emissive sphere, emitting outwards (and inwards when two-sided).
-    Sphere { center: Vec3A, radius: f32, radiance: Rgb, two_sided: bool, sampling: SphereSampling },
+    Sphere {
+        center: Vec3A,
+        radius: f32,
+        radiance: Rgb,
+        two_sided: bool,
+        sampling: SphereSampling,
+    },
     /// An isotropic point light of `intensity` (W/sr per channel).
     Point { position: Vec3A, intensity: Rgb },
 }
@@ -63,11 +77,25 @@ impl Light {
     /// Emitted power in luminance units, used to choose lights.
     pub fn power(&self) -> f32 {
         match *self {
-            Light::Triangle { area, radiance, two_sided, .. } => {
-                luminance(radiance) * area * PI * if two_sided { 2.0 } else { 1.0 }
-            }
-            Light::Sphere { radius, radiance, two_sided, .. } => {
-                luminance(radiance) * 4.0 * PI * radius * radius * PI * if two_sided { 2.0 } else { 1.0 }
+            Light::Triangle {
+                area,
+                radiance,
+                two_sided,
+                ..
+            } => luminance(radiance) * area * PI * if two_sided { 2.0 } else { 1.0 },
+            Light::Sphere {
+                radius,
+                radiance,
+                two_sided,
+                ..
+            } => {
+                luminance(radiance)
+                    * 4.0
+                    * PI
+                    * radius
+                    * radius
+                    * PI
+                    * if two_sided { 2.0 } else { 1.0 }
             }
             Light::Point { intensity, .. } => luminance(intensity) * 4.0 * PI,
         }
@@ -77,7 +105,15 @@ impl Light {
     #[inline]
     fn sample(&self, reference: Vec3A, u: Vec2) -> Option<LightSample> {
         match *self {
-            Light::Triangle { p0, e1, e2, normal, area, radiance, two_sided } => {
+            Light::Triangle {
+                p0,
+                e1,
+                e2,
+                normal,
+                area,
+                radiance,
+                two_sided,
+            } => {
                 let b = square_to_uniform_triangle(u);
                 let point = p0 + b.x * e1 + b.y * e2;
                 let error = gamma(6) * (p0.abs() + (b.x * e1).abs() + (b.y * e2).abs());
@@ -91,9 +127,24 @@ impl Light {
                 }
                 // Area density 1/A converted to solid angle: d^2 / (|cos| A).
                 let pdf = dist2 / (cos_light.abs() * area);
-                Some(LightSample { point, error, normal, wi, distance, radiance, pdf, delta: false })
+                Some(LightSample {
+                    point,
+                    error,
+                    normal,
+                    wi,
+                    distance,
+                    radiance,
+                    pdf,
+                    delta: false,
+                })
             }
-            Light::Sphere { center, radius, radiance, two_sided, sampling } => {
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+                two_sided,
+                sampling,
+            } => {
                 let to_center = center - reference;
                 let dc2 = to_center.length_squared();
                 let inside = dc2 <= radius * radius * (1.0 + 1e-4);
@@ -102,7 +153,9 @@ impl Light {
                     let sin2_max = (radius * radius / dc2).min(1.0);
                     let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
                     let frame = Frame::from_normal(to_center / dc);
-                    let wi = frame.to_world(square_to_uniform_cone(u, cos_max)).normalize();
+                    let wi = frame
+                        .to_world(square_to_uniform_cone(u, cos_max))
+                        .normalize();
                     // Nearest intersection of the sampled direction with the sphere;
                     // clamping the discriminant handles directions at the silhouette.
                     let b = wi.dot(to_center);
@@ -117,7 +170,16 @@ impl Light {
                     if !pdf.is_finite() {
                         return None;
                     }
-                    Some(LightSample { point, error, normal, wi, distance, radiance, pdf, delta: false })
+                    Some(LightSample {
+                        point,
+                        error,
+                        normal,
+                        wi,
+                        distance,
+                        radiance,
+                        pdf,
+                        delta: false,
+                    })
                 } else {
                     let normal = square_to_uniform_sphere(u);
                     let point = center + radius * normal;
@@ -133,10 +195,22 @@ impl Light {
                         return None;
                     }
                     let pdf = dist2 / (cos_light.abs() * 4.0 * PI * radius * radius);
-                    Some(LightSample { point, error, normal, wi, distance, radiance, pdf, delta: false })
+                    Some(LightSample {
+                        point,
+                        error,
+                        normal,
+                        wi,
+                        distance,
+                        radiance,
+                        pdf,
+                        delta: false,
+                    })
                 }
             }
-            Light::Point { position, intensity } => {
+            Light::Point {
+                position,
+                intensity,
+            } => {
                 let to_light = position - reference;
                 let dist2 = to_light.length_squared();
                 let distance = dist2.sqrt();
@@ -163,7 +237,12 @@ impl Light {
         let cos_light = normal.dot(to_light).abs() / dist2.sqrt();
         match *self {
             Light::Triangle { area, .. } => dist2 / (cos_light * area),
-            Light::Sphere { center, radius, sampling, .. } => {
+            Light::Sphere {
+                center,
+                radius,
+                sampling,
+                ..
+            } => {
                 let dc2 = (center - reference).length_squared();
                 let inside = dc2 <= radius * radius * (1.0 + 1e-4);
                 if sampling == SphereSampling::SolidAngle && !inside {
@@ -220,7 +299,10 @@ impl Lights {
     #[inline]
     pub fn pdf(&self, light: u32, reference: Vec3A, point: Vec3A, normal: Vec3A) -> f32 {
         match &self.selection {
-            Some(table) => table.pmf(light as usize) * self.lights[light as usize].pdf(reference, point, normal),
+            Some(table) => {
+                table.pmf(light as usize)
+                    * self.lights[light as usize].pdf(reference, point, normal)
+            }
             None => 0.0,
         }
     }

@@ -29,7 +29,9 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         Error::at(path, line, e.message())
     })?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let at = |span: std::ops::Range<usize>, msg: String| Error::at(path, Some(line_of(text, span.start)), msg);
+    let at = |span: std::ops::Range<usize>, msg: String| {
+        Error::at(path, Some(line_of(text, span.start)), msg)
+    };
 
     let camera = build_camera(&file.camera, limits).map_err(|m| at(file.camera.span(), m))?;
 
@@ -46,7 +48,10 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         by_name.get(name).copied().ok_or_else(|| {
             let mut known: Vec<&String> = by_name.keys().collect();
             known.sort();
-            at(span, format!("unknown material `{name}` (defined: {known:?})"))
+            at(
+                span,
+                format!("unknown material `{name}` (defined: {known:?})"),
+            )
         })
     };
 
@@ -55,7 +60,14 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         let desc = mesh.get_ref();
         let obj_path = dir.join(&desc.file);
         if !obj_path.is_file() {
-            return Err(at(mesh.span(), format!("mesh file `{}` not found (looked for {})", desc.file, obj_path.display())));
+            return Err(at(
+                mesh.span(),
+                format!(
+                    "mesh file `{}` not found (looked for {})",
+                    desc.file,
+                    obj_path.display()
+                ),
+            ));
         }
         let transform = mesh_transform(desc).map_err(|m| at(mesh.span(), m))?;
         let obj = load_obj(&obj_path)?;
@@ -91,7 +103,10 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
             if triangles.len() > limits.max_triangles {
                 return Err(at(
                     mesh.span(),
-                    format!("more than {} triangles (raise the limit with --max-triangles)", limits.max_triangles),
+                    format!(
+                        "more than {} triangles (raise the limit with --max-triangles)",
+                        limits.max_triangles
+                    ),
                 ));
             }
         }
@@ -102,10 +117,19 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         let material = lookup(&q.material, quad.span(), &by_name)?;
         let (c, u, v) = (Vec3A::from(q.corner), Vec3A::from(q.u), Vec3A::from(q.v));
         if !(c.is_finite() && u.is_finite() && v.is_finite()) {
-            return Err(at(quad.span(), "quad: `corner`, `u` and `v` must be finite".into()));
+            return Err(at(
+                quad.span(),
+                "quad: `corner`, `u` and `v` must be finite".into(),
+            ));
         }
-        triangles.push(TriangleInput { vertices: [c, c + u, c + u + v], material });
-        triangles.push(TriangleInput { vertices: [c, c + u + v, c + v], material });
+        triangles.push(TriangleInput {
+            vertices: [c, c + u, c + u + v],
+            material,
+        });
+        triangles.push(TriangleInput {
+            vertices: [c, c + u + v, c + v],
+            material,
+        });
     }
 
     let mut spheres = Vec::new();
@@ -114,9 +138,20 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         let material = lookup(&s.material, sphere.span(), &by_name)?;
         let center = Vec3A::from(s.center);
         if !center.is_finite() || !s.radius.is_finite() || s.radius < 0.0 {
-            return Err(at(sphere.span(), format!("sphere: `center` must be finite and `radius` >= 0, got {}", s.radius)));
+            return Err(at(
+                sphere.span(),
+                format!(
+                    "sphere: `center` must be finite and `radius` >= 0, got {}",
+                    s.radius
+                ),
+            ));
         }
-        spheres.push(Sphere { center, radius: s.radius, material, light: NO_LIGHT });
+        spheres.push(Sphere {
+            center,
+            radius: s.radius,
+            material,
+            light: NO_LIGHT,
+        });
     }
 
     let mut point_lights = Vec::new();
@@ -125,9 +160,15 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         let position = Vec3A::from(l.position);
         let intensity = Rgb::from(l.intensity);
         if !position.is_finite() || !intensity.is_finite() || intensity.min_element() < 0.0 {
-            return Err(at(light.span(), "point_light: `position` must be finite, `intensity` finite and >= 0".into()));
+            return Err(at(
+                light.span(),
+                "point_light: `position` must be finite, `intensity` finite and >= 0".into(),
+            ));
         }
-        point_lights.push(Light::Point { position, intensity });
+        point_lights.push(Light::Point {
+            position,
+            intensity,
+        });
     }
 
     Ok(SceneInput {
@@ -142,10 +183,17 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
 
 fn finite3(name: &str, v: [f32; 3]) -> std::result::Result<Vec3A, String> {
     let v3 = Vec3A::from(v);
-    if v3.is_finite() { Ok(v3) } else { Err(format!("`{name}` must be finite, got {v:?}")) }
+    if v3.is_finite() {
+        Ok(v3)
+    } else {
+        Err(format!("`{name}` must be finite, got {v:?}"))
+    }
 }
 
-fn build_camera(span: &Spanned<CameraDesc>, limits: &Limits) -> std::result::Result<Camera, String> {
+fn build_camera(
+    span: &Spanned<CameraDesc>,
+    limits: &Limits,
+) -> std::result::Result<Camera, String> {
     let c = span.get_ref();
     let eye = finite3("camera.eye", c.eye)?;
     let look_at = finite3("camera.look_at", c.look_at)?;
@@ -153,21 +201,43 @@ fn build_camera(span: &Spanned<CameraDesc>, limits: &Limits) -> std::result::Res
     if (look_at - eye).length_squared() == 0.0 {
         return Err("`camera.look_at` must differ from `camera.eye`".into());
     }
-    if (look_at - eye).normalize().cross(up.normalize_or_zero()).length_squared() < 1e-12 {
+    if (look_at - eye)
+        .normalize()
+        .cross(up.normalize_or_zero())
+        .length_squared()
+        < 1e-12
+    {
         return Err("`camera.up` must not be parallel to the view direction".into());
     }
     if !(c.fov_y > 0.0 && c.fov_y < 180.0) {
-        return Err(format!("`camera.fov_y` must be in (0, 180) degrees, got {}", c.fov_y));
+        return Err(format!(
+            "`camera.fov_y` must be in (0, 180) degrees, got {}",
+            c.fov_y
+        ));
     }
-    limits.check_resolution(c.width, c.height).map_err(|e| format!("camera: {e}"))?;
+    limits
+        .check_resolution(c.width, c.height)
+        .map_err(|e| format!("camera: {e}"))?;
     if !(c.aperture_radius.is_finite() && c.aperture_radius >= 0.0) {
-        return Err(format!("`camera.aperture_radius` must be >= 0, got {}", c.aperture_radius));
+        return Err(format!(
+            "`camera.aperture_radius` must be >= 0, got {}",
+            c.aperture_radius
+        ));
     }
     let focus = c.focus_distance.unwrap_or((look_at - eye).length());
     if !(focus.is_finite() && focus > 0.0) {
         return Err(format!("`camera.focus_distance` must be > 0, got {focus}"));
     }
-    Ok(Camera::look_at(eye, look_at, up, c.fov_y, c.width, c.height, c.aperture_radius, focus))
+    Ok(Camera::look_at(
+        eye,
+        look_at,
+        up,
+        c.fov_y,
+        c.width,
+        c.height,
+        c.aperture_radius,
+        focus,
+    ))
 }
 
 fn mesh_transform(m: &MeshDesc) -> std::result::Result<Mat4, String> {
@@ -176,12 +246,18 @@ fn mesh_transform(m: &MeshDesc) -> std::result::Result<Mat4, String> {
         Scale::PerAxis(s) => Vec3::from(s),
     };
     if !scale.is_finite() || scale.min_element().abs() == 0.0 {
-        return Err(format!("mesh `{}`: `scale` must be finite and non-zero", m.file));
+        return Err(format!(
+            "mesh `{}`: `scale` must be finite and non-zero",
+            m.file
+        ));
     }
     let rotate = Vec3::from(m.rotate);
     let translate = Vec3::from(m.translate);
     if !rotate.is_finite() || !translate.is_finite() {
-        return Err(format!("mesh `{}`: `rotate` and `translate` must be finite", m.file));
+        return Err(format!(
+            "mesh `{}`: `rotate` and `translate` must be finite",
+            m.file
+        ));
     }
     // Rotation about x first, then y, then z.
     let rotation = Quat::from_euler(
@@ -190,24 +266,36 @@ fn mesh_transform(m: &MeshDesc) -> std::result::Result<Mat4, String> {
         rotate.y.to_radians(),
         rotate.x.to_radians(),
     );
-    Ok(Mat4::from_scale_rotation_translation(scale, rotation, translate))
+    Ok(Mat4::from_scale_rotation_translation(
+        scale, rotation, translate,
+    ))
 }
 
 fn default_material() -> Material {
     Material {
         name: "default".into(),
-        bsdf: Bsdf::Diffuse { albedo: Rgb::splat(0.8) },
+        bsdf: Bsdf::Diffuse {
+            albedo: Rgb::splat(0.8),
+        },
         emission: Rgb::ZERO,
         two_sided_emission: false,
     }
 }
 
 fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material, String> {
-    let colour = |field: &str, v: Option<[f32; 3]>, default: Rgb, max: f32| -> std::result::Result<Rgb, String> {
+    let colour = |field: &str,
+                  v: Option<[f32; 3]>,
+                  default: Rgb,
+                  max: f32|
+     -> std::result::Result<Rgb, String> {
         match v {
             None => Ok(default),
-            Some(c) if c.iter().all(|x| x.is_finite() && *x >= 0.0 && *x <= max) => Ok(Rgb::from(c)),
-            Some(c) => Err(format!("material `{name}`: `{field}` must be in [0, {max}], got {c:?}")),
+            Some(c) if c.iter().all(|x| x.is_finite() && *x >= 0.0 && *x <= max) => {
+                Ok(Rgb::from(c))
+            }
+            Some(c) => Err(format!(
+                "material `{name}`: `{field}` must be in [0, {max}], got {c:?}"
+            )),
         }
     };
     let allowed: &[&str] = match d.kind {
@@ -233,11 +321,15 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
         }
     }
     let bsdf = match d.kind {
-        MaterialKind::Diffuse => Bsdf::Diffuse { albedo: colour("albedo", d.albedo, Rgb::splat(0.8), 1.0)? },
+        MaterialKind::Diffuse => Bsdf::Diffuse {
+            albedo: colour("albedo", d.albedo, Rgb::splat(0.8), 1.0)?,
+        },
         MaterialKind::Glossy => {
             let exponent = d.exponent.unwrap_or(50.0);
             if !(exponent.is_finite() && exponent >= 0.0) {
-                return Err(format!("material `{name}`: `exponent` must be >= 0, got {exponent}"));
+                return Err(format!(
+                    "material `{name}`: `exponent` must be >= 0, got {exponent}"
+                ));
             }
             Bsdf::glossy(
                 colour("albedo", d.albedo, Rgb::splat(0.3), 1.0)?,
@@ -245,13 +337,18 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
                 exponent,
             )
         }
-        MaterialKind::Mirror => Bsdf::Mirror { reflectance: colour("reflectance", d.reflectance, Rgb::ONE, 1.0)? },
+        MaterialKind::Mirror => Bsdf::Mirror {
+            reflectance: colour("reflectance", d.reflectance, Rgb::ONE, 1.0)?,
+        },
         MaterialKind::Dielectric => {
             let eta = d.ior.unwrap_or(1.5);
             if !(eta.is_finite() && eta > 0.0) {
                 return Err(format!("material `{name}`: `ior` must be > 0, got {eta}"));
             }
-            Bsdf::Dielectric { eta, tint: colour("tint", d.tint, Rgb::ONE, 1.0)? }
+            Bsdf::Dielectric {
+                eta,
+                tint: colour("tint", d.tint, Rgb::ONE, 1.0)?,
+            }
         }
     };
     Ok(Material {

@@ -5,11 +5,11 @@
 //! the geometric normal as stored, not flipped), both pointing away from the
 //! surface. Opaque BSDFs are two-sided: they act on whichever side `wo` is.
 
+use crate::math::Frame;
 use crate::math::{Rgb, luminance, reflect};
 use crate::sampling::warp::{
     cosine_hemisphere_pdf, phong_lobe_pdf, square_to_cosine_hemisphere, square_to_phong_lobe,
 };
-use crate::math::Frame;
 use glam::{Vec2, Vec3A};
 use std::f32::consts::{FRAC_1_PI, PI};
 
@@ -22,7 +22,12 @@ pub enum Bsdf {
     /// f = kd / pi + ks (n + 2) / (2 pi) cos^n(alpha), alpha the angle between
     /// wi and the mirror direction of wo. Energy-conserving when kd + ks <= 1
     /// (the loader scales them down otherwise).
-    Glossy { diffuse: Rgb, specular: Rgb, exponent: f32, diffuse_probability: f32 },
+    Glossy {
+        diffuse: Rgb,
+        specular: Rgb,
+        exponent: f32,
+        diffuse_probability: f32,
+    },
     /// Perfect specular reflection.
     Mirror { reflectance: Rgb },
     /// Smooth dielectric boundary: Snell refraction, exact unpolarised Fresnel
@@ -51,7 +56,11 @@ impl Material {
     /// Radiance emitted from a surface with geometric normal `n` towards `w`.
     #[inline]
     pub fn emitted(&self, n: Vec3A, w: Vec3A) -> Rgb {
-        if self.two_sided_emission || n.dot(w) > 0.0 { self.emission } else { Rgb::ZERO }
+        if self.two_sided_emission || n.dot(w) > 0.0 {
+            self.emission
+        } else {
+            Rgb::ZERO
+        }
     }
 }
 
@@ -72,7 +81,14 @@ pub struct BsdfSample {
 /// Flips both directions to the +z side when `wo` is below: opaque BSDFs are two-sided.
 #[inline]
 fn to_upper_side(wo: Vec3A, wi: Vec3A) -> (Vec3A, Vec3A) {
-    if wo.z < 0.0 { (wo * Vec3A::new(1.0, 1.0, -1.0), wi * Vec3A::new(1.0, 1.0, -1.0)) } else { (wo, wi) }
+    if wo.z < 0.0 {
+        (
+            wo * Vec3A::new(1.0, 1.0, -1.0),
+            wi * Vec3A::new(1.0, 1.0, -1.0),
+        )
+    } else {
+        (wo, wi)
+    }
 }
 
 impl Bsdf {
@@ -87,7 +103,9 @@ impl Bsdf {
     pub fn is_black(&self) -> bool {
         match *self {
             Bsdf::Diffuse { albedo } => albedo.max_element() <= 0.0,
-            Bsdf::Glossy { diffuse, specular, .. } => diffuse.max_element() <= 0.0 && specular.max_element() <= 0.0,
+            Bsdf::Glossy {
+                diffuse, specular, ..
+            } => diffuse.max_element() <= 0.0 && specular.max_element() <= 0.0,
             Bsdf::Mirror { reflectance } => reflectance.max_element() <= 0.0,
             Bsdf::Dielectric { .. } => false,
         }
@@ -103,13 +121,19 @@ impl Bsdf {
                 }
                 albedo * FRAC_1_PI
             }
-            Bsdf::Glossy { diffuse, specular, exponent, .. } => {
+            Bsdf::Glossy {
+                diffuse,
+                specular,
+                exponent,
+                ..
+            } => {
                 let (wo, wi) = to_upper_side(wo, wi);
                 if wo.z <= 0.0 || wi.z <= 0.0 {
                     return Rgb::ZERO;
                 }
                 let cos_alpha = reflect(wo, Vec3A::Z).dot(wi).max(0.0);
-                diffuse * FRAC_1_PI + specular * ((exponent + 2.0) / (2.0 * PI) * cos_alpha.powf(exponent))
+                diffuse * FRAC_1_PI
+                    + specular * ((exponent + 2.0) / (2.0 * PI) * cos_alpha.powf(exponent))
             }
             Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => Rgb::ZERO,
         }
@@ -123,7 +147,11 @@ impl Bsdf {
                 let (_, wi) = to_upper_side(wo, wi);
                 cosine_hemisphere_pdf(wi)
             }
-            Bsdf::Glossy { exponent, diffuse_probability, .. } => {
+            Bsdf::Glossy {
+                exponent,
+                diffuse_probability,
+                ..
+            } => {
                 let (wo, wi) = to_upper_side(wo, wi);
                 if wo.z <= 0.0 || wi.z <= 0.0 {
                     return 0.0;
@@ -151,10 +179,23 @@ impl Bsdf {
                     return None;
                 }
                 // f cos / pdf = (albedo / pi) cos / (cos / pi) = albedo.
-                Some(BsdfSample { wi, weight: albedo, pdf: cosine_hemisphere_pdf(wi.abs()), specular: false })
+                Some(BsdfSample {
+                    wi,
+                    weight: albedo,
+                    pdf: cosine_hemisphere_pdf(wi.abs()),
+                    specular: false,
+                })
             }
-            Bsdf::Glossy { exponent, diffuse_probability, .. } => {
-                let flip = if wo.z < 0.0 { Vec3A::new(1.0, 1.0, -1.0) } else { Vec3A::ONE };
+            Bsdf::Glossy {
+                exponent,
+                diffuse_probability,
+                ..
+            } => {
+                let flip = if wo.z < 0.0 {
+                    Vec3A::new(1.0, 1.0, -1.0)
+                } else {
+                    Vec3A::ONE
+                };
                 let wo_up = wo * flip;
                 if wo_up.z <= 0.0 {
                     return None;
@@ -174,7 +215,12 @@ impl Bsdf {
                     return None;
                 }
                 let weight = self.eval(wo, wi) * (wi_up.z / pdf);
-                Some(BsdfSample { wi, weight, pdf, specular: false })
+                Some(BsdfSample {
+                    wi,
+                    weight,
+                    pdf,
+                    specular: false,
+                })
             }
             Bsdf::Mirror { reflectance } => Some(BsdfSample {
                 wi: Vec3A::new(-wo.x, -wo.y, wo.z),
@@ -213,7 +259,9 @@ impl Bsdf {
     pub fn max_reflectance(&self) -> f32 {
         match *self {
             Bsdf::Diffuse { albedo } => albedo.max_element(),
-            Bsdf::Glossy { diffuse, specular, .. } => (diffuse + specular).max_element(),
+            Bsdf::Glossy {
+                diffuse, specular, ..
+            } => (diffuse + specular).max_element(),
             Bsdf::Mirror { reflectance } => reflectance.max_element(),
             Bsdf::Dielectric { tint, .. } => tint.max_element(),
         }
@@ -227,7 +275,12 @@ impl Bsdf {
         let (diffuse, specular) = (diffuse * scale, specular * scale);
         let (ld, ls) = (luminance(diffuse), luminance(specular));
         let diffuse_probability = if ld + ls > 0.0 { ld / (ld + ls) } else { 1.0 };
-        Bsdf::Glossy { diffuse, specular, exponent: exponent.max(0.0), diffuse_probability }
+        Bsdf::Glossy {
+            diffuse,
+            specular,
+            exponent: exponent.max(0.0),
+            diffuse_probability,
+        }
     }
 }
 
@@ -246,18 +299,30 @@ pub struct Fresnel {
 /// on the exterior side) at a boundary with relative IOR `eta` = interior / exterior.
 #[inline]
 pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> Fresnel {
-    let (eta_rel, cos_i_abs) = if cos_i >= 0.0 { (eta, cos_i) } else { (1.0 / eta, -cos_i) };
+    let (eta_rel, cos_i_abs) = if cos_i >= 0.0 {
+        (eta, cos_i)
+    } else {
+        (1.0 / eta, -cos_i)
+    };
     let eta_ti = 1.0 / eta_rel;
     // Snell: sin_t = sin_i / eta_rel.
     let sin2_t = (1.0 - cos_i_abs * cos_i_abs).max(0.0) * eta_ti * eta_ti;
     if sin2_t >= 1.0 {
-        return Fresnel { reflectance: 1.0, cos_t: 0.0, eta_ti };
+        return Fresnel {
+            reflectance: 1.0,
+            cos_t: 0.0,
+            eta_ti,
+        };
     }
     let cos_t_abs = (1.0 - sin2_t).sqrt();
     let rs = (cos_i_abs - eta_rel * cos_t_abs) / (cos_i_abs + eta_rel * cos_t_abs);
     let rp = (eta_rel * cos_i_abs - cos_t_abs) / (eta_rel * cos_i_abs + cos_t_abs);
     let reflectance = 0.5 * (rs * rs + rp * rp);
-    Fresnel { reflectance, cos_t: if cos_i >= 0.0 { -cos_t_abs } else { cos_t_abs }, eta_ti }
+    Fresnel {
+        reflectance,
+        cos_t: if cos_i >= 0.0 { -cos_t_abs } else { cos_t_abs },
+        eta_ti,
+    }
 }
 
 #[cfg(test)]
@@ -279,7 +344,10 @@ mod tests {
 
     #[test]
     fn refraction_obeys_snell() {
-        let bsdf = Bsdf::Dielectric { eta: 1.5, tint: Rgb::ONE };
+        let bsdf = Bsdf::Dielectric {
+            eta: 1.5,
+            tint: Rgb::ONE,
+        };
         let theta_i = 30f32.to_radians();
         let wo = Vec3A::new(theta_i.sin(), 0.0, theta_i.cos());
         // u_lobe = 0.999 > F picks refraction.
@@ -293,7 +361,9 @@ mod tests {
     #[test]
     fn glossy_is_scaled_to_conserve_energy() {
         match Bsdf::glossy(Rgb::splat(0.8), Rgb::splat(0.6), 10.0) {
-            Bsdf::Glossy { diffuse, specular, .. } => {
+            Bsdf::Glossy {
+                diffuse, specular, ..
+            } => {
                 assert!(((diffuse + specular).max_element() - 1.0).abs() < 1e-6)
             }
             _ => unreachable!(),

@@ -24,7 +24,10 @@ pub struct Limits {
 
 impl Default for Limits {
     fn default() -> Self {
-        Limits { max_resolution: 16384, max_triangles: 50_000_000 }
+        Limits {
+            max_resolution: 16384,
+            max_triangles: 50_000_000,
+        }
     }
 }
 
@@ -33,7 +36,9 @@ impl Limits {
     pub fn check_resolution(&self, width: u32, height: u32) -> std::result::Result<(), String> {
         let max = self.max_resolution;
         if width == 0 || height == 0 || width > max || height > max {
-            return Err(format!("resolution {width}x{height} is outside 1..={max} per side"));
+            return Err(format!(
+                "resolution {width}x{height} is outside 1..={max} per side"
+            ));
         }
         Ok(())
     }
@@ -90,15 +95,30 @@ impl Scene {
         let dropped = total - triangles.len();
         if dropped > 0 {
             let emitters_hint = "(zero-area emitters among them emit nothing)";
-            warnings.push(format!("dropped {dropped} degenerate triangle(s) of {total} {emitters_hint}"));
+            warnings.push(format!(
+                "dropped {dropped} degenerate triangle(s) of {total} {emitters_hint}"
+            ));
         }
         let sphere_total = input.spheres.len();
-        let spheres: Vec<Sphere> = input.spheres.into_iter().filter(|s| s.radius > 0.0).collect();
+        let spheres: Vec<Sphere> = input
+            .spheres
+            .into_iter()
+            .filter(|s| s.radius > 0.0)
+            .collect();
         if spheres.len() < sphere_total {
-            warnings.push(format!("dropped {} sphere(s) of radius 0", sphere_total - spheres.len()));
+            warnings.push(format!(
+                "dropped {} sphere(s) of radius 0",
+                sphere_total - spheres.len()
+            ));
         }
-        if let Some(bad) = triangles.iter().find(|t| t.material as usize >= input.materials.len()) {
-            return Err(Error::new(format!("internal: triangle refers to material {}", bad.material)));
+        if let Some(bad) = triangles
+            .iter()
+            .find(|t| t.material as usize >= input.materials.len())
+        {
+            return Err(Error::new(format!(
+                "internal: triangle refers to material {}",
+                bad.material
+            )));
         }
 
         let mut geometry = Geometry::build(&triangles, spheres);
@@ -140,7 +160,13 @@ impl Scene {
         if lights.is_empty() {
             warnings.push("the scene has no light source: the image will be black".into());
         }
-        Ok(Scene { camera: input.camera, geometry, materials: input.materials, lights, warnings })
+        Ok(Scene {
+            camera: input.camera,
+            geometry,
+            materials: input.materials,
+            lights,
+            warnings,
+        })
     }
 
     /// Overrides the image size (keeping the field of view).

@@ -26,32 +26,55 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh> {
         .map_err(|e| Error::at(path, None, format!("cannot read OBJ file: {e}")))?;
     check_obj_text(path, &text)?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let options = tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
-    let (models, materials) = tobj::load_obj_buf(&mut BufReader::new(text.as_bytes()), &options, |mtl| {
-        tobj::load_mtl(dir.join(mtl))
-    })
-    .map_err(|e| Error::at(path, None, format!("malformed OBJ: {e}")))?;
-    let materials = materials.map_err(|e| Error::at(path, None, format!("cannot load its material library: {e}")))?;
-    let mtl_path = mtl_library(&text).map(|m| dir.join(m)).unwrap_or_else(|| path.to_path_buf());
-    let materials = materials.iter().map(|m| convert_material(&mtl_path, m)).collect::<Result<Vec<_>>>()?;
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let (models, materials) =
+        tobj::load_obj_buf(&mut BufReader::new(text.as_bytes()), &options, |mtl| {
+            tobj::load_mtl(dir.join(mtl))
+        })
+        .map_err(|e| Error::at(path, None, format!("malformed OBJ: {e}")))?;
+    let materials = materials
+        .map_err(|e| Error::at(path, None, format!("cannot load its material library: {e}")))?;
+    let mtl_path = mtl_library(&text)
+        .map(|m| dir.join(m))
+        .unwrap_or_else(|| path.to_path_buf());
+    let materials = materials
+        .iter()
+        .map(|m| convert_material(&mtl_path, m))
+        .collect::<Result<Vec<_>>>()?;
 
     let mut triangles = Vec::new();
     for model in &models {
         let mesh = &model.mesh;
         let vertex = |i: u32| -> Vec3A {
             let i = i as usize * 3;
-            Vec3A::new(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2])
+            Vec3A::new(
+                mesh.positions[i],
+                mesh.positions[i + 1],
+                mesh.positions[i + 2],
+            )
         };
         for face in mesh.indices.chunks_exact(3) {
-            triangles.push(([vertex(face[0]), vertex(face[1]), vertex(face[2])], mesh.material_id));
+            triangles.push((
+                [vertex(face[0]), vertex(face[1]), vertex(face[2])],
+                mesh.material_id,
+            ));
         }
     }
-    Ok(ObjMesh { triangles, materials })
+    Ok(ObjMesh {
+        triangles,
+        materials,
+    })
 }
 
 /// The first `mtllib` file name, if any.
 fn mtl_library(text: &str) -> Option<&str> {
-    text.lines().find_map(|l| l.trim().strip_prefix("mtllib ").map(str::trim))
+    text.lines()
+        .find_map(|l| l.trim().strip_prefix("mtllib ").map(str::trim))
 }
 
 /// Line scan for what tobj accepts silently or reports without a line.
@@ -65,16 +88,28 @@ pub fn check_obj_text(path: &Path, text: &str) -> Result<()> {
             Some("v") => {
                 let coords: Vec<&str> = words.take(3).collect();
                 if coords.len() < 3 {
-                    return Err(Error::at(path, Some(number), "vertex needs three coordinates `v x y z`"));
+                    return Err(Error::at(
+                        path,
+                        Some(number),
+                        "vertex needs three coordinates `v x y z`",
+                    ));
                 }
                 for c in coords {
                     match c.parse::<f32>() {
                         Ok(x) if x.is_finite() => {}
                         Ok(_) => {
-                            return Err(Error::at(path, Some(number), format!("vertex coordinate `{c}` is not finite")));
+                            return Err(Error::at(
+                                path,
+                                Some(number),
+                                format!("vertex coordinate `{c}` is not finite"),
+                            ));
                         }
                         Err(_) => {
-                            return Err(Error::at(path, Some(number), format!("vertex coordinate `{c}` is not a number")));
+                            return Err(Error::at(
+                                path,
+                                Some(number),
+                                format!("vertex coordinate `{c}` is not a number"),
+                            ));
                         }
                     }
                 }
@@ -90,19 +125,29 @@ pub fn check_obj_text(path: &Path, text: &str) -> Result<()> {
                         Ok(i) if i > 0 => i,
                         Ok(i) if i < 0 => vertex_count + 1 + i,
                         _ => {
-                            return Err(Error::at(path, Some(number), format!("face index `{corner}` is not a valid index")));
+                            return Err(Error::at(
+                                path,
+                                Some(number),
+                                format!("face index `{corner}` is not a valid index"),
+                            ));
                         }
                     };
                     if resolved < 1 || resolved > vertex_count {
                         return Err(Error::at(
                             path,
                             Some(number),
-                            format!("face index {index} is out of range: {vertex_count} vertices defined so far"),
+                            format!(
+                                "face index {index} is out of range: {vertex_count} vertices defined so far"
+                            ),
                         ));
                     }
                 }
                 if corners < 3 {
-                    return Err(Error::at(path, Some(number), "face needs at least three vertices"));
+                    return Err(Error::at(
+                        path,
+                        Some(number),
+                        "face needs at least three vertices",
+                    ));
                 }
             }
             Some("mtllib") => {
@@ -112,7 +157,10 @@ pub fn check_obj_text(path: &Path, text: &str) -> Result<()> {
                     return Err(Error::at(
                         path,
                         Some(number),
-                        format!("material library `{name}` not found (looked for {})", mtl.display()),
+                        format!(
+                            "material library `{name}` not found (looked for {})",
+                            mtl.display()
+                        ),
                     ));
                 }
             }
@@ -134,7 +182,10 @@ fn convert_material(mtl_path: &Path, m: &tobj::Material) -> Result<Material> {
             Some(c) => Err(Error::at(
                 mtl_path,
                 None,
-                format!("material `{}`: `{field}` must be finite and non-negative, got {c:?}", m.name),
+                format!(
+                    "material `{}`: `{field}` must be finite and non-negative, got {c:?}",
+                    m.name
+                ),
             )),
             None => Ok(None),
         }
@@ -143,26 +194,49 @@ fn convert_material(mtl_path: &Path, m: &tobj::Material) -> Result<Material> {
     let ks = check("Ks", m.specular)?;
     let emission = check("Ke", m.emissive)?.unwrap_or(Rgb::ZERO);
     let ns = m.shininess.unwrap_or(0.0);
-    let tf = m.unknown_param.get("Tf").and_then(|s| parse_rgb(s)).unwrap_or(Rgb::ONE);
+    let tf = m
+        .unknown_param
+        .get("Tf")
+        .and_then(|s| parse_rgb(s))
+        .unwrap_or(Rgb::ONE);
     let bsdf = match m.illumination_model {
-        Some(3 | 5) => Bsdf::Mirror { reflectance: ks.unwrap_or(Rgb::ONE).min(Rgb::ONE) },
+        Some(3 | 5) => Bsdf::Mirror {
+            reflectance: ks.unwrap_or(Rgb::ONE).min(Rgb::ONE),
+        },
         Some(4 | 6 | 7) => {
             let eta = m.optical_density.unwrap_or(1.5);
             if !(eta.is_finite() && eta > 0.0) {
-                return Err(Error::at(mtl_path, None, format!("material `{}`: `Ni` must be positive, got {eta}", m.name)));
+                return Err(Error::at(
+                    mtl_path,
+                    None,
+                    format!("material `{}`: `Ni` must be positive, got {eta}", m.name),
+                ));
             }
-            Bsdf::Dielectric { eta, tint: tf.min(Rgb::ONE) }
+            Bsdf::Dielectric {
+                eta,
+                tint: tf.min(Rgb::ONE),
+            }
         }
         _ => match ks {
             Some(ks) if ks.max_element() > 0.0 && ns > 0.0 => Bsdf::glossy(kd, ks, ns),
-            _ => Bsdf::Diffuse { albedo: kd.min(Rgb::ONE) },
+            _ => Bsdf::Diffuse {
+                albedo: kd.min(Rgb::ONE),
+            },
         },
     };
-    Ok(Material { name: m.name.clone(), bsdf, emission, two_sided_emission: false })
+    Ok(Material {
+        name: m.name.clone(),
+        bsdf,
+        emission,
+        two_sided_emission: false,
+    })
 }
 
 fn parse_rgb(s: &str) -> Option<Rgb> {
-    let v: Vec<f32> = s.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+    let v: Vec<f32> = s
+        .split_whitespace()
+        .filter_map(|x| x.parse().ok())
+        .collect();
     match v.as_slice() {
         [r, g, b] => Some(Rgb::new(*r, *g, *b)),
         [x] => Some(Rgb::splat(*x)),
@@ -186,14 +260,26 @@ mod tests {
     #[test]
     fn names_the_line_of_bad_vertices_and_faces() {
         let e = check("v 0 0 0\nv nan 0 0\n").unwrap_err();
-        assert_eq!(e.message(), "m.obj:2: vertex coordinate `nan` is not finite");
+        assert_eq!(
+            e.message(),
+            "m.obj:2: vertex coordinate `nan` is not finite"
+        );
         let e = check("v 0 0 0\nv 1 0 inf\n").unwrap_err();
         assert!(e.message().starts_with("m.obj:2:"));
         let e = check("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").unwrap_err();
-        assert_eq!(e.message(), "m.obj:4: face index 4 is out of range: 3 vertices defined so far");
+        assert_eq!(
+            e.message(),
+            "m.obj:4: face index 4 is out of range: 3 vertices defined so far"
+        );
         let e = check("v 0 0 0\nf 1 -5 1\n").unwrap_err();
-        assert!(e.message().starts_with("m.obj:2: face index -5 is out of range"));
+        assert!(
+            e.message()
+                .starts_with("m.obj:2: face index -5 is out of range")
+        );
         let e = check("v 0 0 0\nmtllib nowhere.mtl\n").unwrap_err();
-        assert!(e.message().starts_with("m.obj:2: material library `nowhere.mtl` not found"));
+        assert!(
+            e.message()
+                .starts_with("m.obj:2: material library `nowhere.mtl` not found")
+        );
     }
 }
