@@ -5,7 +5,7 @@
 //! the same watertight test as `triangle.rs` (Woop, Benthin & Wald) runs on
 //! eight triangles per instruction, stored as structure-of-arrays blocks.
 
-use super::triangle::ShearedRay;
+use super::triangle::{ShearedRay, permuted_axes};
 use crate::math::{Ray, gamma};
 use glam::Vec3A;
 use wide::f32x8;
@@ -130,12 +130,7 @@ impl Axes {
     #[inline]
     fn new(ray: &Ray) -> Self {
         let d = ray.direction;
-        let kz = d.abs().max_position();
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        let (kx, ky, kz) = permuted_axes(d);
         let o = ray.origin;
         Axes {
             kx,

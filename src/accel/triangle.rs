@@ -16,16 +16,25 @@ pub struct ShearedRay {
     shear: Mat3A,
 }
 
+/// Axes (kx, ky, kz) of the watertight test: kz is the direction's dominant
+/// axis, and kx, ky are swapped when it points down kz so that the sheared
+/// triangle keeps its winding.
+#[inline]
+pub fn permuted_axes(d: Vec3A) -> (usize, usize, usize) {
+    let kz = d.abs().max_position();
+    let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    if d[kz] < 0.0 {
+        (ky, kx, kz)
+    } else {
+        (kx, ky, kz)
+    }
+}
+
 impl ShearedRay {
     #[inline]
     pub fn new(ray: &Ray) -> Self {
         let d = ray.direction;
-        let kz = d.abs().max_position();
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        let (kx, ky, kz) = permuted_axes(d);
         let (sx, sy, sz) = (d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
         let axis = |k: usize| Vec3A::AXES[k];
         // Rows: x' = v[kx] - sx v[kz], y' = v[ky] - sy v[kz], z' = sz v[kz].
