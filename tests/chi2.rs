@@ -335,6 +335,22 @@ fn glossy_bsdf() {
     );
 }
 
+/// Light sampling from `reference` (directions of the sampled points) against
+/// the density `Lights::pdf` gives the point each direction hits on the light.
+fn check_light(name: &str, seed: u64, reference: Vec3A, lights: &Lights, geometry: &Geometry) {
+    check_directions(
+        name,
+        |i| {
+            let u = Vec2::new(uniform(seed, i, 1), uniform(seed, i, 2));
+            Some(lights.sample(reference, uniform(seed, i, 0), u)?.wi)
+        },
+        |w| match geometry.intersect(&tracelab::math::Ray::new(reference, w.normalize())) {
+            Some(hit) => lights.pdf(0, reference, hit.point, hit.normal) as f64,
+            None => 0.0,
+        },
+    );
+}
+
 /// A reference point, a big emissive triangle above it, and the lights and
 /// geometry to find where a direction lands on it.
 fn triangle_light() -> (Vec3A, Lights, Geometry) {
@@ -369,21 +385,7 @@ fn triangle_light() -> (Vec3A, Lights, Geometry) {
 #[test]
 fn triangle_light_area_sampling_in_solid_angle() {
     let (reference, lights, geometry) = triangle_light();
-    check_directions(
-        "triangle light",
-        |i| {
-            let s = lights.sample(
-                reference,
-                uniform(8, i, 0),
-                Vec2::new(uniform(8, i, 1), uniform(8, i, 2)),
-            )?;
-            Some(s.wi)
-        },
-        |w| match geometry.intersect(&tracelab::math::Ray::new(reference, w.normalize())) {
-            Some(hit) => lights.pdf(0, reference, hit.point, hit.normal) as f64,
-            None => 0.0,
-        },
-    );
+    check_light("triangle light", 8, reference, &lights, &geometry);
 }
 
 #[test]
@@ -444,20 +446,12 @@ fn sphere_light_solid_angle_sampling() {
             light: NO_LIGHT,
         }],
     );
-    check_directions(
+    check_light(
         "sphere light, solid angle",
-        |i| {
-            let s = lights.sample(
-                reference,
-                uniform(seed, i, 0),
-                Vec2::new(uniform(seed, i, 1), uniform(seed, i, 2)),
-            )?;
-            Some(s.wi)
-        },
-        |w| match geometry.intersect(&tracelab::math::Ray::new(reference, w.normalize())) {
-            Some(hit) => lights.pdf(0, reference, hit.point, hit.normal) as f64,
-            None => 0.0,
-        },
+        seed,
+        reference,
+        &lights,
+        &geometry,
     );
 }
 

@@ -117,26 +117,7 @@ impl Light {
                 let b = square_to_uniform_triangle(u);
                 let point = p0 + b.x * e1 + b.y * e2;
                 let error = gamma(6) * (p0.abs() + (b.x * e1).abs() + (b.y * e2).abs());
-                let to_light = point - reference;
-                let dist2 = to_light.length_squared();
-                let distance = dist2.sqrt();
-                let wi = to_light / distance;
-                let cos_light = -normal.dot(wi);
-                if !(cos_light > 0.0 || (two_sided && cos_light < 0.0)) {
-                    return None;
-                }
-                // Area density 1/A converted to solid angle: d^2 / (|cos| A).
-                let pdf = dist2 / (cos_light.abs() * area);
-                Some(LightSample {
-                    point,
-                    error,
-                    normal,
-                    wi,
-                    distance,
-                    radiance,
-                    pdf,
-                    delta: false,
-                })
+                area_sample(reference, point, error, normal, area, radiance, two_sided)
             }
             Light::Sphere {
                 center,
@@ -165,7 +146,7 @@ impl Light {
                     let normal = (reference + distance * wi - center).normalize();
                     // Re-projected onto the sphere, as intersections are.
                     let point = center + radius * normal;
-                    let error = gamma(5) * (radius * normal).abs() + gamma(1) * point.abs();
+                    let error = sphere_point_error(radius * normal, point);
                     let pdf = uniform_cone_pdf(cos_max);
                     if !pdf.is_finite() {
                         return None;
@@ -183,28 +164,9 @@ impl Light {
                 } else {
                     let normal = square_to_uniform_sphere(u);
                     let point = center + radius * normal;
-                    let error = gamma(5) * (radius * normal).abs() + gamma(1) * point.abs();
-                    let to_light = point - reference;
-                    let dist2 = to_light.length_squared();
-                    let distance = dist2.sqrt();
-                    let wi = to_light / distance;
-                    // Seen from outside only the outer side emits; from inside
-                    // (two-sided emitters) the inner side.
-                    let cos_light = -normal.dot(wi);
-                    if !(cos_light > 0.0 || (two_sided && cos_light < 0.0)) {
-                        return None;
-                    }
-                    let pdf = dist2 / (cos_light.abs() * 4.0 * PI * radius * radius);
-                    Some(LightSample {
-                        point,
-                        error,
-                        normal,
-                        wi,
-                        distance,
-                        radiance,
-                        pdf,
-                        delta: false,
-                    })
+                    let error = sphere_point_error(radius * normal, point);
+                    let area = 4.0 * PI * radius * radius;
+                    area_sample(reference, point, error, normal, area, radiance, two_sided)
                 }
             }
             Light::Point {
@@ -255,6 +217,48 @@ impl Light {
             Light::Point { .. } => 0.0,
         }
     }
+}
+
+/// Rounding error bound of a point re-projected onto a sphere (pbrt-v4
+/// 6.8.5, gamma(5) of the offset from the centre) plus the translation by
+/// the centre.
+#[inline]
+fn sphere_point_error(offset_from_center: Vec3A, point: Vec3A) -> Vec3A {
+    gamma(5) * offset_from_center.abs() + gamma(1) * point.abs()
+}
+
+/// A point sampled uniformly by area (density 1 / `area`) seen from
+/// `reference`, its density converted to solid angle: d^2 / (|cos| A).
+/// `None` when the point shows the reference its non-emitting side.
+#[inline]
+fn area_sample(
+    reference: Vec3A,
+    point: Vec3A,
+    error: Vec3A,
+    normal: Vec3A,
+    area: f32,
+    radiance: Rgb,
+    two_sided: bool,
+) -> Option<LightSample> {
+    let to_light = point - reference;
+    let dist2 = to_light.length_squared();
+    let distance = dist2.sqrt();
+    let wi = to_light / distance;
+    let cos_light = -normal.dot(wi);
+    if !(cos_light > 0.0 || (two_sided && cos_light < 0.0)) {
+        return None;
+    }
+    let pdf = dist2 / (cos_light.abs() * area);
+    Some(LightSample {
+        point,
+        error,
+        normal,
+        wi,
+        distance,
+        radiance,
+        pdf,
+        delta: false,
+    })
 }
 
 /// All lights of a scene with the power-proportional selection table.
