@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tracelab::image::{Image, check_writable};
-use tracelab::integrator::{Integrator, MisHeuristic, PathTracer};
+use tracelab::integrator::{
+    GlassShadows, IntegratorKind, IntegratorOptions, MisHeuristic, Strategy,
+};
 use tracelab::render::{RenderSettings, RenderStats, Session};
 use tracelab::sampling::SamplerKind;
 use tracelab::scene::{Limits, Scene};
@@ -36,8 +38,30 @@ enum Command {
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
 enum IntegratorArg {
+    /// Whitted ray tracing: point-light direct light, hard shadows, mirror and glass recursion.
+    Whitted,
+    /// Monte Carlo (distribution) ray tracing: N shadow rays and M branching BSDF rays per hit.
+    Mcrt,
     /// Path tracing with next-event estimation, MIS and Russian roulette.
     Path,
+    /// Light (particle) tracing: paths from the lights, every vertex connected to the camera.
+    Light,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum StrategyArg {
+    /// BSDF sampling only.
+    Bsdf,
+    /// Light sampling only.
+    Light,
+    /// Both, combined by MIS.
+    Mis,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum GlassShadowsArg {
+    Opaque,
+    Tinted,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -60,11 +84,14 @@ struct RenderArgs {
     #[arg(long, value_enum, default_value = "path")]
     integrator: IntegratorArg,
     /// Samples per pixel.
-    #[arg(long, conflicts_with = "time")]
+    #[arg(long, conflicts_with_all = ["time", "rays_per_pixel"])]
     spp: Option<u32>,
     /// Render for this many seconds instead of a sample count.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "rays_per_pixel")]
     time: Option<f64>,
+    /// Render until this many rays per pixel (all kinds) are cast: equal-cost comparisons.
+    #[arg(long)]
+    rays_per_pixel: Option<f64>,
     #[arg(long, value_enum, default_value = "independent")]
     sampler: SamplerArg,
     /// Maximum bounces (1 = direct lighting); Mitsuba's max_depth is one more.
@@ -76,12 +103,27 @@ struct RenderArgs {
     /// Turn Russian roulette off.
     #[arg(long)]
     no_rr: bool,
-    /// Turn next-event estimation (light sampling) off: BSDF sampling only.
-    #[arg(long)]
+    /// Turn next-event estimation (light sampling) off: the same as --strategy bsdf.
+    #[arg(long, conflicts_with = "strategy")]
     no_nee: bool,
-    /// How light and BSDF samples are combined.
+    /// Path tracing: sample the BSDF, the lights, or both with MIS.
+    #[arg(long, value_enum)]
+    strategy: Option<StrategyArg>,
+    /// How light and BSDF samples are combined (none = light sampling only).
     #[arg(long, value_enum, default_value = "power")]
     mis: MisArg,
+    /// MC ray tracing: light samples (shadow rays) per hit.
+    #[arg(long, default_value_t = 1)]
+    shadow_rays: u32,
+    /// MC ray tracing: BSDF samples (branching rays) per hit.
+    #[arg(long, default_value_t = 1)]
+    glossy_rays: u32,
+    /// Whitted: constant ambient radiance times the diffuse albedo.
+    #[arg(long, default_value_t = 0.0)]
+    ambient: f32,
+    /// Whitted: shadow rays through glass are blocked, or tinted by the glass.
+    #[arg(long, value_enum, default_value = "opaque")]
+    glass_shadows: GlassShadowsArg,
     /// Image width (overrides the scene).
     #[arg(long)]
     width: Option<u32>,
@@ -198,24 +240,27 @@ fn render(args: &RenderArgs) -> Result<()> {
     }
     let load_time = load_start.elapsed();
 
-    let integrator = match args.integrator {
-        IntegratorArg::Path => Integrator::Path(PathTracer {
-            max_depth: args.max_depth,
-            rr_depth: args.rr_depth,
-            russian_roulette: !args.no_rr,
-            nee: !args.no_nee,
-            mis: match args.mis {
-                MisArg::None => MisHeuristic::None,
-                MisArg::Balance => MisHeuristic::Balance,
-                MisArg::Power => MisHeuristic::Power,
-            },
-        }),
-    };
+    let integrator = integrator_options(args)?.build();
     let sampler = match args.sampler {
         SamplerArg::Independent => SamplerKind::Independent,
         SamplerArg::Stratified => SamplerKind::Stratified,
     };
-    let target_spp = if args.time.is_some() {
+    if let Some(r) = args.rays_per_pixel
+        && !(r.is_finite() && r > 0.0)
+    {
+        return Err(Error::new(format!(
+            "--rays-per-pixel must be a positive number, got {r}"
+        )));
+    }
+    let target_spp = if integrator.is_deterministic() {
+        if args.spp.is_some_and(|s| s > 1) || args.time.is_some() || args.rays_per_pixel.is_some() {
+            eprintln!(
+                "note: {} is deterministic; rendering 1 sample per pixel",
+                integrator.name()
+            );
+        }
+        Some(1)
+    } else if args.time.is_some() || args.rays_per_pixel.is_some() {
         None
     } else {
         Some(args.spp.unwrap_or(64))
@@ -228,9 +273,10 @@ fn render(args: &RenderArgs) -> Result<()> {
         threads: args.threads,
     };
     let session = Session::new(Arc::new(scene), settings)?;
-    let stats = match target_spp {
-        Some(spp) => render_spp(&session, spp),
-        None => render_time(&session, Duration::from_secs_f64(args.time.unwrap_or(1.0))),
+    let stats = match (target_spp, args.rays_per_pixel) {
+        (Some(spp), _) => render_spp(&session, spp),
+        (None, Some(rays)) => render_rays(&session, rays),
+        (None, None) => render_time(&session, Duration::from_secs_f64(args.time.unwrap_or(1.0))),
     };
     let snapshot = session.snapshot();
     match format {
@@ -275,6 +321,64 @@ fn render_spp(session: &Session, spp: u32) -> RenderStats {
     session.stats()
 }
 
+/// Renders one sample per pixel at a time until the rays cast per pixel reach
+/// `budget` (the last pass may overshoot by one sample's rays).
+fn render_rays(session: &Session, budget: f64) -> RenderStats {
+    let pixels = f64::from(session.scene().camera.width) * f64::from(session.scene().camera.height);
+    let bar = progress_bar(budget.ceil() as u64, "rays/pixel");
+    loop {
+        let stats = session.stats();
+        let per_pixel = stats.rays.total() as f64 / pixels;
+        bar.set_position(per_pixel.min(budget) as u64);
+        if per_pixel >= budget {
+            break;
+        }
+        session.render_pass(1);
+    }
+    bar.finish_and_clear();
+    session.stats()
+}
+
+/// Estimator options from the command line.
+fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
+    let strategy = match (args.strategy, args.no_nee, args.mis) {
+        (Some(StrategyArg::Bsdf), ..) | (None, true, _) => Strategy::Bsdf,
+        (Some(StrategyArg::Light), ..) | (None, false, MisArg::None) => Strategy::Light,
+        (Some(StrategyArg::Mis), _, MisArg::None) => {
+            return Err(Error::new("--strategy mis needs --mis balance or power"));
+        }
+        _ => Strategy::Mis,
+    };
+    if matches!(args.integrator, IntegratorArg::Mcrt) && args.shadow_rays + args.glossy_rays == 0 {
+        return Err(Error::new(
+            "--shadow-rays and --glossy-rays cannot both be 0",
+        ));
+    }
+    Ok(IntegratorOptions {
+        kind: match args.integrator {
+            IntegratorArg::Whitted => IntegratorKind::Whitted,
+            IntegratorArg::Mcrt => IntegratorKind::Mcrt,
+            IntegratorArg::Path => IntegratorKind::Path,
+            IntegratorArg::Light => IntegratorKind::Light,
+        },
+        max_depth: args.max_depth,
+        russian_roulette: !args.no_rr,
+        rr_depth: args.rr_depth,
+        strategy,
+        mis: match args.mis {
+            MisArg::Balance => MisHeuristic::Balance,
+            MisArg::None | MisArg::Power => MisHeuristic::Power,
+        },
+        shadow_rays: args.shadow_rays,
+        glossy_rays: args.glossy_rays,
+        ambient: args.ambient,
+        glass_shadows: match args.glass_shadows {
+            GlassShadowsArg::Opaque => GlassShadows::Opaque,
+            GlassShadowsArg::Tinted => GlassShadows::Tinted,
+        },
+    })
+}
+
 /// Renders passes until `budget` is spent, sizing passes so as not to overshoot.
 fn render_time(session: &Session, budget: Duration) -> RenderStats {
     let bar = progress_bar(budget.as_millis() as u64, "ms");
@@ -310,6 +414,15 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         settings.sampler.name(),
         session.threads(),
         load_time.as_secs_f64()
+    );
+    let pixels = f64::from(session.scene().camera.width) * f64::from(session.scene().camera.height);
+    let per_pixel = |n: u64| n as f64 / pixels;
+    eprintln!(
+        "rays per pixel: {:.1} (camera {:.1}, shadow {:.1}, bounce {:.1})",
+        per_pixel(rays),
+        per_pixel(stats.rays.camera),
+        per_pixel(stats.rays.shadow),
+        per_pixel(stats.rays.bounce)
     );
     println!(
         "spp {} | {:.3} s | {:.2} M rays (camera {:.2} M, shadow {:.2} M, bounce {:.2} M) | {:.2} Mrays/s | {:.3} M paths/s | non-finite {}",

@@ -40,6 +40,17 @@ impl PixelSums {
         self.count += 1;
     }
 
+    /// Adds `n` samples that all have the value `value` (a pass estimate of
+    /// light tracing counted as the `n` samples it was made of).
+    pub fn add_repeated(&mut self, value: [f64; 3], n: u32) {
+        let weight = f64::from(n);
+        for c in 0..3 {
+            self.sum[c] += value[c] * weight;
+            self.sum_sq[c] += value[c] * value[c] * weight;
+        }
+        self.count += n;
+    }
+
     /// Mean of the samples (zero without samples).
     pub fn mean(&self) -> [f32; 3] {
         if self.count == 0 {

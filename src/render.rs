@@ -9,7 +9,8 @@
 
 use crate::error::{Error, Result};
 use crate::film::{Film, FilmSnapshot};
-use crate::integrator::{Integrator, RayCounts};
+use crate::integrator::{Integrator, LightTracer, RayCounts};
+use crate::math::Rgb;
 use crate::sampling::{Sampler, SamplerKind};
 use crate::scene::Scene;
 use glam::Vec2;
@@ -109,8 +110,25 @@ impl Session {
     pub fn render_pass(&self, spp: u32) -> bool {
         let start = Instant::now();
         let first = self.spp.load(Ordering::Relaxed);
+        if let Integrator::Light(tracer) = self.settings.integrator {
+            self.light_pass(&tracer, first, spp);
+        } else {
+            self.camera_pass(first, spp);
+        }
+        self.render_nanos
+            .fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        if self.cancelled.load(Ordering::Relaxed) {
+            return false;
+        }
+        self.spp.store(first + spp, Ordering::Relaxed);
+        true
+    }
+
+    /// Camera-driven estimators: samples `first..first + spp` of every pixel.
+    fn camera_pass(&self, first: u32, spp: u32) {
         let scene = &*self.scene;
         let settings = &self.settings;
+        let deterministic = settings.integrator.is_deterministic();
         let width = self.film.width();
         self.pool.install(|| {
             self.film.tiles().par_iter().for_each(|tile| {
@@ -128,8 +146,12 @@ impl Session {
                     let pixel_index = y * width + x;
                     for s in first..first + spp {
                         sampler.start(pixel_index, s);
-                        let film_point = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-                        let lens = sampler.next_2d();
+                        let mut film_point = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+                        let mut lens = sampler.next_2d();
+                        if deterministic {
+                            film_point = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                            lens = Vec2::splat(0.5);
+                        }
                         let ray = scene.camera.generate_ray(film_point, lens);
                         counts.camera += 1;
                         let value =
@@ -141,20 +163,74 @@ impl Session {
                     }
                 }
                 drop(tile);
-                self.samples.fetch_add(counts.camera, Ordering::Relaxed);
-                self.camera_rays.fetch_add(counts.camera, Ordering::Relaxed);
-                self.shadow_rays.fetch_add(counts.shadow, Ordering::Relaxed);
-                self.bounce_rays.fetch_add(counts.bounce, Ordering::Relaxed);
-                self.non_finite.fetch_add(non_finite, Ordering::Relaxed);
+                self.add_counts(counts.camera, &counts, non_finite);
             });
         });
-        self.render_nanos
-            .fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+    }
+
+    /// Light tracing: `spp` particles per pixel (the same total as a camera
+    /// pass), seeded by (pixel, index) so the result does not depend on the
+    /// schedule. Splats go to a fixed-point buffer whose integer sums do not
+    /// depend on their order either; the pass's estimate then enters the film
+    /// as `spp` samples of equal value, so the film's mean is exact and its
+    /// standard error is estimated across passes (exact for 1-spp passes).
+    fn light_pass(&self, tracer: &LightTracer, first: u32, spp: u32) {
+        let scene = &*self.scene;
+        let settings = &self.settings;
+        let (width, height) = (self.film.width(), self.film.height());
+        let splats = SplatBuffer::new(width, height);
+        self.pool.install(|| {
+            self.film.tiles().par_iter().for_each(|tile| {
+                if self.cancelled.load(Ordering::Relaxed) {
+                    return;
+                }
+                let (x0, y0, tile_width, tile_height) = {
+                    let t = tile.lock().unwrap_or_else(|e| e.into_inner());
+                    (t.x0, t.y0, t.width, t.height)
+                };
+                let mut sampler =
+                    Sampler::new(settings.sampler, settings.seed, settings.planned_spp);
+                let mut counts = RayCounts::default();
+                let mut non_finite = 0u64;
+                for i in 0..tile_width * tile_height {
+                    let (x, y) = (x0 + i % tile_width, y0 + i / tile_width);
+                    for s in first..first + spp {
+                        sampler.start(y * width + x, s);
+                        tracer.trace_particle(scene, &mut sampler, &mut counts, |splat| {
+                            if !splats.add(splat.film, splat.value) {
+                                non_finite += 1;
+                            }
+                        });
+                    }
+                }
+                self.add_counts(
+                    u64::from(tile_width * tile_height * spp),
+                    &counts,
+                    non_finite,
+                );
+            });
+        });
         if self.cancelled.load(Ordering::Relaxed) {
-            return false;
+            return;
         }
-        self.spp.store(first + spp, Ordering::Relaxed);
-        true
+        let particles = f64::from(width) * f64::from(height) * f64::from(spp);
+        for tile in self.film.tiles() {
+            let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
+            let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
+            for (i, pixel) in tile.pixels.iter_mut().enumerate() {
+                let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
+                let estimate = splats.get(y * width + x).map(|v| v / particles);
+                pixel.add_repeated(estimate, spp);
+            }
+        }
+    }
+
+    fn add_counts(&self, samples: u64, counts: &RayCounts, non_finite: u64) {
+        self.samples.fetch_add(samples, Ordering::Relaxed);
+        self.camera_rays.fetch_add(counts.camera, Ordering::Relaxed);
+        self.shadow_rays.fetch_add(counts.shadow, Ordering::Relaxed);
+        self.bounce_rays.fetch_add(counts.bounce, Ordering::Relaxed);
+        self.non_finite.fetch_add(non_finite, Ordering::Relaxed);
     }
 
     /// Copies the film (means, standard errors, counts) while passes may run.
@@ -175,5 +251,56 @@ impl Session {
             non_finite: self.non_finite.load(Ordering::Relaxed),
             render_time: Duration::from_nanos(self.render_nanos.load(Ordering::Relaxed)),
         }
+    }
+}
+
+/// Per-pixel sums of light-tracing splats in 32.32 fixed point: integer
+/// additions commute, so the sums are the same in any thread order.
+struct SplatBuffer {
+    width: u32,
+    height: u32,
+    sums: Vec<[AtomicU64; 3]>,
+}
+
+/// 2^32: resolution 2.3e-10 per splat, overflow past 4e9 per pixel and pass.
+const SPLAT_SCALE: f64 = 4294967296.0;
+
+impl SplatBuffer {
+    fn new(width: u32, height: u32) -> Self {
+        let sums = (0..width as usize * height as usize)
+            .map(|_| [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)])
+            .collect();
+        SplatBuffer {
+            width,
+            height,
+            sums,
+        }
+    }
+
+    /// Adds `value` to the pixel containing `film`; false (and nothing added)
+    /// when the value is not finite, negative or too large to represent.
+    fn add(&self, film: Vec2, value: Rgb) -> bool {
+        let (x, y) = (film.x as u32, film.y as u32);
+        if x >= self.width || y >= self.height {
+            return true;
+        }
+        let mut fixed = [0u64; 3];
+        for c in 0..3 {
+            let v = f64::from(value[c]) * SPLAT_SCALE;
+            if !(v >= 0.0 && v < 9.0e18) {
+                return false;
+            }
+            fixed[c] = v.round() as u64;
+        }
+        let sums = &self.sums[(y * self.width + x) as usize];
+        for c in 0..3 {
+            sums[c].fetch_add(fixed[c], Ordering::Relaxed);
+        }
+        true
+    }
+
+    fn get(&self, index: u32) -> [f64; 3] {
+        let sums = &self.sums[index as usize];
+        [0, 1, 2].map(|c| sums[c].load(Ordering::Relaxed) as f64 / SPLAT_SCALE)
     }
 }

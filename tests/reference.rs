@@ -8,17 +8,38 @@
 //! by 10% (the standard-error estimate misses some rare high-variance paths at
 //! 64 spp); a bias, even small, shows up as a larger excess at these sample
 //! counts. The image mean must agree within 4 standard errors of the mean.
+//!
+//! Every unbiased estimator must pass: path tracing with each strategy, MC
+//! ray tracing without branching, and light tracing (rendered in 1-spp passes,
+//! for which its film's standard error is exact).
 
-use crate::common::{cornell_box, mean_and_standard_error, reference, render};
-use tracelab::integrator::{Integrator, PathTracer};
+use crate::common::{cornell_box, mean_and_standard_error, reference, render_with};
+use tracelab::integrator::{IntegratorKind, IntegratorOptions, Strategy};
 use tracelab::sampling::SamplerKind;
 
-fn check_against_reference(max_depth: u32, reference_name: &str, variance_name: &str) {
-    let integrator = Integrator::Path(PathTracer {
+fn options(kind: IntegratorKind, max_depth: u32) -> IntegratorOptions {
+    IntegratorOptions {
+        kind,
         max_depth,
         ..Default::default()
-    });
-    let (snapshot, stats) = render(cornell_box(), integrator, SamplerKind::Independent, 64, 1);
+    }
+}
+
+fn check_against_reference(options: IntegratorOptions, reference_name: &str, variance_name: &str) {
+    let pass = if options.kind == IntegratorKind::Light {
+        1
+    } else {
+        8
+    };
+    let (snapshot, stats) = render_with(
+        cornell_box(),
+        options.build(),
+        SamplerKind::Independent,
+        64,
+        1,
+        0,
+        pass,
+    );
     assert_eq!(stats.non_finite, 0);
     let reference = reference(reference_name);
     let reference_variance = crate::common::reference(variance_name);
@@ -37,7 +58,9 @@ fn check_against_reference(max_depth: u32, reference_name: &str, variance_name: 
     }
     expected_mse /= (snapshot.image.pixels.len() * 3) as f64;
     let expected = expected_mse.sqrt();
-    eprintln!("{reference_name}: RMSE {measured:.5}, expected from variances {expected:.5}");
+    eprintln!(
+        "{options:?} vs {reference_name}: RMSE {measured:.5}, expected from variances {expected:.5}"
+    );
     assert!(
         measured <= 1.10 * expected,
         "RMSE {measured:.5} vs expected {expected:.5} from the variances"
@@ -59,7 +82,7 @@ fn check_against_reference(max_depth: u32, reference_name: &str, variance_name: 
 #[test]
 fn path_tracing_matches_mitsuba_on_the_cornell_box() {
     check_against_reference(
-        8,
+        options(IntegratorKind::Path, 8),
         "cornell_box_path_ref.exr",
         "cornell_box_path_ref_var.exr",
     );
@@ -68,8 +91,44 @@ fn path_tracing_matches_mitsuba_on_the_cornell_box() {
 #[test]
 fn direct_lighting_matches_mitsuba_on_the_cornell_box() {
     check_against_reference(
-        1,
+        options(IntegratorKind::Path, 1),
         "cornell_box_direct_ref.exr",
         "cornell_box_direct_ref_var.exr",
+    );
+}
+
+#[test]
+fn path_tracing_with_bsdf_or_light_sampling_alone_matches_mitsuba() {
+    for strategy in [Strategy::Bsdf, Strategy::Light] {
+        check_against_reference(
+            IntegratorOptions {
+                strategy,
+                ..options(IntegratorKind::Path, 8)
+            },
+            "cornell_box_path_ref.exr",
+            "cornell_box_path_ref_var.exr",
+        );
+    }
+}
+
+#[test]
+fn mc_ray_tracing_without_branching_matches_mitsuba() {
+    check_against_reference(
+        IntegratorOptions {
+            shadow_rays: 1,
+            glossy_rays: 1,
+            ..options(IntegratorKind::Mcrt, 8)
+        },
+        "cornell_box_path_ref.exr",
+        "cornell_box_path_ref_var.exr",
+    );
+}
+
+#[test]
+fn light_tracing_matches_mitsuba_on_the_cornell_box() {
+    check_against_reference(
+        options(IntegratorKind::Light, 8),
+        "cornell_box_path_ref.exr",
+        "cornell_box_path_ref_var.exr",
     );
 }

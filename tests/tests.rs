@@ -11,6 +11,8 @@ mod furnace;
 mod chi2;
 // BSDF energy conservation, reciprocity and sample/eval/pdf consistency.
 mod bsdf;
+// Whitted by hand, MC ray tracing's ray count.
+mod estimators;
 // NEE on/off and MIS variants converge to the same image.
 mod strategies;
 // Same seed, same film, whatever the thread count or pass split.

@@ -2,7 +2,8 @@
 
 /// How light sampling and BSDF sampling are combined when both can produce
 /// the same path.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum MisHeuristic {
     /// No combination: with next-event estimation on, light sampling alone
     /// accounts for direct light and BSDF-sampled hits on lights are ignored.

@@ -1,18 +1,32 @@
 //! Estimators of the rendering equation, one file each, behind one interface:
 //! given a camera ray and a sampler, return a radiance sample. The enum is
 //! dispatched once per camera sample, never inside the bounce loop.
+//!
+//! Light tracing runs the other way (particles from the lights splat onto
+//! the film), so it has its own entry point, [`LightTracer::trace_particle`],
+//! which the render session calls instead of [`Integrator::radiance`].
 
+pub mod light;
+pub mod mcrt;
 pub mod mis;
+pub mod options;
 pub mod path;
+pub mod whitted;
 
+pub use light::LightTracer;
+pub use mcrt::McRayTracer;
 pub use mis::MisHeuristic;
+pub use options::{IntegratorKind, IntegratorOptions, Strategy};
 pub use path::PathTracer;
+pub use whitted::{GlassShadows, WhittedTracer};
 
 use crate::math::{Ray, Rgb};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 
-/// Rays cast, by kind; kept per thread and summed after each tile.
+/// Rays cast, by kind; kept per thread and summed after each tile. For light
+/// tracing, `camera` counts the rays leaving the lights (the primary rays)
+/// and `shadow` the connections to the camera.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RayCounts {
     pub camera: u64,
@@ -27,17 +41,13 @@ impl RayCounts {
     }
 }
 
-/// Names of the estimators, as the command line spells them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum IntegratorKind {
-    #[default]
-    Path,
-}
-
 /// A configured estimator.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Integrator {
+    Whitted(WhittedTracer),
+    Mcrt(McRayTracer),
     Path(PathTracer),
+    Light(LightTracer),
 }
 
 impl Integrator {
@@ -52,14 +62,37 @@ impl Integrator {
         counts: &mut RayCounts,
     ) -> Rgb {
         match self {
+            Integrator::Whitted(w) => w.radiance(scene, ray, counts),
+            Integrator::Mcrt(m) => m.radiance(scene, ray, sampler, counts),
             Integrator::Path(p) => p.radiance(scene, ray, sampler, counts),
+            // Light tracing splats instead; the session never calls this for it.
+            Integrator::Light(_) => Rgb::ZERO,
         }
     }
 
     /// Short description for summaries and file names.
     pub fn describe(&self) -> String {
         match self {
+            Integrator::Whitted(w) => w.describe(),
+            Integrator::Mcrt(m) => m.describe(),
             Integrator::Path(p) => p.describe(),
+            Integrator::Light(l) => l.describe(),
         }
+    }
+
+    /// Short name, as the command line spells it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Whitted(_) => "whitted",
+            Integrator::Mcrt(_) => "mcrt",
+            Integrator::Path(_) => "path",
+            Integrator::Light(_) => "light",
+        }
+    }
+
+    /// True when every sample of a pixel gives the same value (Whitted: one
+    /// ray through the pixel centre), so one sample per pixel is the image.
+    pub fn is_deterministic(&self) -> bool {
+        matches!(self, Integrator::Whitted(_))
     }
 }

@@ -79,6 +79,78 @@ impl Camera {
     }
 }
 
+/// A connection from a scene point to the camera, for light tracing.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraConnection {
+    /// Film position (pixels) the connection lands on.
+    pub film: Vec2,
+    /// Point on the lens (the eye for a pinhole).
+    pub lens_point: Vec3A,
+    /// Unit direction from the scene point to `lens_point`.
+    pub wi: Vec3A,
+    /// We / p: importance of the ray through one pixel divided by the density
+    /// of the connection wrt. solid angle at the scene point.
+    pub weight: f32,
+}
+
+impl Camera {
+    /// Connects `point` to a point on the lens chosen with `u_lens` (pbrt-v4's
+    /// `PerspectiveCamera::SampleWi`). A box-filtered pixel of area A (on the
+    /// image plane at unit distance) has importance We = 1 / (A A_lens cos^4),
+    /// and the lens point has density d^2 / (cos A_lens) wrt. solid angle, so
+    /// We / p = 1 / (A cos^3 d^2) for both pinhole and thin lens.
+    /// `None` when the point is behind the camera or maps outside the film.
+    #[inline]
+    pub fn connect(&self, point: Vec3A, u_lens: Vec2) -> Option<CameraConnection> {
+        let lens_local = if self.aperture_radius > 0.0 {
+            square_to_concentric_disk(u_lens) * self.aperture_radius
+        } else {
+            Vec2::ZERO
+        };
+        let lens_point = self.eye + self.right * lens_local.x + self.up * lens_local.y;
+        let to_lens = lens_point - point;
+        let dist2 = to_lens.length_squared();
+        let distance = dist2.sqrt();
+        let wi = to_lens / distance;
+        let outgoing = -wi;
+        let cos = outgoing.dot(self.forward);
+        if cos <= 0.0 || !distance.is_finite() || distance == 0.0 {
+            return None;
+        }
+        // The ray from the lens point crosses the focus plane where a pinhole
+        // ray through the lens centre would; that point fixes the pixel.
+        let in_focus = if self.aperture_radius > 0.0 {
+            lens_point + outgoing * (self.focus_distance / cos) - self.eye
+        } else {
+            outgoing
+        };
+        let depth = in_focus.dot(self.forward);
+        let aspect = self.width as f32 / self.height as f32;
+        let ndc_x = in_focus.dot(self.right) / (depth * self.tan_half_fov_y * aspect);
+        let ndc_y = in_focus.dot(self.up) / (depth * self.tan_half_fov_y);
+        let film = Vec2::new(
+            (ndc_x + 1.0) * 0.5 * self.width as f32,
+            (1.0 - ndc_y) * 0.5 * self.height as f32,
+        );
+        if !(film.x >= 0.0
+            && film.y >= 0.0
+            && film.x < self.width as f32
+            && film.y < self.height as f32)
+        {
+            return None;
+        }
+        let pixel_side = 2.0 * self.tan_half_fov_y / self.height as f32;
+        let pixel_area = pixel_side * pixel_side;
+        let weight = 1.0 / (pixel_area * cos * cos * cos * dist2);
+        Some(CameraConnection {
+            film,
+            lens_point,
+            wi,
+            weight,
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -122,5 +194,25 @@ mod tests {
         let pb = b.at((800.0) / b.direction.z);
         assert!((pa - pb).length() < 1e-2, "{pa:?} {pb:?}");
         assert!((a.origin - b.origin).length() > 1.0);
+    }
+
+    #[test]
+    fn connections_land_on_the_pixel_whose_ray_passes_through_the_point() {
+        for aperture in [0.0, 20.0] {
+            let mut cam = cornell_camera();
+            cam.aperture_radius = aperture;
+            let (film, lens) = (Vec2::new(37.3, 201.6), Vec2::new(0.3, 0.8));
+            let ray = cam.generate_ray(film, lens);
+            let point = ray.at(1234.0);
+            let c = cam.connect(point, lens).expect("point is in view");
+            assert!((c.film - film).length() < 1e-2, "{:?} vs {film:?}", c.film);
+            assert!((c.wi + ray.direction).length() < 1e-5);
+            assert!((c.lens_point - ray.origin).length() < 1e-3);
+        }
+        let cam = cornell_camera();
+        assert!(
+            cam.connect(Vec3A::new(278.0, 273.0, -900.0), Vec2::ZERO)
+                .is_none()
+        );
     }
 }

@@ -9,7 +9,8 @@
 use crate::math::{Frame, Rgb, gamma, luminance};
 use crate::sampling::AliasTable;
 use crate::sampling::warp::{
-    square_to_uniform_cone, square_to_uniform_sphere, square_to_uniform_triangle, uniform_cone_pdf,
+    cosine_hemisphere_pdf, square_to_cosine_hemisphere, square_to_uniform_cone,
+    square_to_uniform_sphere, square_to_uniform_triangle, uniform_cone_pdf,
 };
 use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
@@ -261,6 +262,147 @@ fn area_sample(
     })
 }
 
+/// A particle leaving a light, for light tracing: a point with its density
+/// by area and a direction with its density by solid angle.
+#[derive(Clone, Copy, Debug)]
+pub struct EmissionSample {
+    pub point: Vec3A,
+    /// Rounding error bound of `point`.
+    pub error: Vec3A,
+    /// Geometric normal at `point` (zero for point lights).
+    pub normal: Vec3A,
+    /// Unit direction the particle leaves in.
+    pub direction: Vec3A,
+    /// Le |cos| / (p_select p_area p_direction): the particle's starting weight.
+    pub throughput: Rgb,
+    /// Radiance (area lights) or intensity (point lights) and whether it is
+    /// emitted on both sides, to connect the light point itself to the camera.
+    pub emitted: Rgb,
+    pub two_sided: bool,
+    /// p_select p_area for area lights, p_select for point lights.
+    pub pdf_position: f32,
+}
+
+impl EmissionSample {
+    /// Emitted radiance (or intensity) from the light point towards `w`.
+    #[inline]
+    pub fn emitted_towards(&self, w: Vec3A) -> Rgb {
+        if self.normal == Vec3A::ZERO || self.two_sided || self.normal.dot(w) > 0.0 {
+            self.emitted
+        } else {
+            Rgb::ZERO
+        }
+    }
+
+    /// |cos| between the light's normal and `w` (1 for point lights).
+    #[inline]
+    pub fn cos_at_light(&self, w: Vec3A) -> f32 {
+        if self.normal == Vec3A::ZERO {
+            1.0
+        } else {
+            self.normal.dot(w).abs()
+        }
+    }
+}
+
+/// Cosine-weighted direction about `normal`, on a side chosen with `u.x` for
+/// two-sided emitters; returns the direction and its solid-angle density.
+#[inline]
+fn emission_direction(normal: Vec3A, two_sided: bool, mut u: Vec2) -> (Vec3A, f32) {
+    let mut side = 1.0;
+    let mut side_pdf = 1.0;
+    if two_sided {
+        side_pdf = 0.5;
+        if u.x < 0.5 {
+            u.x *= 2.0;
+        } else {
+            u.x = (u.x - 0.5) * 2.0;
+            side = -1.0;
+        }
+        u.x = u.x.min(ONE_MINUS_EPSILON);
+    }
+    let local = square_to_cosine_hemisphere(u);
+    let direction = Frame::from_normal(normal * side).to_world(local);
+    (direction, side_pdf * cosine_hemisphere_pdf(local))
+}
+
+const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+impl Light {
+    /// Samples a particle: a point uniformly by area (uniform directions for
+    /// point lights) and a cosine-weighted direction. Density excludes selection.
+    #[inline]
+    fn sample_emission(&self, u_position: Vec2, u_direction: Vec2) -> Option<EmissionSample> {
+        let (point, error, normal, area, radiance, two_sided) = match *self {
+            Light::Triangle {
+                p0,
+                e1,
+                e2,
+                normal,
+                area,
+                radiance,
+                two_sided,
+            } => {
+                let b = square_to_uniform_triangle(u_position);
+                let point = p0 + b.x * e1 + b.y * e2;
+                let error = gamma(6) * (p0.abs() + (b.x * e1).abs() + (b.y * e2).abs());
+                (point, error, normal, area, radiance, two_sided)
+            }
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+                two_sided,
+                ..
+            } => {
+                let normal = square_to_uniform_sphere(u_position);
+                let point = center + radius * normal;
+                let error = sphere_point_error(radius * normal, point);
+                (
+                    point,
+                    error,
+                    normal,
+                    4.0 * PI * radius * radius,
+                    radiance,
+                    two_sided,
+                )
+            }
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                let direction = square_to_uniform_sphere(u_direction);
+                return Some(EmissionSample {
+                    point: position,
+                    error: Vec3A::ZERO,
+                    normal: Vec3A::ZERO,
+                    direction,
+                    // I / (1 / 4 pi).
+                    throughput: intensity * (4.0 * PI),
+                    emitted: intensity,
+                    two_sided: true,
+                    pdf_position: 1.0,
+                });
+            }
+        };
+        let (direction, pdf_direction) = emission_direction(normal, two_sided, u_direction);
+        let cos = normal.dot(direction).abs();
+        if pdf_direction <= 0.0 || cos <= 0.0 {
+            return None;
+        }
+        Some(EmissionSample {
+            point,
+            error,
+            normal,
+            direction,
+            throughput: radiance * (cos * area / pdf_direction),
+            emitted: radiance,
+            two_sided,
+            pdf_position: 1.0 / area,
+        })
+    }
+}
+
 /// All lights of a scene with the power-proportional selection table.
 #[derive(Clone, Debug, Default)]
 pub struct Lights {
@@ -295,6 +437,22 @@ impl Lights {
         let mut s = self.lights[index].sample(reference, u)?;
         s.pdf *= pmf;
         (s.pdf > 0.0 && s.pdf.is_finite() && s.distance > 0.0).then_some(s)
+    }
+
+    /// Chooses a light by power and samples a particle leaving it (light tracing).
+    #[inline]
+    pub fn sample_emission(
+        &self,
+        u_select: f32,
+        u_position: Vec2,
+        u_direction: Vec2,
+    ) -> Option<EmissionSample> {
+        let table = self.selection.as_ref()?;
+        let (index, pmf) = table.sample(u_select);
+        let mut s = self.lights[index].sample_emission(u_position, u_direction)?;
+        s.throughput /= pmf;
+        s.pdf_position *= pmf;
+        (s.throughput.is_finite() && s.pdf_position > 0.0).then_some(s)
     }
 
     /// Density (solid angle, including selection) that [`Lights::sample`] gives

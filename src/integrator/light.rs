@@ -1,0 +1,195 @@
+//! Light tracing (forward ray tracing, "particle tracing"): particles leave
+//! the lights, bounce by BSDF sampling, and at every vertex a ray is sent to
+//! the eye; the contribution lands on whatever pixel it reaches.
+//!
+//! With N particles per pass and a particle weight beta (Le cos / p after
+//! emission, times f cos / p per bounce), a vertex x adds to the pixel it
+//! projects on
+//!   beta f(x, w_prev -> w_cam) |cos theta_x| We / p_cam  / N,
+//! where We / p_cam = 1 / (A_pixel cos^3 d^2) (see `Camera::connect`). The
+//! light point itself connects with Le |cos| / p_position. Specular surfaces
+//! cannot connect (their f is a delta), so a mirror seen by the camera stays
+//! black: the reason light tracing alone is a poor way to render, except for
+//! caustics, which it finds easily.
+//!
+//! The BSDF is sampled in importance-transport mode: the (eta_i / eta_t)^2
+//! radiance scaling at refraction does not apply to particles (Veach's
+//! thesis, 5.2).
+
+use super::RayCounts;
+use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
+use crate::sampling::Sampler;
+use crate::scene::Scene;
+use crate::scene::material::Bsdf;
+use glam::{Vec2, Vec3A};
+
+/// Settings of the light tracer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightTracer {
+    /// Bounces after leaving the light (0 = only lights seen directly).
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    pub russian_roulette: bool,
+}
+
+impl Default for LightTracer {
+    fn default() -> Self {
+        LightTracer {
+            max_depth: 8,
+            rr_depth: 5,
+            russian_roulette: true,
+        }
+    }
+}
+
+/// Where a particle's connection lands: a film position and its contribution
+/// (not yet divided by the number of particles).
+#[derive(Clone, Copy, Debug)]
+pub struct Splat {
+    pub film: Vec2,
+    pub value: Rgb,
+}
+
+impl LightTracer {
+    pub fn describe(&self) -> String {
+        format!(
+            "light tracing (max depth {}, rr {})",
+            self.max_depth,
+            if self.russian_roulette {
+                format!("from {}", self.rr_depth)
+            } else {
+                "off".into()
+            }
+        )
+    }
+
+    /// Traces one particle and hands each camera connection to `splat`.
+    pub fn trace_particle(
+        &self,
+        scene: &Scene,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+        mut splat: impl FnMut(Splat),
+    ) {
+        let u_select = sampler.next_1d();
+        let u_position = sampler.next_2d();
+        let u_direction = sampler.next_2d();
+        let u_lens = sampler.next_2d();
+        let Some(emission) = scene
+            .lights
+            .sample_emission(u_select, u_position, u_direction)
+        else {
+            return;
+        };
+        let camera = &scene.camera;
+
+        // The light point seen directly: Le |cos| / p_position * We / p_cam.
+        if let Some(c) = camera.connect(emission.point, u_lens) {
+            let le = emission.emitted_towards(c.wi);
+            if le.max_element() > 0.0 {
+                counts.shadow += 1;
+                let ray = ray_between(
+                    emission.point,
+                    emission.error,
+                    emission.normal,
+                    c.lens_point,
+                    Vec3A::ZERO,
+                    Vec3A::ZERO,
+                );
+                if !scene.geometry.occluded(&ray) {
+                    let value =
+                        le * (emission.cos_at_light(c.wi) * c.weight / emission.pdf_position);
+                    splat(Splat {
+                        film: c.film,
+                        value,
+                    });
+                }
+            }
+        }
+
+        let mut beta = emission.throughput;
+        let mut ray = Ray::new(
+            offset_ray_origin(
+                emission.point,
+                emission.error,
+                emission.normal,
+                emission.direction,
+            ),
+            emission.direction,
+        );
+        counts.camera += 1;
+        let mut bounces = 0;
+        while bounces < self.max_depth {
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                break;
+            };
+            let bsdf = scene.materials[hit.material as usize].bsdf;
+            if bsdf.is_black() {
+                break;
+            }
+            let frame = Frame::from_normal(hit.normal);
+            // Direction back towards where the particle came from.
+            let w_prev = frame.to_local(-ray.direction);
+            let u_lens = sampler.next_2d();
+            let u_lobe = sampler.next_1d();
+            let u_bsdf = sampler.next_2d();
+            let u_roulette = sampler.next_1d();
+
+            if !bsdf.is_specular()
+                && let Some(c) = camera.connect(hit.point, u_lens)
+            {
+                let w_cam = frame.to_local(c.wi);
+                let f = bsdf.eval(w_cam, w_prev);
+                if f.max_element() > 0.0 {
+                    counts.shadow += 1;
+                    let ray = ray_between(
+                        hit.point,
+                        hit.error,
+                        hit.normal,
+                        c.lens_point,
+                        Vec3A::ZERO,
+                        Vec3A::ZERO,
+                    );
+                    if !scene.geometry.occluded(&ray) {
+                        splat(Splat {
+                            film: c.film,
+                            value: beta * f * (w_cam.z.abs() * c.weight),
+                        });
+                    }
+                }
+            }
+
+            let Some(sample) = bsdf.sample(w_prev, u_lobe, u_bsdf) else {
+                break;
+            };
+            beta *= importance_weight(bsdf, w_prev, sample.wi, sample.weight);
+            bounces += 1;
+            if self.russian_roulette && bounces > self.rr_depth {
+                let q = beta.max_element().min(0.95);
+                if u_roulette >= q {
+                    break;
+                }
+                beta /= q;
+            }
+            if beta.max_element() <= 0.0 {
+                break;
+            }
+            let wi_world = frame.to_world(sample.wi);
+            ray = Ray::new(
+                offset_ray_origin(hit.point, hit.error, hit.normal, wi_world),
+                wi_world,
+            );
+            counts.bounce += 1;
+        }
+    }
+}
+
+/// The sample weight f cos / p in importance transport: as for radiance,
+/// except that refraction does not scale by (eta_i / eta_t)^2.
+#[inline]
+fn importance_weight(bsdf: Bsdf, wo: Vec3A, wi: Vec3A, radiance_weight: Rgb) -> Rgb {
+    match bsdf {
+        Bsdf::Dielectric { tint, .. } if wo.z * wi.z < 0.0 => tint,
+        _ => radiance_weight,
+    }
+}

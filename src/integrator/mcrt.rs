@@ -1,0 +1,186 @@
+//! Monte Carlo (distribution) ray tracing (Cook, Porter & Carpenter 1984):
+//! at every hit, N shadow rays to sampled light points and M rays sampled
+//! from the BSDF, each of which recurses. The tree of rays grows as M^D with
+//! the depth D, which is why path tracing (M = 1) replaced it.
+//!
+//! The two sample sets are combined by the multi-sample MIS of Veach
+//! (balance or power heuristic with sample counts): with densities p_l, p_b,
+//!   L(x) = (1/N) sum_i w_l f Le cos / p_l  +  (1/M) sum_j f cos / p_b [w_b Le(y_j) + L(y_j)]
+//!   w_l = (N p_l)^b / ((N p_l)^b + (M p_b)^b),   w_b likewise.
+//! At the last level no BSDF rays are cast (M = 0), so light samples carry
+//! all of the direct light there.
+
+use super::{MisHeuristic, RayCounts};
+use crate::accel::{NO_LIGHT, SurfaceHit};
+use crate::math::{Frame, Ray, Rgb, offset_ray_origin};
+use crate::sampling::Sampler;
+use crate::scene::Scene;
+
+use super::path::shadow_ray;
+
+/// Settings of the branching ray tracer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct McRayTracer {
+    /// Bounces: 1 = direct lighting only.
+    pub max_depth: u32,
+    /// Light samples (shadow rays) per hit.
+    pub shadow_rays: u32,
+    /// BSDF samples (secondary rays) per hit, each recursing.
+    pub glossy_rays: u32,
+    pub mis: MisHeuristic,
+}
+
+impl Default for McRayTracer {
+    fn default() -> Self {
+        McRayTracer {
+            max_depth: 2,
+            shadow_rays: 5,
+            glossy_rays: 5,
+            mis: MisHeuristic::Power,
+        }
+    }
+}
+
+/// Multi-sample MIS weight of a strategy with `n_a` samples of density `pdf_a`
+/// against one with `n_b` samples of density `pdf_b`.
+#[inline]
+fn multi_sample_weight(heuristic: MisHeuristic, n_a: u32, pdf_a: f32, n_b: u32, pdf_b: f32) -> f32 {
+    if n_b == 0 {
+        return 1.0;
+    }
+    heuristic.weight(n_a as f32 * pdf_a, n_b as f32 * pdf_b)
+}
+
+impl McRayTracer {
+    pub fn describe(&self) -> String {
+        format!(
+            "mcrt (max depth {}, shadow rays {}, glossy rays {}, mis {:?})",
+            self.max_depth, self.shadow_rays, self.glossy_rays, self.mis
+        )
+    }
+
+    /// Expected rays per camera sample in a closed scene where every ray hits
+    /// a scattering surface: 1 + sum_{d=0..D} M^d N + sum_{d=1..D} M^d.
+    pub fn rays_per_sample_closed(&self) -> u64 {
+        let (m, n) = (self.glossy_rays as u64, self.shadow_rays as u64);
+        let mut total = 1;
+        let mut width = 1u64;
+        for depth in 0..=self.max_depth {
+            total += width * n;
+            if depth < self.max_depth {
+                width *= m;
+                total += width;
+            }
+        }
+        total
+    }
+
+    /// One radiance sample along the camera ray.
+    pub fn radiance(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
+        let Some(hit) = scene.geometry.intersect(&ray) else {
+            return Rgb::ZERO;
+        };
+        let material = &scene.materials[hit.material as usize];
+        let emitted = if hit.light != NO_LIGHT {
+            material.emitted(hit.normal, -ray.direction)
+        } else {
+            Rgb::ZERO
+        };
+        emitted + self.scattered(scene, &hit, -ray.direction, 0, sampler, counts)
+    }
+
+    /// Light scattered at `hit` towards `wo_world`, excluding its emission.
+    fn scattered(
+        &self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        wo_world: glam::Vec3A,
+        depth: u32,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
+        let bsdf = scene.materials[hit.material as usize].bsdf;
+        if bsdf.is_black() {
+            return Rgb::ZERO;
+        }
+        let frame = Frame::from_normal(hit.normal);
+        let wo = frame.to_local(wo_world);
+        let n_light = if bsdf.is_specular() {
+            0
+        } else {
+            self.shadow_rays
+        };
+        let n_bsdf = if depth < self.max_depth {
+            self.glossy_rays
+        } else {
+            0
+        };
+        let mut radiance = Rgb::ZERO;
+
+        for _ in 0..n_light {
+            let u_select = sampler.next_1d();
+            let u_light = sampler.next_2d();
+            let Some(ls) = scene.lights.sample(hit.point, u_select, u_light) else {
+                continue;
+            };
+            let wi = frame.to_local(ls.wi);
+            let f = bsdf.eval(wo, wi);
+            if f.max_element() <= 0.0 {
+                continue;
+            }
+            let weight = if ls.delta || self.mis == MisHeuristic::None {
+                1.0
+            } else {
+                multi_sample_weight(self.mis, n_light, ls.pdf, n_bsdf, bsdf.pdf(wo, wi))
+            };
+            counts.shadow += 1;
+            if !scene.geometry.occluded(&shadow_ray(hit, &ls)) {
+                radiance += f * ls.radiance * (wi.z.abs() * weight / (ls.pdf * n_light as f32));
+            }
+        }
+
+        for _ in 0..n_bsdf {
+            let u_lobe = sampler.next_1d();
+            let u_bsdf = sampler.next_2d();
+            let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
+                continue;
+            };
+            let wi_world = frame.to_world(sample.wi);
+            let ray = Ray::new(
+                offset_ray_origin(hit.point, hit.error, hit.normal, wi_world),
+                wi_world,
+            );
+            counts.bounce += 1;
+            let Some(next) = scene.geometry.intersect(&ray) else {
+                continue;
+            };
+            let beta = sample.weight / n_bsdf as f32;
+            let material = &scene.materials[next.material as usize];
+            if next.light != NO_LIGHT {
+                let emitted = material.emitted(next.normal, -wi_world);
+                if emitted.max_element() > 0.0 {
+                    let weight = if sample.specular || n_light == 0 {
+                        1.0
+                    } else if self.mis == MisHeuristic::None {
+                        0.0
+                    } else {
+                        let light_pdf =
+                            scene
+                                .lights
+                                .pdf(next.light, hit.point, next.point, next.normal);
+                        multi_sample_weight(self.mis, n_bsdf, sample.pdf, n_light, light_pdf)
+                    };
+                    radiance += beta * emitted * weight;
+                }
+            }
+            radiance += beta * self.scattered(scene, &next, -wi_world, depth + 1, sampler, counts);
+        }
+        radiance
+    }
+}

@@ -1,0 +1,127 @@
+//! Estimator settings as plain data, the one form that the CLI and the viewer
+//! both fill in; [`IntegratorOptions::build`] turns them into an [`Integrator`].
+
+use super::{
+    GlassShadows, Integrator, LightTracer, McRayTracer, MisHeuristic, PathTracer, WhittedTracer,
+};
+use crate::math::Rgb;
+
+/// Which estimator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IntegratorKind {
+    Whitted,
+    Mcrt,
+    #[default]
+    Path,
+    Light,
+}
+
+impl IntegratorKind {
+    pub const ALL: [IntegratorKind; 4] = [
+        IntegratorKind::Whitted,
+        IntegratorKind::Mcrt,
+        IntegratorKind::Path,
+        IntegratorKind::Light,
+    ];
+
+    /// Name for menus.
+    pub fn label(self) -> &'static str {
+        match self {
+            IntegratorKind::Whitted => "Whitted ray tracing",
+            IntegratorKind::Mcrt => "Monte Carlo ray tracing",
+            IntegratorKind::Path => "Path tracing",
+            IntegratorKind::Light => "Light tracing",
+        }
+    }
+}
+
+/// Which sampling strategies the path tracer uses for direct light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Strategy {
+    /// BSDF sampling only: light is found when a bounce hits an emitter.
+    Bsdf,
+    /// Light sampling only (next-event estimation); hits on emitters after a
+    /// diffuse or glossy bounce are ignored.
+    Light,
+    /// Both, combined by multiple importance sampling.
+    #[default]
+    Mis,
+}
+
+/// Every estimator setting; each estimator reads the ones it has.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct IntegratorOptions {
+    pub kind: IntegratorKind,
+    /// Bounces (1 = direct lighting); Mitsuba's max_depth is one more.
+    pub max_depth: u32,
+    pub russian_roulette: bool,
+    pub rr_depth: u32,
+    pub strategy: Strategy,
+    /// Heuristic for [`Strategy::Mis`] and MC ray tracing (never `None`).
+    pub mis: MisHeuristic,
+    /// MC ray tracing branching factors.
+    pub shadow_rays: u32,
+    pub glossy_rays: u32,
+    /// Whitted's constant ambient radiance (grey).
+    pub ambient: f32,
+    pub glass_shadows: GlassShadows,
+}
+
+impl Default for IntegratorOptions {
+    fn default() -> Self {
+        IntegratorOptions {
+            kind: IntegratorKind::Path,
+            max_depth: 8,
+            russian_roulette: true,
+            rr_depth: 5,
+            strategy: Strategy::Mis,
+            mis: MisHeuristic::Power,
+            shadow_rays: 1,
+            glossy_rays: 1,
+            ambient: 0.0,
+            glass_shadows: GlassShadows::Opaque,
+        }
+    }
+}
+
+impl IntegratorOptions {
+    /// The configured estimator.
+    pub fn build(&self) -> Integrator {
+        let mis = if self.mis == MisHeuristic::None {
+            MisHeuristic::Power
+        } else {
+            self.mis
+        };
+        match self.kind {
+            IntegratorKind::Whitted => Integrator::Whitted(WhittedTracer {
+                max_depth: self.max_depth,
+                ambient: Rgb::splat(self.ambient.max(0.0)),
+                glass_shadows: self.glass_shadows,
+            }),
+            IntegratorKind::Mcrt => Integrator::Mcrt(McRayTracer {
+                max_depth: self.max_depth,
+                shadow_rays: self.shadow_rays,
+                glossy_rays: self.glossy_rays,
+                mis,
+            }),
+            IntegratorKind::Path => Integrator::Path(PathTracer {
+                max_depth: self.max_depth,
+                rr_depth: self.rr_depth,
+                russian_roulette: self.russian_roulette,
+                nee: self.strategy != Strategy::Bsdf,
+                mis: match self.strategy {
+                    Strategy::Light => MisHeuristic::None,
+                    _ => mis,
+                },
+            }),
+            IntegratorKind::Light => Integrator::Light(LightTracer {
+                max_depth: self.max_depth,
+                rr_depth: self.rr_depth,
+                russian_roulette: self.russian_roulette,
+            }),
+        }
+    }
+}

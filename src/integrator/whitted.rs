@@ -1,0 +1,247 @@
+//! Whitted ray tracing (1980): deterministic "backward" ray tracing.
+//!
+//! At every hit: emission, direct light from each light treated as a point
+//! (area lights at their centroid, with the intensity of a Lambertian emitter,
+//! I = Le A cos), one hard shadow ray per light, an optional constant ambient
+//! term, and recursion along the perfect mirror and refraction directions
+//! (Snell, Fresnel-weighted) up to a depth. Diffuse interreflection, soft
+//! shadows and caustics are missing by construction: that is the point of
+//! showing it next to the path tracer.
+//!
+//!   L(x, wo) = Le + sum_lights f(wo, wl) I cos / d^2 V + ka albedo
+//!            + R L(x, reflect(wo)) + (1 - R) T L(x, refract(wo))
+
+use super::RayCounts;
+use crate::accel::{NO_LIGHT, SurfaceHit};
+use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
+use crate::scene::Scene;
+use crate::scene::light::Light;
+use crate::scene::material::{Bsdf, fresnel_dielectric};
+use glam::Vec3A;
+
+/// How shadow rays treat glass in their way (the classic shortcuts: no
+/// refraction of the light, no caustics).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GlassShadows {
+    /// Glass blocks light like any other surface.
+    #[default]
+    Opaque,
+    /// Light passes through glass, multiplied by its tint at every crossing.
+    Tinted,
+}
+
+/// Settings of the Whitted ray tracer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WhittedTracer {
+    /// Maximum number of specular bounces after the first hit.
+    pub max_depth: u32,
+    /// Constant ambient radiance, multiplied by the diffuse albedo.
+    pub ambient: Rgb,
+    pub glass_shadows: GlassShadows,
+}
+
+impl Default for WhittedTracer {
+    fn default() -> Self {
+        WhittedTracer {
+            max_depth: 8,
+            ambient: Rgb::ZERO,
+            glass_shadows: GlassShadows::Opaque,
+        }
+    }
+}
+
+/// Most glass surfaces a tinted shadow ray passes before it gives up.
+const MAX_GLASS_CROSSINGS: u32 = 16;
+
+impl WhittedTracer {
+    pub fn describe(&self) -> String {
+        format!(
+            "whitted (max depth {}, ambient {:?}, glass shadows {:?})",
+            self.max_depth,
+            self.ambient.to_array(),
+            self.glass_shadows
+        )
+    }
+
+    /// Radiance along `ray`; deterministic, so one sample per pixel is enough.
+    pub fn radiance(&self, scene: &Scene, ray: Ray, counts: &mut RayCounts) -> Rgb {
+        self.trace(scene, ray, 0, counts)
+    }
+
+    fn trace(&self, scene: &Scene, ray: Ray, depth: u32, counts: &mut RayCounts) -> Rgb {
+        let Some(hit) = scene.geometry.intersect(&ray) else {
+            return Rgb::ZERO;
+        };
+        let wo_world = -ray.direction;
+        let material = &scene.materials[hit.material as usize];
+        let mut radiance = if hit.light != NO_LIGHT {
+            material.emitted(hit.normal, wo_world)
+        } else {
+            Rgb::ZERO
+        };
+        let frame = Frame::from_normal(hit.normal);
+        let wo = frame.to_local(wo_world);
+        match material.bsdf {
+            Bsdf::Diffuse { albedo } => {
+                radiance += self.direct(scene, &hit, &frame, wo, material.bsdf, counts);
+                radiance += self.ambient * albedo;
+            }
+            Bsdf::Glossy { diffuse, .. } => {
+                radiance += self.direct(scene, &hit, &frame, wo, material.bsdf, counts);
+                radiance += self.ambient * diffuse;
+            }
+            Bsdf::Mirror { reflectance } => {
+                if depth < self.max_depth {
+                    let wi = Vec3A::new(-wo.x, -wo.y, wo.z);
+                    radiance +=
+                        reflectance * self.follow(scene, &hit, frame.to_world(wi), depth, counts);
+                }
+            }
+            Bsdf::Dielectric { eta, tint } => {
+                if depth < self.max_depth {
+                    let f = fresnel_dielectric(wo.z, eta);
+                    let reflected = frame.to_world(Vec3A::new(-wo.x, -wo.y, wo.z));
+                    radiance += f.reflectance * self.follow(scene, &hit, reflected, depth, counts);
+                    if f.reflectance < 1.0 {
+                        let refracted =
+                            frame.to_world(Vec3A::new(-wo.x * f.eta_ti, -wo.y * f.eta_ti, f.cos_t));
+                        // (eta_i / eta_t)^2: radiance crossing into a denser medium.
+                        let scale = (1.0 - f.reflectance) * f.eta_ti * f.eta_ti;
+                        radiance +=
+                            tint * scale * self.follow(scene, &hit, refracted, depth, counts);
+                    }
+                }
+            }
+        }
+        radiance
+    }
+
+    /// Recurses along a specular direction.
+    fn follow(
+        &self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        direction: Vec3A,
+        depth: u32,
+        counts: &mut RayCounts,
+    ) -> Rgb {
+        counts.bounce += 1;
+        let origin = offset_ray_origin(hit.point, hit.error, hit.normal, direction);
+        self.trace(scene, Ray::new(origin, direction), depth + 1, counts)
+    }
+
+    /// Direct light from every light, each treated as a point.
+    fn direct(
+        &self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        frame: &Frame,
+        wo: Vec3A,
+        bsdf: Bsdf,
+        counts: &mut RayCounts,
+    ) -> Rgb {
+        let mut sum = Rgb::ZERO;
+        for light in scene.lights.as_slice() {
+            let (position, shadow_target, intensity) = point_equivalent(light, hit.point);
+            let to_light = position - hit.point;
+            let dist2 = to_light.length_squared();
+            if intensity.max_element() <= 0.0 || dist2 <= 0.0 {
+                continue;
+            }
+            let wl = to_light / dist2.sqrt();
+            let wi = frame.to_local(wl);
+            let f = bsdf.eval(wo, wi);
+            if f.max_element() <= 0.0 {
+                continue;
+            }
+            let ray = ray_between(
+                hit.point,
+                hit.error,
+                hit.normal,
+                shadow_target,
+                Vec3A::ZERO,
+                Vec3A::ZERO,
+            );
+            let visibility = self.transmittance(scene, ray, counts);
+            sum += f * intensity * visibility * (wi.z.abs() / dist2);
+        }
+        sum
+    }
+
+    /// Fraction of light passing along a shadow ray: 0 or 1, or the product
+    /// of glass tints with [`GlassShadows::Tinted`].
+    fn transmittance(&self, scene: &Scene, mut ray: Ray, counts: &mut RayCounts) -> Rgb {
+        counts.shadow += 1;
+        if self.glass_shadows == GlassShadows::Opaque {
+            return if scene.geometry.occluded(&ray) {
+                Rgb::ZERO
+            } else {
+                Rgb::ONE
+            };
+        }
+        let mut tint = Rgb::ONE;
+        for _ in 0..MAX_GLASS_CROSSINGS {
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                return tint;
+            };
+            let Bsdf::Dielectric { tint: glass, .. } = scene.materials[hit.material as usize].bsdf
+            else {
+                return Rgb::ZERO;
+            };
+            tint *= glass;
+            // Continue from the far side of the glass surface to the same end.
+            let end = ray.at(ray.t_max);
+            let origin = offset_ray_origin(hit.point, hit.error, hit.normal, ray.direction);
+            let remaining = (end - origin).dot(ray.direction);
+            if remaining <= 0.0 {
+                return tint;
+            }
+            ray = Ray {
+                origin,
+                direction: ray.direction,
+                t_max: remaining,
+            };
+            counts.shadow += 1;
+        }
+        Rgb::ZERO
+    }
+}
+
+/// A light as a point: its position, where shadow rays towards it end, and
+/// its intensity towards `reference`. An area light of radiance Le and area A
+/// is a Lambertian emitter with intensity Le A cos(theta) about its normal,
+/// placed at its centroid; a sphere shows a disc of area pi r^2 from anywhere.
+fn point_equivalent(light: &Light, reference: Vec3A) -> (Vec3A, Vec3A, Rgb) {
+    match *light {
+        Light::Point {
+            position,
+            intensity,
+        } => (position, position, intensity),
+        Light::Triangle {
+            p0,
+            e1,
+            e2,
+            normal,
+            area,
+            radiance,
+            two_sided,
+        } => {
+            let centroid = p0 + (e1 + e2) / 3.0;
+            let cos = normal.dot((reference - centroid).normalize_or_zero());
+            let cos = if two_sided { cos.abs() } else { cos.max(0.0) };
+            (centroid, centroid, radiance * (area * cos))
+        }
+        Light::Sphere {
+            center,
+            radius,
+            radiance,
+            ..
+        } => {
+            // Shadow rays stop at the near side of the sphere, not inside it.
+            let surface = center + radius * (reference - center).normalize_or_zero();
+            let intensity = radiance * (std::f32::consts::PI * radius * radius);
+            (center, surface, intensity)
+        }
+    }
+}

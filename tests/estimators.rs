@@ -1,0 +1,268 @@
+//! The estimators of issue 3 on scenes small enough to check by hand: the
+//! branching factor of MC ray tracing, and Whitted ray tracing's values for
+//! single pixels, computed here from the geometry with pencil-and-paper
+//! formulas (Lambert, inverse square law, Fresnel at normal incidence).
+
+use crate::common::{render_with, temp_dir};
+use std::f32::consts::PI;
+use tracelab::integrator::{GlassShadows, IntegratorKind, IntegratorOptions};
+use tracelab::sampling::SamplerKind;
+use tracelab::scene::Scene;
+
+fn load(name: &str, text: &str) -> Scene {
+    let path = temp_dir(name).join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Six inward-facing diffuse walls around a point light: every ray hits a
+/// scattering surface and every light sample is in front of it.
+const CLOSED_BOX: &str = r#"
+[camera]
+eye = [0.0, 0.0, 0.5]
+look_at = [0.0, 0.0, -1.0]
+fov_y = 60.0
+width = 8
+height = 8
+
+[materials.white]
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+
+[[quad]]
+corner = [-1.0, -1.0, -1.0]
+u = [2.0, 0.0, 0.0]
+v = [0.0, 2.0, 0.0]
+material = "white"
+[[quad]]
+corner = [-1.0, -1.0, 1.0]
+u = [0.0, 2.0, 0.0]
+v = [2.0, 0.0, 0.0]
+material = "white"
+[[quad]]
+corner = [-1.0, -1.0, -1.0]
+u = [0.0, 0.0, 2.0]
+v = [2.0, 0.0, 0.0]
+material = "white"
+[[quad]]
+corner = [-1.0, 1.0, -1.0]
+u = [2.0, 0.0, 0.0]
+v = [0.0, 0.0, 2.0]
+material = "white"
+[[quad]]
+corner = [-1.0, -1.0, -1.0]
+u = [0.0, 2.0, 0.0]
+v = [0.0, 0.0, 2.0]
+material = "white"
+[[quad]]
+corner = [1.0, -1.0, -1.0]
+u = [0.0, 0.0, 2.0]
+v = [0.0, 2.0, 0.0]
+material = "white"
+
+[[point_light]]
+position = [0.0, 0.5, 0.0]
+intensity = [1.0, 1.0, 1.0]
+"#;
+
+#[test]
+fn mc_ray_tracing_casts_186_rays_per_pixel_with_depth_2_and_5_by_5_branching() {
+    let options = IntegratorOptions {
+        kind: IntegratorKind::Mcrt,
+        max_depth: 2,
+        shadow_rays: 5,
+        glossy_rays: 5,
+        ..Default::default()
+    };
+    let tracelab::integrator::Integrator::Mcrt(mcrt) = options.build() else {
+        unreachable!()
+    };
+    assert_eq!(mcrt.rays_per_sample_closed(), 186);
+    let (snapshot, stats) = render_with(
+        load("mcrt-count", CLOSED_BOX),
+        options.build(),
+        SamplerKind::Independent,
+        1,
+        3,
+        1,
+        1,
+    );
+    let pixels = 64;
+    assert_eq!(stats.rays.camera, pixels);
+    assert_eq!(stats.rays.shadow, pixels * (5 + 25 + 125));
+    assert_eq!(stats.rays.bounce, pixels * (5 + 25));
+    assert_eq!(stats.rays.total(), pixels * 186);
+    assert!(snapshot.image.mean()[0] > 0.0);
+}
+
+/// Camera on the +z axis looking at the origin; 101 pixels so that the
+/// centre pixel's ray runs exactly along the axis.
+fn whitted_scene(extra: &str, light: [f32; 3]) -> String {
+    format!(
+        r#"
+[camera]
+eye = [0.0, 0.0, 10.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 30.0
+width = 101
+height = 101
+
+[materials.wall]
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+[materials.glass]
+type = "dielectric"
+ior = 1.5
+tint = [0.9, 0.8, 0.7]
+[materials.mirror]
+type = "mirror"
+reflectance = [0.8, 0.8, 0.8]
+
+[[point_light]]
+position = {light:?}
+intensity = [10.0, 10.0, 10.0]
+{extra}
+"#
+    )
+}
+
+const WALL: &str = r#"
+[[quad]]
+corner = [-5.0, -5.0, 0.0]
+u = [10.0, 0.0, 0.0]
+v = [0.0, 10.0, 0.0]
+material = "wall"
+"#;
+
+/// A glass slab between z = 3 and z = 4 in front of the wall's centre.
+const SLAB: &str = r#"
+[[quad]]
+corner = [-1.0, -1.0, 4.0]
+u = [2.0, 0.0, 0.0]
+v = [0.0, 2.0, 0.0]
+material = "glass"
+[[quad]]
+corner = [-1.0, -1.0, 3.0]
+u = [0.0, 2.0, 0.0]
+v = [2.0, 0.0, 0.0]
+material = "glass"
+"#;
+
+fn whitted(text: &str, glass_shadows: GlassShadows, max_depth: u32) -> Vec<[f32; 3]> {
+    let options = IntegratorOptions {
+        kind: IntegratorKind::Whitted,
+        max_depth,
+        glass_shadows,
+        ..Default::default()
+    };
+    let (a, _) = render_with(
+        load("whitted", text),
+        options.build(),
+        SamplerKind::Independent,
+        1,
+        1,
+        1,
+        1,
+    );
+    // Deterministic: another seed and more samples change nothing.
+    let (b, _) = render_with(
+        load("whitted", text),
+        options.build(),
+        SamplerKind::Stratified,
+        3,
+        99,
+        2,
+        2,
+    );
+    assert_eq!(a.image.pixels, b.image.pixels);
+    a.image.pixels
+}
+
+/// Radiance of the diffuse wall (albedo 0.5) at `p` with normal `n`, lit by
+/// the 10 W/sr point light at `light`: (rho / pi) I cos / d^2.
+fn lambert(p: [f32; 3], n: [f32; 3], light: [f32; 3]) -> f32 {
+    let d = [light[0] - p[0], light[1] - p[1], light[2] - p[2]];
+    let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    let cos = (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]) / d2.sqrt();
+    0.5 / PI * 10.0 * cos / d2
+}
+
+fn assert_close(got: [f32; 3], want: [f32; 3], what: &str) {
+    for c in 0..3 {
+        assert!(
+            (got[c] - want[c]).abs() <= 1e-5 + 1e-4 * want[c].abs(),
+            "{what}: got {got:?}, want {want:?}"
+        );
+    }
+}
+
+const CENTRE: usize = 50 * 101 + 50;
+
+#[test]
+fn whitted_diffuse_wall_under_a_point_light_matches_lambert() {
+    let light = [0.0, 3.0, 5.0];
+    let image = whitted(&whitted_scene(WALL, light), GlassShadows::Opaque, 8);
+    let centre = lambert([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], light);
+    assert_close(image[CENTRE], [centre; 3], "centre pixel");
+    // Pixel (75, 50): its ray leaves at tan(15 deg) * ndc_x off the axis and
+    // meets the wall 10 units away; image right is +x.
+    let ndc_x = 2.0 * 75.5 / 101.0 - 1.0;
+    let x = 10.0 * ndc_x * 15f32.to_radians().tan();
+    let off_axis = lambert([x, 0.0, 0.0], [0.0, 0.0, 1.0], light);
+    assert_close(image[50 * 101 + 75], [off_axis; 3], "pixel (75, 50)");
+}
+
+#[test]
+fn whitted_sees_the_wall_through_glass_with_fresnel_losses() {
+    // Normal incidence: F = ((1.5 - 1) / (1.5 + 1))^2 = 0.04 at each face;
+    // the (eta_i/eta_t)^2 factors of entering and leaving cancel. Depth 2
+    // stops the internal reflections, which would add F^2 (1 - F)^2 terms.
+    let tint = [0.9f32, 0.8, 0.7];
+    let through = (1.0f32 - 0.04).powi(2);
+    let light = [0.0, 3.0, 5.0];
+    let image = whitted(
+        &whitted_scene(&format!("{WALL}{SLAB}"), light),
+        GlassShadows::Opaque,
+        2,
+    );
+    let wall = lambert([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], light);
+    assert_close(
+        image[CENTRE],
+        tint.map(|t| t * t * through * wall),
+        "wall seen through the slab",
+    );
+
+    // Light behind the slab as seen from the wall: opaque shadows make the
+    // wall black; tinted shadows let tint^2 through, without refraction.
+    let light = [0.0, 0.5, 8.0];
+    let text = whitted_scene(&format!("{WALL}{SLAB}"), light);
+    let opaque = whitted(&text, GlassShadows::Opaque, 2);
+    assert_close(opaque[CENTRE], [0.0; 3], "opaque glass shadow");
+    let tinted = whitted(&text, GlassShadows::Tinted, 2);
+    let wall = lambert([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], light);
+    assert_close(
+        tinted[CENTRE],
+        tint.map(|t| t.powi(4) * through * wall),
+        "tinted glass shadow",
+    );
+}
+
+#[test]
+fn whitted_mirror_shows_the_wall_behind_the_camera() {
+    let mirror = r#"
+[[quad]]
+corner = [-5.0, -5.0, 0.0]
+u = [10.0, 0.0, 0.0]
+v = [0.0, 10.0, 0.0]
+material = "mirror"
+[[quad]]
+corner = [-50.0, -50.0, 20.0]
+u = [0.0, 100.0, 0.0]
+v = [100.0, 0.0, 0.0]
+material = "wall"
+"#;
+    let light = [0.0, 3.0, 15.0];
+    let image = whitted(&whitted_scene(mirror, light), GlassShadows::Opaque, 8);
+    let wall = lambert([0.0, 0.0, 20.0], [0.0, 0.0, -1.0], light);
+    assert_close(image[CENTRE], [0.8 * wall; 3], "mirror reflection");
+}
