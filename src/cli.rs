@@ -27,6 +27,9 @@ pub struct Cli {
 enum Command {
     /// Render a scene to an EXR (linear float) or PNG (tone-mapped sRGB) file.
     Render(RenderArgs),
+    /// Open the live window (the default when no command is given).
+    #[cfg(feature = "viewer")]
+    View(ViewArgs),
     /// Compare two images: RMSE, relative MSE and mean relative error (as tev computes them).
     Compare {
         /// The image to measure.
@@ -46,6 +49,36 @@ enum IntegratorArg {
     Path,
     /// Light (particle) tracing: paths from the lights, every vertex connected to the camera.
     Light,
+}
+
+#[cfg(feature = "viewer")]
+#[derive(Args, Debug)]
+struct ViewArgs {
+    /// Scene file (TOML); default: the last one, or the Cornell box.
+    scene: Option<PathBuf>,
+    #[arg(long, value_enum)]
+    integrator: Option<IntegratorArg>,
+    /// Target samples per pixel.
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Save a screenshot of the window here once every view has --after-spp samples, then exit.
+    #[arg(long)]
+    screenshot: Option<PathBuf>,
+    /// Samples per pixel to wait for before --screenshot.
+    #[arg(long, default_value_t = 64, requires = "screenshot")]
+    after_spp: u32,
+    /// Start a side-by-side comparison (B = A with the stratified sampler).
+    #[arg(long)]
+    compare: bool,
+    /// Render threads (default: one per core).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Ignore the settings saved by the last session.
+    #[arg(long)]
+    fresh: bool,
+    /// Folder for exports (default: ./exports).
+    #[arg(long)]
+    export_dir: Option<PathBuf>,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -154,6 +187,21 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Render(args)) => render(&args),
         Some(Command::Compare { image, reference }) => compare(&image, &reference),
+        #[cfg(feature = "viewer")]
+        Some(Command::View(args)) => view(args),
+        #[cfg(feature = "viewer")]
+        None => view(ViewArgs {
+            scene: None,
+            integrator: None,
+            spp: None,
+            screenshot: None,
+            after_spp: 64,
+            compare: false,
+            threads: 0,
+            fresh: false,
+            export_dir: None,
+        }),
+        #[cfg(not(feature = "viewer"))]
         None => {
             eprintln!(
                 "tracelab: no command given; rendering the default Cornell box (see `tracelab --help`)."
@@ -175,6 +223,39 @@ pub fn run(cli: Cli) -> Result<()> {
     }
 }
 
+#[cfg(feature = "viewer")]
+fn view(args: ViewArgs) -> Result<()> {
+    if let Some(scene) = &args.scene
+        && !scene.is_file()
+    {
+        return Err(Error::at(scene, None, "no such scene file"));
+    }
+    if let Some(shot) = &args.screenshot {
+        check_writable(shot)?;
+    }
+    tracelab::viewer::run(tracelab::viewer::Launch {
+        scene: args.scene,
+        integrator: args.integrator.map(integrator_kind),
+        target_spp: args.spp,
+        fresh: args.fresh || args.screenshot.is_some(),
+        screenshot: args.screenshot,
+        after_spp: args.after_spp,
+        compare: args.compare,
+        threads: args.threads,
+        export_dir: args.export_dir,
+    })
+}
+
+fn integrator_kind(arg: IntegratorArg) -> IntegratorKind {
+    match arg {
+        IntegratorArg::Whitted => IntegratorKind::Whitted,
+        IntegratorArg::Mcrt => IntegratorKind::Mcrt,
+        IntegratorArg::Path => IntegratorKind::Path,
+        IntegratorArg::Light => IntegratorKind::Light,
+    }
+}
+
+#[cfg_attr(feature = "viewer", allow(dead_code))]
 fn default_scene_path() -> PathBuf {
     let local = PathBuf::from("scenes/cornell_box.toml");
     if local.is_file() {
@@ -355,12 +436,7 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
         ));
     }
     Ok(IntegratorOptions {
-        kind: match args.integrator {
-            IntegratorArg::Whitted => IntegratorKind::Whitted,
-            IntegratorArg::Mcrt => IntegratorKind::Mcrt,
-            IntegratorArg::Path => IntegratorKind::Path,
-            IntegratorArg::Light => IntegratorKind::Light,
-        },
+        kind: integrator_kind(args.integrator),
         max_depth: args.max_depth,
         russian_roulette: !args.no_rr,
         rr_depth: args.rr_depth,

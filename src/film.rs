@@ -107,6 +107,8 @@ pub struct FilmSnapshot {
     pub standard_error: Image,
     /// Per-pixel sample counts.
     pub samples: Vec<u32>,
+    /// Per-pixel counts of non-finite samples left out.
+    pub non_finite_pixels: Vec<u32>,
     /// Total non-finite samples left out.
     pub non_finite: u64,
 }
@@ -153,6 +155,7 @@ impl Film {
         let mut image = Image::new(self.width, self.height);
         let mut standard_error = Image::new(self.width, self.height);
         let mut samples = vec![0u32; n];
+        let mut non_finite_pixels = vec![0u32; n];
         let mut non_finite = 0u64;
         for tile in &self.tiles {
             // A poisoned lock only means a pass panicked; the sums are still valid.
@@ -164,6 +167,7 @@ impl Film {
                     image.pixels[i] = p.mean();
                     standard_error.pixels[i] = p.standard_error();
                     samples[i] = p.count;
+                    non_finite_pixels[i] = p.non_finite;
                     non_finite += p.non_finite as u64;
                 }
             }
@@ -172,6 +176,7 @@ impl Film {
             image,
             standard_error,
             samples,
+            non_finite_pixels,
             non_finite,
         }
     }

@@ -63,14 +63,17 @@ impl Image {
 
     /// Writes linear float32 RGB EXR.
     pub fn write_exr(&self, path: &Path) -> Result<()> {
+        write_atomically(path, |tmp| self.encode_exr(tmp))
+    }
+
+    /// Writes an EXR straight to `path` (callers make it atomic).
+    pub fn encode_exr(&self, path: &Path) -> std::result::Result<(), String> {
         let data: Vec<f32> = self.pixels.iter().flatten().copied().collect();
         let buffer = Rgb32FImage::from_raw(self.width, self.height, data)
-            .ok_or_else(|| Error::new("internal: image buffer size mismatch"))?;
-        write_atomically(path, |tmp| {
-            buffer
-                .save_with_format(tmp, ImageFormat::OpenExr)
-                .map_err(|e| e.to_string())
-        })
+            .ok_or("internal: image buffer size mismatch")?;
+        buffer
+            .save_with_format(path, ImageFormat::OpenExr)
+            .map_err(|e| e.to_string())
     }
 
     /// Writes an 8-bit sRGB PNG: radiance times 2^exposure, clamped, sRGB-encoded.
@@ -168,6 +171,51 @@ pub fn write_atomically(
     })
 }
 
+/// Writes a new file at `path`, or at `stem-2.ext`, `stem-3.ext`, ... when
+/// that exists: never overwrites. The data goes to a temporary file first and
+/// is hard-linked into place, which fails rather than replace a file that
+/// appeared meanwhile. Returns the path written.
+pub fn write_new_file(
+    path: &Path,
+    write: impl FnOnce(&Path) -> std::result::Result<(), String>,
+) -> Result<PathBuf> {
+    let tmp = temporary_path(path);
+    if let Err(e) = write(&tmp) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::at(path, None, format!("cannot write output: {e}")));
+    }
+    let stem = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("export");
+    let ext = path.extension().and_then(|s| s.to_str()).unwrap_or("");
+    let mut result = Err(Error::at(path, None, "no free file name"));
+    for n in 1..10_000 {
+        let candidate = if n == 1 {
+            path.to_path_buf()
+        } else {
+            path.with_file_name(format!("{stem}-{n}.{ext}"))
+        };
+        match std::fs::hard_link(&tmp, &candidate) {
+            Ok(()) => {
+                result = Ok(candidate);
+                break;
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => {
+                result = Err(Error::at(
+                    &candidate,
+                    None,
+                    format!("cannot write output: {e}"),
+                ));
+                break;
+            }
+        }
+    }
+    let _ = std::fs::remove_file(&tmp);
+    result
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -202,6 +250,23 @@ mod tests {
         assert_eq!(Image::read(&path).unwrap(), img);
         // No temporary file is left next to it.
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn new_files_never_overwrite() {
+        let dir = std::env::temp_dir().join(format!("tracelab-new-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("shot.png");
+        let write =
+            |text: &'static str| move |p: &Path| std::fs::write(p, text).map_err(|e| e.to_string());
+        assert_eq!(write_new_file(&path, write("a")).unwrap(), path);
+        let second = write_new_file(&path, write("b")).unwrap();
+        assert_eq!(second, dir.join("shot-2.png"));
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "a");
+        assert_eq!(std::fs::read_to_string(&second).unwrap(), "b");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

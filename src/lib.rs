@@ -2,16 +2,20 @@
 //!
 //! The core (scene, geometry, BVH, sampling, materials, integrators, film)
 //! is plain data and free functions; front ends (the CLI, the tests, and the
-//! viewer) drive it through [`render::Session`]. Nothing here imports a GUI.
+//! viewer) drive it through [`render::Session`] and [`live::LiveRender`].
+//! Only `viewer` (behind the default `viewer` feature) imports egui.
 
 pub mod accel;
 pub mod error;
 pub mod film;
 pub mod image;
 pub mod integrator;
+pub mod live;
 pub mod math;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+#[cfg(feature = "viewer")]
+pub mod viewer;
 
 pub use error::{Error, Result};

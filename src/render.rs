@@ -51,7 +51,7 @@ pub struct Session {
     scene: Arc<Scene>,
     settings: RenderSettings,
     film: Film,
-    pool: rayon::ThreadPool,
+    pool: Arc<rayon::ThreadPool>,
     spp: AtomicU32,
     samples: AtomicU64,
     camera_rays: AtomicU64,
@@ -63,15 +63,21 @@ pub struct Session {
 }
 
 impl Session {
-    /// Starts a session; nothing renders until [`Session::render_pass`].
+    /// Starts a session with its own `settings.threads` worker threads;
+    /// nothing renders until [`Session::render_pass`].
     pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Result<Session> {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(settings.threads)
-            .thread_name(|i| format!("tracelab-render-{i}"))
-            .build()
-            .map_err(|e| Error::new(format!("cannot start render threads: {e}")))?;
+        let pool = thread_pool(settings.threads)?;
+        Ok(Self::with_pool(scene, settings, pool))
+    }
+
+    /// Starts a session on an existing pool (sessions that take turns share one).
+    pub fn with_pool(
+        scene: Arc<Scene>,
+        settings: RenderSettings,
+        pool: Arc<rayon::ThreadPool>,
+    ) -> Session {
         let film = Film::new(scene.camera.width, scene.camera.height);
-        Ok(Session {
+        Session {
             scene,
             settings,
             film,
@@ -84,7 +90,7 @@ impl Session {
             non_finite: AtomicU64::new(0),
             render_nanos: AtomicU64::new(0),
             cancelled: AtomicBool::new(false),
-        })
+        }
     }
 
     pub fn scene(&self) -> &Scene {
@@ -233,6 +239,11 @@ impl Session {
         self.non_finite.fetch_add(non_finite, Ordering::Relaxed);
     }
 
+    /// True once [`Session::cancel`] was called.
+    pub fn is_cancelled(&self) -> bool {
+        self.cancelled.load(Ordering::Relaxed)
+    }
+
     /// Copies the film (means, standard errors, counts) while passes may run.
     pub fn snapshot(&self) -> FilmSnapshot {
         self.film.snapshot()
@@ -252,6 +263,16 @@ impl Session {
             render_time: Duration::from_nanos(self.render_nanos.load(Ordering::Relaxed)),
         }
     }
+}
+
+/// A pool of `threads` render threads (0 = one per core).
+pub fn thread_pool(threads: usize) -> Result<Arc<rayon::ThreadPool>> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(|i| format!("tracelab-render-{i}"))
+        .build()
+        .map(Arc::new)
+        .map_err(|e| Error::new(format!("cannot start render threads: {e}")))
 }
 
 /// Per-pixel sums of light-tracing splats in 32.32 fixed point: integer

@@ -14,6 +14,7 @@ use camera::Camera;
 use light::{Light, Lights, SphereSampling};
 use material::Material;
 use std::path::Path;
+use std::sync::Arc;
 
 /// Sizes beyond which input is taken for a typo rather than a wish.
 #[derive(Clone, Copy, Debug)]
@@ -59,7 +60,8 @@ pub struct SceneInput {
 #[derive(Clone, Debug)]
 pub struct Scene {
     pub camera: Camera,
-    pub geometry: Geometry,
+    /// Shared, so that a scene with another camera costs no copy of the BVH.
+    pub geometry: Arc<Geometry>,
     pub materials: Vec<Material>,
     pub lights: Lights,
     /// Things the user should know that did not stop loading (dropped triangles, ...).
@@ -162,7 +164,7 @@ impl Scene {
         }
         Ok(Scene {
             camera: input.camera,
-            geometry,
+            geometry: Arc::new(geometry),
             materials: input.materials,
             lights,
             warnings,

@@ -1,0 +1,723 @@
+//! The viewer's state and logic: which scene, which settings, what is shown,
+//! and the actions (restart, export, screenshots). The panels in `panel.rs`,
+//! `image_view.rs` and `stats.rs` only read this state and change settings;
+//! [`ViewerApp::sync`] notices changes once per frame and restarts the
+//! renderer when a render setting changed.
+
+use super::display::render_view;
+use super::export::{export_path, write_color_image, write_exr};
+use super::settings::{Config, Display, Settings};
+use crate::image::Image;
+use crate::integrator::IntegratorKind;
+use crate::live::{ErrorPoint, LiveConfig, LiveFrame, LiveRender};
+use crate::render::RenderSettings;
+use crate::scene::camera::Camera;
+use crate::scene::{Limits, Scene};
+use eframe::egui::{self, ColorImage, TextureHandle, TextureOptions};
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// How the viewer was started (command line or tests).
+#[derive(Clone, Debug, Default)]
+pub struct Launch {
+    /// Scene to open (otherwise the last one, or the Cornell box).
+    pub scene: Option<PathBuf>,
+    pub integrator: Option<IntegratorKind>,
+    pub target_spp: Option<u32>,
+    /// Save the window here once every view has `after_spp` samples, then quit.
+    pub screenshot: Option<PathBuf>,
+    pub after_spp: u32,
+    /// Open a side-by-side comparison (A as given, B stratified).
+    pub compare: bool,
+    /// Render threads (0 = one per core).
+    pub threads: usize,
+    /// Start from default settings instead of the saved ones.
+    pub fresh: bool,
+    pub export_dir: Option<PathBuf>,
+}
+
+/// A convergence curve of a configuration that is no longer rendering.
+#[derive(Clone, Debug)]
+pub struct Curve {
+    pub label: String,
+    pub points: Vec<ErrorPoint>,
+}
+
+/// A message that fades after a few seconds.
+#[derive(Clone, Debug)]
+pub struct Toast {
+    pub text: String,
+    pub shown_at: Instant,
+}
+
+/// What a pending screen capture is for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Capture {
+    /// The whole window, to this file (from the Export menu or --screenshot).
+    Window { path: PathBuf, quit_after: bool },
+    /// The comparison sheet layout.
+    Sheet { path: PathBuf },
+}
+
+/// Zoom and pan of the image area.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewTransform {
+    /// Screen points per image pixel; `None` fits the image to the area.
+    pub zoom: Option<f32>,
+    pub pan: egui::Vec2,
+}
+
+impl Default for ViewTransform {
+    fn default() -> Self {
+        ViewTransform {
+            zoom: None,
+            pan: egui::Vec2::ZERO,
+        }
+    }
+}
+
+/// Everything whose change restarts rendering: the render settings, the
+/// camera, the scene (by identity) and a counter of forced restarts.
+type RenderKey = (
+    (
+        Config,
+        Option<Config>,
+        crate::live::Lock,
+        Option<u32>,
+        Option<(u32, u32)>,
+    ),
+    Option<CameraKey>,
+    usize,
+    u64,
+);
+
+type CameraKey = [u32; 6];
+
+fn camera_key(c: &Camera) -> CameraKey {
+    [
+        c.eye.x.to_bits(),
+        c.eye.y.to_bits(),
+        c.eye.z.to_bits(),
+        c.forward.x.to_bits(),
+        c.forward.y.to_bits(),
+        c.forward.z.to_bits(),
+    ]
+}
+
+/// Frame times kept for the p95 figure.
+const FRAME_TIME_WINDOW: usize = 600;
+
+pub struct ViewerApp {
+    pub settings: Settings,
+    live: LiveRender,
+    /// The last scene that loaded; kept when a new one fails.
+    scene: Option<Arc<Scene>>,
+    scene_name: String,
+    /// Camera moved with the mouse; `None` uses the scene's.
+    pub camera: Option<Camera>,
+    reference: Option<Arc<Image>>,
+    pub errors: Vec<String>,
+    pub toasts: Vec<Toast>,
+    textures: Vec<TextureHandle>,
+    shown: Option<(Arc<LiveFrame>, Display)>,
+    last_key: Option<RenderKey>,
+    restarts: u64,
+    /// The configurations of the views now rendering.
+    rendered_configs: Vec<Config>,
+    pub view: ViewTransform,
+    pub curves: Vec<Curve>,
+    frame_times: VecDeque<f32>,
+    latencies: VecDeque<Duration>,
+    counted_latency_generation: u64,
+    pub exports: Vec<PathBuf>,
+    pub scene_files: Vec<String>,
+    launch: Launch,
+    pub capture: Option<Capture>,
+    captured: Arc<Mutex<Option<Arc<ColorImage>>>>,
+    capture_requested: bool,
+    /// Draw the comparison sheet instead of the normal layout.
+    pub sheet_mode: bool,
+    /// The path typed into the scene field.
+    pub scene_field: String,
+}
+
+impl ViewerApp {
+    /// Builds the app: restores saved settings (unless `launch.fresh`), applies
+    /// the launch options, loads the scene and starts rendering.
+    pub fn new(cc: &eframe::CreationContext<'_>, launch: Launch) -> Self {
+        let mut settings: Settings = if launch.fresh {
+            Settings::default()
+        } else {
+            cc.storage
+                .and_then(|s| eframe::get_value(s, eframe::APP_KEY))
+                .unwrap_or_default()
+        };
+        if let Some(scene) = &launch.scene {
+            settings.scene_path = scene.to_string_lossy().into_owned();
+        }
+        if let Some(kind) = launch.integrator {
+            settings.a.integrator.kind = kind;
+        }
+        if let Some(spp) = launch.target_spp {
+            settings.target_spp = spp.max(1);
+            settings.unlimited = false;
+        }
+        if launch.compare {
+            settings.compare = true;
+            settings.b = Config {
+                sampler: crate::sampling::SamplerKind::Stratified,
+                ..settings.a
+            };
+        }
+        if let Some(dir) = &launch.export_dir {
+            settings.export_dir = dir.to_string_lossy().into_owned();
+        }
+        if let Some(path) = &launch.screenshot {
+            settings.target_spp = settings.target_spp.max(launch.after_spp);
+            settings.unlimited = false;
+            let _ = path;
+        }
+        let mut errors = Vec::new();
+        let live = match LiveRender::start(launch.threads) {
+            Ok(live) => live,
+            Err(e) => {
+                errors.push(e.to_string());
+                LiveRender::start(1).expect("a single render thread starts")
+            }
+        };
+        let capture = launch.screenshot.clone().map(|path| Capture::Window {
+            path,
+            quit_after: true,
+        });
+        let mut app = ViewerApp {
+            scene_field: settings.scene_path.clone(),
+            settings,
+            live,
+            scene: None,
+            scene_name: String::new(),
+            camera: None,
+            reference: None,
+            errors,
+            toasts: Vec::new(),
+            textures: Vec::new(),
+            shown: None,
+            last_key: None,
+            restarts: 0,
+            rendered_configs: Vec::new(),
+            view: ViewTransform::default(),
+            curves: Vec::new(),
+            frame_times: VecDeque::new(),
+            latencies: VecDeque::new(),
+            counted_latency_generation: 0,
+            exports: Vec::new(),
+            scene_files: list_scene_files(),
+            launch,
+            capture,
+            captured: Arc::new(Mutex::new(None)),
+            capture_requested: false,
+            sheet_mode: false,
+        };
+        let scene_path = resolve_scene_path(&app.settings.scene_path);
+        app.load_scene(&scene_path);
+        if !app.settings.reference_path.is_empty() {
+            app.load_reference(&app.settings.reference_path.clone());
+        }
+        app
+    }
+
+    /// Loads a scene file; on failure shows the error and keeps the last good scene.
+    pub fn load_scene(&mut self, path: &str) {
+        match Scene::load_with_limits(Path::new(path), &Limits::default()) {
+            Ok(scene) => {
+                for w in &scene.warnings {
+                    self.toast(format!("{path}: {w}"));
+                }
+                self.scene = Some(Arc::new(scene));
+                self.camera = None;
+                self.settings.scene_path = path.to_string();
+                self.scene_field = path.to_string();
+                self.scene_name = Path::new(path)
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| "scene".into());
+                self.view = ViewTransform::default();
+            }
+            Err(e) => self.errors.push(e.to_string()),
+        }
+    }
+
+    /// Loads a reference image for RMSE and the difference view.
+    pub fn load_reference(&mut self, path: &str) {
+        if path.is_empty() {
+            self.reference = None;
+            self.settings.reference_path.clear();
+            self.force_restart();
+            return;
+        }
+        match Image::read(Path::new(path)) {
+            Ok(image) => {
+                self.reference = Some(Arc::new(image));
+                self.settings.reference_path = path.to_string();
+                self.force_restart();
+            }
+            Err(e) => {
+                self.reference = None;
+                self.errors.push(e.to_string());
+            }
+        }
+    }
+
+    pub fn reference(&self) -> Option<&Arc<Image>> {
+        self.reference.as_ref()
+    }
+
+    pub fn scene(&self) -> Option<&Arc<Scene>> {
+        self.scene.as_ref()
+    }
+
+    pub fn scene_name(&self) -> &str {
+        &self.scene_name
+    }
+
+    /// The camera in use: the orbited one or the scene's.
+    pub fn current_camera(&self) -> Option<Camera> {
+        self.camera
+            .or_else(|| self.scene.as_ref().map(|s| s.camera))
+    }
+
+    /// Restarts accumulation with unchanged settings.
+    pub fn force_restart(&mut self) {
+        self.restarts += 1;
+    }
+
+    pub fn toast(&mut self, text: String) {
+        self.toasts.push(Toast {
+            text,
+            shown_at: Instant::now(),
+        });
+    }
+
+    /// The newest frame from the renderer.
+    pub fn frame(&self) -> Arc<LiveFrame> {
+        self.live.latest()
+    }
+
+    pub fn live(&self) -> &LiveRender {
+        &self.live
+    }
+
+    /// The configurations being rendered, in view order.
+    pub fn configs(&self) -> Vec<Config> {
+        let mut v = vec![self.settings.a];
+        if self.settings.compare {
+            v.push(self.settings.b);
+        }
+        v
+    }
+
+    /// Restarts the renderer when a render setting, the camera or the scene changed.
+    pub fn sync(&mut self) {
+        let Some(scene) = self.scene.clone() else {
+            return;
+        };
+        let key: RenderKey = (
+            self.settings.render_key(),
+            self.camera.as_ref().map(camera_key),
+            Arc::as_ptr(&scene) as usize,
+            self.restarts,
+        );
+        if self.last_key.as_ref() == Some(&key) {
+            return;
+        }
+        self.last_key = Some(key);
+
+        // Finished curves stay on the plot, labelled by their settings.
+        let frame = self.live.latest();
+        for (view, config) in frame.views.iter().zip(self.rendered_configs.iter()) {
+            if view.history.len() >= 2 {
+                self.curves.push(Curve {
+                    label: config.label(),
+                    points: view.history.clone(),
+                });
+            }
+        }
+        let excess = self.curves.len().saturating_sub(8);
+        self.curves.drain(..excess);
+
+        let mut scene = (*scene).clone();
+        if let Some(camera) = self.camera {
+            scene.camera = camera;
+        }
+        if let Some((w, h)) = self.settings.resolution {
+            scene.set_resolution(w, h);
+        }
+        let scene = Arc::new(scene);
+        let configs = self.configs();
+        let target = (!self.settings.unlimited).then_some(self.settings.target_spp.max(1));
+        let live_configs = configs
+            .iter()
+            .map(|c| {
+                let integrator = c.integrator.build();
+                LiveConfig {
+                    scene: scene.clone(),
+                    settings: RenderSettings {
+                        integrator,
+                        sampler: c.sampler,
+                        seed: c.seed,
+                        planned_spp: target.unwrap_or(0),
+                        threads: 0,
+                    },
+                    target_spp: if integrator.is_deterministic() {
+                        Some(1)
+                    } else {
+                        target
+                    },
+                }
+            })
+            .collect();
+        self.rendered_configs = configs;
+        self.live
+            .restart(live_configs, self.settings.lock, self.reference.clone());
+    }
+
+    /// Uploads new frames (or the same frame under new display settings) to textures.
+    pub fn update_textures(&mut self, ctx: &egui::Context) {
+        let frame = self.live.latest();
+        if frame.views.is_empty() {
+            return;
+        }
+        if frame.generation == self.live.generation()
+            && self.counted_latency_generation != frame.generation
+        {
+            if let Some(latency) = frame.first_image_latency {
+                self.latencies.push_back(latency);
+                if self.latencies.len() > 200 {
+                    self.latencies.pop_front();
+                }
+            }
+            self.counted_latency_generation = frame.generation;
+        }
+        let display = self.settings.display;
+        if let Some((shown, shown_display)) = &self.shown
+            && Arc::ptr_eq(shown, &frame)
+            && *shown_display == display
+        {
+            return;
+        }
+        let images: Vec<ColorImage> = frame
+            .views
+            .iter()
+            .enumerate()
+            .map(|(i, view)| {
+                // Differences: A against B, B against A, or against the reference.
+                let other = if frame.views.len() == 2 {
+                    Some(&frame.views[1 - i].snapshot.image)
+                } else {
+                    self.reference.as_deref()
+                };
+                render_view(&view.snapshot, other, &display)
+            })
+            .collect();
+        self.textures.truncate(images.len());
+        for (i, image) in images.into_iter().enumerate() {
+            if let Some(texture) = self.textures.get_mut(i) {
+                texture.set(image, TextureOptions::NEAREST);
+            } else {
+                self.textures.push(ctx.load_texture(
+                    format!("view-{i}"),
+                    image,
+                    TextureOptions::NEAREST,
+                ));
+            }
+        }
+        self.shown = Some((frame, display));
+    }
+
+    pub fn textures(&self) -> &[TextureHandle] {
+        &self.textures
+    }
+
+    /// Records how long the UI took to build a frame.
+    pub fn record_frame_time(&mut self, seconds: f32) {
+        self.frame_times.push_back(seconds);
+        if self.frame_times.len() > FRAME_TIME_WINDOW {
+            self.frame_times.pop_front();
+        }
+    }
+
+    /// 95th percentile of recent UI frame times, in seconds.
+    pub fn frame_time_p95(&self) -> Option<f32> {
+        percentile(self.frame_times.iter().copied(), 0.95)
+    }
+
+    /// Median time from a setting change to the first image of the new settings.
+    pub fn restart_latency_median(&self) -> Option<f32> {
+        percentile(self.latencies.iter().map(Duration::as_secs_f32), 0.5)
+    }
+
+    /// Exports view `index` as a tone-mapped PNG with its settings in text chunks.
+    pub fn export_png(&mut self, index: usize) -> Option<PathBuf> {
+        let frame = self.live.latest();
+        let view = frame.views.get(index)?;
+        let config = *self.rendered_configs.get(index)?;
+        let display = Display {
+            view: super::settings::ViewMode::Image,
+            ..self.settings.display
+        };
+        let image = render_view(&view.snapshot, None, &display);
+        let path = export_path(
+            Path::new(&self.settings.export_dir),
+            &self.scene_name,
+            &config.label(),
+            view.stats.spp,
+            "png",
+        );
+        let text = self.png_text(&config, view.stats.spp);
+        self.report(write_color_image(&path, &image, &text))
+    }
+
+    /// Exports view `index`'s linear radiance as EXR.
+    pub fn export_exr(&mut self, index: usize) -> Option<PathBuf> {
+        let frame = self.live.latest();
+        let view = frame.views.get(index)?;
+        let config = *self.rendered_configs.get(index)?;
+        let path = export_path(
+            Path::new(&self.settings.export_dir),
+            &self.scene_name,
+            &config.label(),
+            view.stats.spp,
+            "exr",
+        );
+        self.report(write_exr(&path, &view.snapshot))
+    }
+
+    /// Asks for a capture of the whole window (written when it arrives).
+    pub fn export_window(&mut self) {
+        let spp = self.live.latest().views.first().map_or(0, |v| v.stats.spp);
+        let path = export_path(
+            Path::new(&self.settings.export_dir),
+            &self.scene_name,
+            &format!("window {}", self.settings.a.label()),
+            spp,
+            "png",
+        );
+        self.capture = Some(Capture::Window {
+            path,
+            quit_after: false,
+        });
+    }
+
+    /// Asks for a capture of the comparison sheet (A, B, difference, plot, settings).
+    pub fn export_sheet(&mut self) {
+        let spp = self.live.latest().views.first().map_or(0, |v| v.stats.spp);
+        let path = export_path(
+            Path::new(&self.settings.export_dir),
+            &self.scene_name,
+            &format!(
+                "sheet {} vs {}",
+                self.settings.a.label(),
+                self.settings.b.label()
+            ),
+            spp,
+            "png",
+        );
+        self.capture = Some(Capture::Sheet { path });
+    }
+
+    fn png_text(&self, config: &Config, spp: u32) -> Vec<(&'static str, String)> {
+        vec![
+            (
+                "Software",
+                format!("tracelab {}", env!("CARGO_PKG_VERSION")),
+            ),
+            ("tracelab:scene", self.settings.scene_path.clone()),
+            ("tracelab:spp", spp.to_string()),
+            ("tracelab:integrator", config.integrator.build().describe()),
+            ("tracelab:sampler", config.sampler.name().to_string()),
+            ("tracelab:seed", config.seed.to_string()),
+            (
+                "tracelab:display",
+                format!(
+                    "exposure {} tone map {:?}",
+                    self.settings.display.exposure, self.settings.display.tone_map
+                ),
+            ),
+        ]
+    }
+
+    fn report(&mut self, result: crate::Result<PathBuf>) -> Option<PathBuf> {
+        match result {
+            Ok(path) => {
+                self.toast(format!("saved {}", path.display()));
+                self.exports.push(path.clone());
+                Some(path)
+            }
+            Err(e) => {
+                self.errors.push(e.to_string());
+                None
+            }
+        }
+    }
+
+    /// Drives captures: requests one when due, writes it when it arrives.
+    pub fn handle_capture(&mut self, ctx: &egui::Context) {
+        let Some(capture) = self.capture.clone() else {
+            return;
+        };
+        self.sheet_mode = matches!(capture, Capture::Sheet { .. });
+        let arrived = self
+            .captured
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take();
+        if let Some(image) = arrived {
+            let (path, quit) = match capture {
+                Capture::Window { path, quit_after } => (path, quit_after),
+                Capture::Sheet { path } => (path, false),
+            };
+            let config = self.settings.a;
+            let spp = self.live.latest().views.first().map_or(0, |v| v.stats.spp);
+            let text = self.png_text(&config, spp);
+            let written = self.report(write_color_image(&path, &image, &text));
+            self.capture = None;
+            self.capture_requested = false;
+            self.sheet_mode = false;
+            if quit {
+                if written.is_none() {
+                    for e in &self.errors {
+                        eprintln!("error: {e}");
+                    }
+                }
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+            return;
+        }
+        if self.capture_requested {
+            ctx.request_repaint();
+            return;
+        }
+        // The automated screenshot waits for its sample count; exports go now.
+        let ready = match &capture {
+            Capture::Window {
+                quit_after: true, ..
+            } => {
+                let frame = self.live.latest();
+                frame.generation == self.live.generation()
+                    && !frame.views.is_empty()
+                    && frame
+                        .views
+                        .iter()
+                        .all(|v| v.done || v.stats.spp >= self.launch.after_spp)
+                    && self
+                        .shown
+                        .as_ref()
+                        .is_some_and(|(shown, _)| Arc::ptr_eq(shown, &frame))
+            }
+            _ => true,
+        };
+        if ready {
+            let slot = self.captured.clone();
+            ctx.request_screenshot(move |image| {
+                *slot.lock().unwrap_or_else(|e| e.into_inner()) = Some(image);
+            });
+            self.capture_requested = true;
+            ctx.request_repaint();
+        }
+    }
+
+    /// Moves the camera: orbit about the point in focus by `yaw`/`pitch`
+    /// radians and dolly towards it by the factor `dolly` (1 = no change).
+    pub fn orbit(&mut self, yaw: f32, pitch: f32, dolly: f32) {
+        let Some(camera) = self.current_camera() else {
+            return;
+        };
+        let pivot = camera.eye + camera.forward * camera.focus_distance;
+        let offset = camera.eye - pivot;
+        let up = glam::Vec3A::Y;
+        let rotation = glam::Quat::from_axis_angle(up.into(), -yaw)
+            * glam::Quat::from_axis_angle(camera.right.into(), -pitch);
+        let mut new_offset = glam::Vec3A::from(rotation * glam::Vec3::from(offset)) * dolly;
+        // Stay off the poles, where the up vector would flip.
+        let dir = new_offset.normalize();
+        if dir.dot(up).abs() > 0.98 {
+            new_offset = offset * dolly;
+        }
+        let distance = new_offset.length();
+        let fov = 2.0 * camera.tan_half_fov_y.atan().to_degrees();
+        self.camera = Some(Camera::look_at(
+            pivot + new_offset,
+            pivot,
+            up,
+            fov,
+            camera.width,
+            camera.height,
+            camera.aperture_radius,
+            distance,
+        ));
+    }
+
+    /// Back to the scene's own camera.
+    pub fn reset_camera(&mut self) {
+        self.camera = None;
+    }
+
+    /// The label of the configuration shown in view `index`.
+    pub fn view_label(&self, index: usize) -> String {
+        self.rendered_configs
+            .get(index)
+            .map(Config::label)
+            .unwrap_or_default()
+    }
+}
+
+impl ViewerApp {
+    pub fn shutdown(&mut self) {
+        self.live.stop();
+    }
+}
+
+fn percentile(values: impl Iterator<Item = f32>, q: f32) -> Option<f32> {
+    let mut v: Vec<f32> = values.collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f32::total_cmp);
+    let i = ((v.len() - 1) as f32 * q).round() as usize;
+    Some(v[i])
+}
+
+/// A relative scene path that does not exist here is looked up in the source
+/// tree, so `cargo run` works from any directory.
+fn resolve_scene_path(path: &str) -> String {
+    let p = Path::new(path);
+    if p.is_relative() && !p.exists() {
+        let in_tree = Path::new(env!("CARGO_MANIFEST_DIR")).join(p);
+        if in_tree.exists() {
+            return in_tree.to_string_lossy().into_owned();
+        }
+    }
+    path.to_string()
+}
+
+/// The `.toml` files in `scenes/` (relative to the working directory, or to
+/// the source tree when run from elsewhere).
+fn list_scene_files() -> Vec<String> {
+    let local = Path::new("scenes");
+    let dir = if local.is_dir() {
+        local.to_path_buf()
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
+    };
+    let mut files: Vec<String> = std::fs::read_dir(&dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .map(|p| p.to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    files
+}

@@ -1,0 +1,314 @@
+//! The side panel: scene, estimator and sampler settings, comparison,
+//! display and export controls. Widgets only change `app.settings` (render
+//! settings restart the renderer at the next `sync`) or call app actions.
+
+use super::app::ViewerApp;
+use super::settings::{CompareLayout, Config, ToneMap, ViewMode};
+use crate::integrator::{GlassShadows, IntegratorKind, MisHeuristic, Strategy};
+use crate::live::Lock;
+use crate::sampling::SamplerKind;
+use eframe::egui::{self, RichText};
+
+/// Which configuration the estimator controls edit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Editing {
+    #[default]
+    A,
+    B,
+}
+
+pub fn side_panel(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing) {
+    egui::ScrollArea::vertical().show(ui, |ui| {
+        scene_section(ui, app);
+        ui.separator();
+        compare_section(ui, app, editing);
+        ui.separator();
+        let config = if app.settings.compare && *editing == Editing::B {
+            &mut app.settings.b
+        } else {
+            &mut app.settings.a
+        };
+        estimator_section(ui, config);
+        ui.separator();
+        samples_section(ui, app);
+        ui.separator();
+        display_section(ui, app);
+        ui.separator();
+        reference_section(ui, app);
+        ui.separator();
+        export_section(ui, app);
+    });
+}
+
+fn scene_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
+    ui.heading("Scene");
+    let mut chosen = None;
+    egui::ComboBox::from_label("Scene file")
+        .selected_text(short_name(&app.settings.scene_path))
+        .show_ui(ui, |ui| {
+            for file in &app.scene_files {
+                if ui
+                    .selectable_label(*file == app.settings.scene_path, short_name(file))
+                    .clicked()
+                {
+                    chosen = Some(file.clone());
+                }
+            }
+        });
+    ui.horizontal(|ui| {
+        ui.add(
+            egui::TextEdit::singleline(&mut app.scene_field)
+                .hint_text("path/to/scene.toml")
+                .desired_width(180.0),
+        );
+        if ui.button("Load").clicked() {
+            chosen = Some(app.scene_field.clone());
+        }
+    });
+    if let Some(path) = chosen {
+        app.load_scene(&path);
+    }
+    ui.horizontal(|ui| {
+        if ui.button("Reset camera").clicked() {
+            app.reset_camera();
+        }
+        if ui.button("Restart").clicked() {
+            app.force_restart();
+        }
+    });
+}
+
+fn short_name(path: &str) -> String {
+    std::path::Path::new(path)
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.to_string())
+}
+
+fn compare_section(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing) {
+    let was = app.settings.compare;
+    ui.checkbox(&mut app.settings.compare, "Side-by-side comparison");
+    if app.settings.compare && !was {
+        // B starts as a copy of A with the other sampler: one change to study.
+        app.settings.b = Config {
+            sampler: match app.settings.a.sampler {
+                SamplerKind::Independent => SamplerKind::Stratified,
+                SamplerKind::Stratified => SamplerKind::Independent,
+            },
+            ..app.settings.a
+        };
+    }
+    if !app.settings.compare {
+        *editing = Editing::A;
+        return;
+    }
+    ui.horizontal(|ui| {
+        ui.label("Lock");
+        ui.radio_value(&mut app.settings.lock, Lock::EqualSpp, "Equal spp");
+        ui.radio_value(&mut app.settings.lock, Lock::EqualTime, "Equal time");
+        ui.radio_value(&mut app.settings.lock, Lock::EqualRays, "Equal rays");
+    });
+    ui.horizontal(|ui| {
+        ui.label("Layout");
+        let layout = &mut app.settings.display.layout;
+        ui.radio_value(layout, CompareLayout::Split, "Split");
+        ui.radio_value(layout, CompareLayout::TwoPanes, "Two panes");
+    });
+    ui.horizontal(|ui| {
+        ui.label("Edit");
+        ui.selectable_value(editing, Editing::A, "A");
+        ui.selectable_value(editing, Editing::B, "B");
+    });
+}
+
+fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
+    ui.heading("Estimator");
+    let options = &mut config.integrator;
+    for kind in IntegratorKind::ALL {
+        ui.radio_value(&mut options.kind, kind, kind.label());
+    }
+    let depth_label = match options.kind {
+        IntegratorKind::Whitted => "Max specular depth",
+        _ => "Max depth (bounces)",
+    };
+    ui.add(egui::Slider::new(&mut options.max_depth, 0..=32).text(depth_label));
+    match options.kind {
+        IntegratorKind::Whitted => {
+            ui.add(egui::Slider::new(&mut options.ambient, 0.0..=0.5).text("Ambient"));
+            ui.horizontal(|ui| {
+                ui.label("Glass shadows");
+                ui.radio_value(&mut options.glass_shadows, GlassShadows::Opaque, "Opaque");
+                ui.radio_value(&mut options.glass_shadows, GlassShadows::Tinted, "Tinted");
+            });
+        }
+        IntegratorKind::Mcrt => {
+            ui.add(egui::Slider::new(&mut options.shadow_rays, 0..=16).text("Shadow rays N"));
+            ui.add(egui::Slider::new(&mut options.glossy_rays, 0..=16).text("Glossy rays M"));
+            if options.shadow_rays + options.glossy_rays == 0 {
+                options.shadow_rays = 1;
+            }
+            mis_heuristic(ui, &mut options.mis);
+            let rays = u64::from(options.glossy_rays).pow(options.max_depth.min(16));
+            if rays > 100_000 {
+                ui.label(
+                    RichText::new(format!("M^D = {rays} rays per sample: slow"))
+                        .color(egui::Color32::YELLOW),
+                );
+            }
+        }
+        IntegratorKind::Path => {
+            ui.horizontal(|ui| {
+                ui.label("Strategy");
+                ui.radio_value(&mut options.strategy, Strategy::Bsdf, "BSDF");
+                ui.radio_value(&mut options.strategy, Strategy::Light, "Light");
+                ui.radio_value(&mut options.strategy, Strategy::Mis, "MIS");
+            });
+            if options.strategy == Strategy::Mis {
+                mis_heuristic(ui, &mut options.mis);
+            }
+            roulette(ui, &mut options.russian_roulette, &mut options.rr_depth);
+        }
+        IntegratorKind::Light => roulette(ui, &mut options.russian_roulette, &mut options.rr_depth),
+    }
+    ui.horizontal(|ui| {
+        ui.label("Sampler");
+        ui.radio_value(&mut config.sampler, SamplerKind::Independent, "Independent");
+        ui.radio_value(&mut config.sampler, SamplerKind::Stratified, "Stratified");
+    });
+    let mut stratified = config.sampler == SamplerKind::Stratified;
+    if ui.checkbox(&mut stratified, "Stratify samples").changed() {
+        config.sampler = if stratified {
+            SamplerKind::Stratified
+        } else {
+            SamplerKind::Independent
+        };
+    }
+    ui.horizontal(|ui| {
+        ui.label("Seed");
+        ui.add(egui::DragValue::new(&mut config.seed));
+    });
+}
+
+fn mis_heuristic(ui: &mut egui::Ui, mis: &mut MisHeuristic) {
+    if *mis == MisHeuristic::None {
+        *mis = MisHeuristic::Power;
+    }
+    ui.horizontal(|ui| {
+        ui.label("MIS");
+        ui.radio_value(mis, MisHeuristic::Balance, "Balance");
+        ui.radio_value(mis, MisHeuristic::Power, "Power");
+    });
+}
+
+fn roulette(ui: &mut egui::Ui, on: &mut bool, depth: &mut u32) {
+    ui.horizontal(|ui| {
+        ui.checkbox(on, "Russian roulette");
+        if *on {
+            ui.add(egui::DragValue::new(depth).range(0..=64).prefix("from "));
+        }
+    });
+}
+
+fn samples_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
+    ui.heading("Samples");
+    ui.horizontal(|ui| {
+        ui.label("Target spp");
+        ui.add_enabled(
+            !app.settings.unlimited,
+            egui::DragValue::new(&mut app.settings.target_spp)
+                .range(1..=1_000_000)
+                .speed(4),
+        );
+        ui.checkbox(&mut app.settings.unlimited, "Unlimited");
+    });
+    let mut scene_size = app.settings.resolution.is_none();
+    ui.checkbox(&mut scene_size, "Scene resolution");
+    if scene_size {
+        app.settings.resolution = None;
+    } else {
+        let (mut w, mut h) = app.settings.resolution.unwrap_or_else(|| {
+            app.scene()
+                .map_or((256, 256), |s| (s.camera.width, s.camera.height))
+        });
+        ui.horizontal(|ui| {
+            ui.add(egui::DragValue::new(&mut w).range(16..=4096).prefix("w "));
+            ui.add(egui::DragValue::new(&mut h).range(16..=4096).prefix("h "));
+        });
+        app.settings.resolution = Some((w, h));
+    }
+}
+
+fn display_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
+    ui.heading("Display");
+    let display = &mut app.settings.display;
+    ui.add(egui::Slider::new(&mut display.exposure, -8.0..=8.0).text("Exposure (stops)"));
+    egui::ComboBox::from_label("Tone map")
+        .selected_text(format!("{:?}", display.tone_map))
+        .show_ui(ui, |ui| {
+            for t in ToneMap::ALL {
+                ui.selectable_value(&mut display.tone_map, t, format!("{t:?}"));
+            }
+        });
+    ui.horizontal_wrapped(|ui| {
+        for mode in ViewMode::ALL {
+            ui.selectable_value(&mut display.view, mode, mode.label());
+        }
+    });
+    if display.view == ViewMode::Fireflies {
+        ui.add(
+            egui::Slider::new(&mut display.firefly_threshold, 0.05..=2.0)
+                .text("Firefly rel. error"),
+        );
+    }
+}
+
+fn reference_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
+    ui.heading("Reference");
+    let mut path = app.settings.reference_path.clone();
+    ui.horizontal(|ui| {
+        ui.add(
+            egui::TextEdit::singleline(&mut path)
+                .hint_text("reference.exr")
+                .desired_width(180.0),
+        );
+        if ui.button("Load reference").clicked() {
+            app.load_reference(&path);
+        } else if ui.button("Clear").clicked() {
+            app.load_reference("");
+        } else {
+            app.settings.reference_path = path;
+        }
+    });
+}
+
+fn export_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
+    ui.heading("Export");
+    ui.horizontal(|ui| {
+        ui.label("Folder");
+        ui.text_edit_singleline(&mut app.settings.export_dir);
+    });
+    ui.horizontal_wrapped(|ui| {
+        if ui.button("Export PNG").clicked() {
+            for i in 0..app.configs().len() {
+                app.export_png(i);
+            }
+        }
+        if ui.button("Export EXR").clicked() {
+            for i in 0..app.configs().len() {
+                app.export_exr(i);
+            }
+        }
+        if ui.button("Save window").clicked() {
+            app.export_window();
+        }
+        if ui
+            .add_enabled(
+                app.settings.compare,
+                egui::Button::new("Save comparison sheet"),
+            )
+            .clicked()
+        {
+            app.export_sheet();
+        }
+    });
+}

@@ -1,0 +1,197 @@
+//! Everything the user sets in the window, as plain data that eframe
+//! persists between runs. Render settings (which restart accumulation) and
+//! display settings (which never do) are kept apart.
+
+use crate::integrator::IntegratorOptions;
+use crate::live::Lock;
+use crate::sampling::SamplerKind;
+use serde::{Deserialize, Serialize};
+
+/// One configuration of the estimator (A, or B when comparing).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Config {
+    pub integrator: IntegratorOptions,
+    pub sampler: SamplerKind,
+    pub seed: u64,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config {
+            integrator: IntegratorOptions::default(),
+            sampler: SamplerKind::Independent,
+            seed: 0,
+        }
+    }
+}
+
+impl Config {
+    /// A short name for labels, legends and file names.
+    pub fn label(&self) -> String {
+        let i = &self.integrator;
+        let estimator = match i.kind {
+            crate::integrator::IntegratorKind::Whitted => format!("whitted d{}", i.max_depth),
+            crate::integrator::IntegratorKind::Mcrt => format!(
+                "mcrt d{} n{} m{}",
+                i.max_depth, i.shadow_rays, i.glossy_rays
+            ),
+            crate::integrator::IntegratorKind::Path => {
+                format!("path d{} {:?}", i.max_depth, i.strategy).to_lowercase()
+            }
+            crate::integrator::IntegratorKind::Light => format!("light d{}", i.max_depth),
+        };
+        format!("{estimator} {}", self.sampler.name())
+    }
+}
+
+/// Side-by-side layouts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum CompareLayout {
+    /// One image, A left of a draggable divider and B right of it.
+    #[default]
+    Split,
+    /// Two images next to each other.
+    TwoPanes,
+}
+
+/// What the image area shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum ViewMode {
+    #[default]
+    Image,
+    /// A - B (or the image minus the reference when not comparing).
+    Difference,
+    /// Per-pixel relative standard error in false colour.
+    StandardError,
+    /// The image with non-finite samples and fireflies marked.
+    Fireflies,
+}
+
+impl ViewMode {
+    pub const ALL: [ViewMode; 4] = [
+        ViewMode::Image,
+        ViewMode::Difference,
+        ViewMode::StandardError,
+        ViewMode::Fireflies,
+    ];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            ViewMode::Image => "Image",
+            ViewMode::Difference => "Difference",
+            ViewMode::StandardError => "Std. error",
+            ViewMode::Fireflies => "Fireflies",
+        }
+    }
+}
+
+/// Display mapping from radiance to screen colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum ToneMap {
+    /// Clip at 1, as the reference renders are shown.
+    #[default]
+    Clamp,
+    /// x / (1 + x).
+    Reinhard,
+    /// The ACES filmic curve fit of Narkowicz (2015).
+    Aces,
+}
+
+impl ToneMap {
+    pub const ALL: [ToneMap; 3] = [ToneMap::Clamp, ToneMap::Reinhard, ToneMap::Aces];
+}
+
+/// Settings that change only how the film is shown.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Display {
+    /// Stops: radiance is multiplied by 2^exposure.
+    pub exposure: f32,
+    pub tone_map: ToneMap,
+    pub view: ViewMode,
+    pub layout: CompareLayout,
+    /// Divider position of the split view, as a fraction of the image width.
+    pub split: f32,
+    /// Relative standard error above which a pixel counts as a firefly.
+    pub firefly_threshold: f32,
+    /// Plot error against render time instead of samples per pixel.
+    pub plot_time: bool,
+}
+
+impl Default for Display {
+    fn default() -> Self {
+        Display {
+            exposure: 0.0,
+            tone_map: ToneMap::Clamp,
+            view: ViewMode::Image,
+            layout: CompareLayout::Split,
+            split: 0.5,
+            firefly_threshold: 0.5,
+            plot_time: false,
+        }
+    }
+}
+
+/// All persisted settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Settings {
+    pub scene_path: String,
+    pub a: Config,
+    pub b: Config,
+    pub compare: bool,
+    pub lock: Lock,
+    /// Stop at this many samples per pixel, unless `unlimited`.
+    pub target_spp: u32,
+    pub unlimited: bool,
+    /// Image size; `None` keeps the scene's.
+    pub resolution: Option<(u32, u32)>,
+    pub reference_path: String,
+    pub export_dir: String,
+    pub display: Display,
+    pub show_help: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            scene_path: "scenes/cornell_box.toml".into(),
+            a: Config::default(),
+            b: Config {
+                sampler: SamplerKind::Stratified,
+                ..Config::default()
+            },
+            compare: false,
+            lock: Lock::EqualSpp,
+            target_spp: 1024,
+            unlimited: false,
+            resolution: None,
+            reference_path: String::new(),
+            export_dir: "exports".into(),
+            display: Display::default(),
+            show_help: false,
+        }
+    }
+}
+
+impl Settings {
+    /// The part of the settings that, when it changes, restarts rendering.
+    pub fn render_key(
+        &self,
+    ) -> (
+        Config,
+        Option<Config>,
+        Lock,
+        Option<u32>,
+        Option<(u32, u32)>,
+    ) {
+        (
+            self.a,
+            self.compare.then_some(self.b),
+            self.lock,
+            (!self.unlimited).then_some(self.target_spp),
+            self.resolution,
+        )
+    }
+}

@@ -1,0 +1,181 @@
+//! Live statistics and the convergence plot (log-log error against samples
+//! per pixel or time, with 1/sqrt(N) and 1/N guides, one curve per
+//! configuration, past configurations kept).
+
+use super::app::ViewerApp;
+use crate::live::{ErrorPoint, LiveView};
+use eframe::egui;
+use egui_plot::{Legend, Line, LineStyle, Plot, PlotPoints};
+
+pub fn stats_panel(ui: &mut egui::Ui, app: &mut ViewerApp) {
+    let frame = app.frame();
+    ui.horizontal_wrapped(|ui| {
+        for (i, view) in frame.views.iter().enumerate() {
+            let name = if frame.views.len() == 2 {
+                if i == 0 { "A" } else { "B" }
+            } else {
+                ""
+            };
+            ui.label(egui::RichText::new(view_summary(name, view, app)).monospace());
+            ui.end_row();
+        }
+    });
+    ui.horizontal_wrapped(|ui| {
+        let mut parts = Vec::new();
+        if let Some(p95) = app.frame_time_p95() {
+            parts.push(format!("UI frame p95 {:.1} ms", p95 * 1e3));
+        }
+        if let Some(latency) = app.restart_latency_median() {
+            parts.push(format!("setting -> image {:.0} ms", latency * 1e3));
+        }
+        if let Some(rss) = resident_memory_mib() {
+            parts.push(format!("memory {rss:.0} MiB"));
+        }
+        parts.push(if app.live().is_rendering() {
+            "rendering".into()
+        } else {
+            "done".into()
+        });
+        ui.label(egui::RichText::new(parts.join(" | ")).weak());
+    });
+}
+
+fn view_summary(name: &str, view: &LiveView, app: &ViewerApp) -> String {
+    let s = &view.stats;
+    let seconds = s.render_time.as_secs_f64().max(1e-9);
+    let pixels = view.snapshot.samples.len().max(1) as f64;
+    let last = view.history.last();
+    let mut text = format!(
+        "{name} {} spp | {:.2} s | {:.2} M samples/s | {:.1} M rays/s | rays/px {:.0} (cam {:.0}, shadow {:.0}, bounce {:.0}) | noise {:.2}%",
+        s.spp,
+        s.render_time.as_secs_f64(),
+        s.samples as f64 / seconds * 1e-6,
+        s.rays.total() as f64 / seconds * 1e-6,
+        s.rays.total() as f64 / pixels,
+        s.rays.camera as f64 / pixels,
+        s.rays.shadow as f64 / pixels,
+        s.rays.bounce as f64 / pixels,
+        last.map_or(f64::NAN, |p| p.noise * 100.0),
+    );
+    if let Some(rmse) = last.and_then(|p| p.rmse) {
+        text += &format!(" | RMSE {rmse:.5}");
+    } else if app.reference().is_some() {
+        text += " | RMSE n/a (size differs)";
+    }
+    if s.non_finite > 0 {
+        text += &format!(" | non-finite {}", s.non_finite);
+    }
+    text
+}
+
+/// Resident set size of this process (Linux), for the long-session check.
+pub fn resident_memory_mib() -> Option<f64> {
+    let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
+    let pages: f64 = statm.split_whitespace().nth(1)?.parse().ok()?;
+    Some(pages * 4096.0 / (1024.0 * 1024.0))
+}
+
+/// The metric plotted: RMSE when a reference is loaded, else the film's noise.
+fn metric(p: &ErrorPoint, use_rmse: bool) -> Option<f64> {
+    let v = if use_rmse { p.rmse? } else { p.noise };
+    (v.is_finite() && v > 0.0).then_some(v)
+}
+
+fn abscissa(p: &ErrorPoint, time: bool) -> Option<f64> {
+    let x = if time { p.seconds } else { f64::from(p.spp) };
+    (x > 0.0).then_some(x)
+}
+
+fn log_points(points: &[ErrorPoint], time: bool, use_rmse: bool) -> Vec<[f64; 2]> {
+    points
+        .iter()
+        .filter_map(|p| Some([abscissa(p, time)?.log10(), metric(p, use_rmse)?.log10()]))
+        .collect()
+}
+
+pub fn convergence_plot(ui: &mut egui::Ui, app: &mut ViewerApp, height: f32) {
+    let frame = app.frame();
+    let use_rmse = app.reference().is_some();
+    ui.horizontal(|ui| {
+        ui.label(if use_rmse {
+            "RMSE vs reference"
+        } else {
+            "Noise (mean relative std. error)"
+        });
+        ui.radio_value(&mut app.settings.display.plot_time, false, "vs spp");
+        ui.radio_value(&mut app.settings.display.plot_time, true, "vs time");
+        if ui.button("Clear old curves").clicked() {
+            app.curves.clear();
+        }
+    });
+    let time = app.settings.display.plot_time;
+    let current: Vec<(String, Vec<[f64; 2]>)> = frame
+        .views
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let prefix = if frame.views.len() == 2 {
+                if i == 0 { "A: " } else { "B: " }
+            } else {
+                ""
+            };
+            (
+                format!("{prefix}{}", app.view_label(i)),
+                log_points(&v.history, time, use_rmse),
+            )
+        })
+        .collect();
+    let past: Vec<(String, Vec<[f64; 2]>)> = app
+        .curves
+        .iter()
+        .map(|c| (c.label.clone(), log_points(&c.points, time, use_rmse)))
+        .collect();
+    let anchor = current.first().and_then(|(_, pts)| pts.first().copied());
+    let x_end = current
+        .iter()
+        .chain(&past)
+        .flat_map(|(_, p)| p.iter().map(|q| q[0]))
+        .fold(f64::NAN, f64::max);
+    let ten_to =
+        |mark: egui_plot::GridMark, _: &std::ops::RangeInclusive<f64>| format_power(mark.value);
+    Plot::new("convergence")
+        .height(height)
+        .legend(Legend::default())
+        .x_axis_label(if time { "seconds" } else { "spp" })
+        .x_axis_formatter(ten_to)
+        .y_axis_formatter(ten_to)
+        .show(ui, |plot| {
+            for (label, points) in past {
+                plot.line(
+                    Line::new(label, PlotPoints::from(points)).style(LineStyle::dotted_dense()),
+                );
+            }
+            for (label, points) in current {
+                plot.line(Line::new(label, PlotPoints::from(points)).width(2.0));
+            }
+            if let Some([x0, y0]) = anchor
+                && x_end.is_finite()
+                && x_end > x0
+            {
+                for (label, slope) in [("1/sqrt(N)", -0.5), ("1/N", -1.0)] {
+                    let guide = vec![[x0, y0], [x_end, y0 + slope * (x_end - x0)]];
+                    plot.line(
+                        Line::new(label, PlotPoints::from(guide))
+                            .style(LineStyle::dashed_loose())
+                            .color(egui::Color32::GRAY),
+                    );
+                }
+            }
+        });
+}
+
+/// Axis label of a log10 value: 10^x as a plain number where short.
+fn format_power(x: f64) -> String {
+    let v = 10f64.powf(x);
+    if (-3.0..=5.0).contains(&x) {
+        let s = format!("{v:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("1e{x:.1}")
+    }
+}
