@@ -56,6 +56,8 @@ pub struct ErrorPoint {
 /// The latest state of one configuration.
 #[derive(Clone, Debug)]
 pub struct LiveView {
+    /// The settings this view renders with.
+    pub settings: RenderSettings,
     pub snapshot: Arc<FilmSnapshot>,
     pub stats: RenderStats,
     pub history: Vec<ErrorPoint>,
@@ -241,6 +243,7 @@ fn render_loop(shared: &Shared, commands: &Receiver<Command>, pool: &Arc<rayon::
                 let views = sessions
                     .iter()
                     .map(|s| LiveView {
+                        settings: s.settings().clone(),
                         snapshot: Arc::new(s.snapshot()),
                         stats: s.stats(),
                         history: Vec::new(),

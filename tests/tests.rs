@@ -21,3 +21,6 @@ mod determinism;
 mod scenes;
 // The command line: renders, comparisons and every kind of bad input.
 mod cli;
+// The viewer driven through egui_kittest (needs the default `viewer` feature).
+#[cfg(feature = "viewer")]
+mod viewer;

@@ -44,8 +44,18 @@ pub fn image_area(ui: &mut egui::Ui, app: &mut ViewerApp) {
     } else {
         vec![rect]
     };
+    // Fitting enlarges by whole factors only, so that every image pixel
+    // covers the same number of screen pixels (no uneven nearest-neighbour rows).
     let fit = (panes[0].width() / image_size.x).min(panes[0].height() / image_size.y);
+    let fit = if fit >= 1.0 { fit.floor() } else { fit };
     let zoom = app.view.zoom.unwrap_or(fit).max(0.01);
+    let pixels_per_point = ui.ctx().pixels_per_point();
+    let snap = |p: Pos2| {
+        pos2(
+            (p.x * pixels_per_point).round() / pixels_per_point,
+            (p.y * pixels_per_point).round() / pixels_per_point,
+        )
+    };
 
     // Zoom about the cursor; shift + scroll dollies the camera instead.
     if response.hovered() {
@@ -82,7 +92,10 @@ pub fn image_area(ui: &mut egui::Ui, app: &mut ViewerApp) {
     let painter = ui.painter_at(rect);
     let image_rects: Vec<Rect> = panes
         .iter()
-        .map(|pane| Rect::from_center_size(pane.center() + app.view.pan, image_size * zoom))
+        .map(|pane| {
+            let r = Rect::from_center_size(pane.center() + app.view.pan, image_size * zoom);
+            Rect::from_min_size(snap(r.min), r.size())
+        })
         .collect();
     if two_panes {
         for (i, (pane, image_rect)) in panes.iter().zip(&image_rects).enumerate() {

@@ -136,13 +136,13 @@ fn layout(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing) {
         .resizable(true)
         .default_size(310.0)
         .show(ui, |ui| panel::side_panel(ui, app, editing));
+    // A fixed height: the plot fills it, and the image above keeps its place.
     egui::Panel::bottom("statistics")
-        .resizable(true)
-        .default_size(280.0)
+        .resizable(false)
+        .exact_size(270.0)
         .show(ui, |ui| {
             stats::stats_panel(ui, app);
-            let height = ui.available_height().max(80.0);
-            stats::convergence_plot(ui, app, height - 24.0);
+            stats::convergence_plot(ui, app);
         });
     egui::CentralPanel::default().show(ui, |ui| image_view::image_area(ui, app));
 }
@@ -184,14 +184,13 @@ fn sheet(ui: &mut egui::Ui, app: &mut ViewerApp) {
                 }
             });
         }
-        stats::stats_panel(ui, app);
-        let height = (ui.available_height() - 40.0).max(120.0);
-        stats::convergence_plot(ui, app, height);
         ui.label(
             RichText::new(format!("A: {:?}\nB: {:?}", app.settings.a, app.settings.b))
                 .monospace()
                 .small(),
         );
+        stats::stats_panel(ui, app);
+        stats::convergence_plot(ui, app);
     });
 }
 

@@ -184,8 +184,9 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
         };
     }
     ui.horizontal(|ui| {
-        ui.label("Seed");
-        ui.add(egui::DragValue::new(&mut config.seed));
+        let label = ui.label("Seed");
+        ui.add(egui::DragValue::new(&mut config.seed))
+            .labelled_by(label.id);
     });
 }
 
@@ -212,13 +213,14 @@ fn roulette(ui: &mut egui::Ui, on: &mut bool, depth: &mut u32) {
 fn samples_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
     ui.heading("Samples");
     ui.horizontal(|ui| {
-        ui.label("Target spp");
+        let label = ui.label("Target spp");
         ui.add_enabled(
             !app.settings.unlimited,
             egui::DragValue::new(&mut app.settings.target_spp)
                 .range(1..=1_000_000)
                 .speed(4),
-        );
+        )
+        .labelled_by(label.id);
         ui.checkbox(&mut app.settings.unlimited, "Unlimited");
     });
     let mut scene_size = app.settings.resolution.is_none();
@@ -284,8 +286,9 @@ fn reference_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
 fn export_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
     ui.heading("Export");
     ui.horizontal(|ui| {
-        ui.label("Folder");
-        ui.text_edit_singleline(&mut app.settings.export_dir);
+        let label = ui.label("Export folder");
+        ui.text_edit_singleline(&mut app.settings.export_dir)
+            .labelled_by(label.id);
     });
     ui.horizontal_wrapped(|ui| {
         if ui.button("Export PNG").clicked() {

@@ -9,18 +9,20 @@ use egui_plot::{Legend, Line, LineStyle, Plot, PlotPoints};
 
 pub fn stats_panel(ui: &mut egui::Ui, app: &mut ViewerApp) {
     let frame = app.frame();
-    ui.horizontal_wrapped(|ui| {
-        for (i, view) in frame.views.iter().enumerate() {
-            let name = if frame.views.len() == 2 {
-                if i == 0 { "A" } else { "B" }
-            } else {
-                ""
-            };
-            ui.label(egui::RichText::new(view_summary(name, view, app)).monospace());
-            ui.end_row();
-        }
-    });
-    ui.horizontal_wrapped(|ui| {
+    // One line per item, truncated rather than wrapped, so that the panel's
+    // layout does not jump as the numbers change.
+    for (i, view) in frame.views.iter().enumerate() {
+        let name = if frame.views.len() == 2 {
+            if i == 0 { "A" } else { "B" }
+        } else {
+            ""
+        };
+        ui.add(
+            egui::Label::new(egui::RichText::new(view_summary(name, view, app)).monospace())
+                .truncate(),
+        );
+    }
+    {
         let mut parts = Vec::new();
         if let Some(p95) = app.frame_time_p95() {
             parts.push(format!("UI frame p95 {:.1} ms", p95 * 1e3));
@@ -36,8 +38,8 @@ pub fn stats_panel(ui: &mut egui::Ui, app: &mut ViewerApp) {
         } else {
             "done".into()
         });
-        ui.label(egui::RichText::new(parts.join(" | ")).weak());
-    });
+        ui.add(egui::Label::new(egui::RichText::new(parts.join(" | ")).weak()).truncate());
+    }
 }
 
 fn view_summary(name: &str, view: &LiveView, app: &ViewerApp) -> String {
@@ -93,7 +95,9 @@ fn log_points(points: &[ErrorPoint], time: bool, use_rmse: bool) -> Vec<[f64; 2]
         .collect()
 }
 
-pub fn convergence_plot(ui: &mut egui::Ui, app: &mut ViewerApp, height: f32) {
+/// The plot fills the height left in `ui` (never more, so that a panel
+/// holding it does not grow frame after frame).
+pub fn convergence_plot(ui: &mut egui::Ui, app: &mut ViewerApp) {
     let frame = app.frame();
     let use_rmse = app.reference().is_some();
     ui.horizontal(|ui| {
@@ -108,6 +112,7 @@ pub fn convergence_plot(ui: &mut egui::Ui, app: &mut ViewerApp, height: f32) {
             app.curves.clear();
         }
     });
+    let height = (ui.available_height() - 6.0).max(60.0);
     let time = app.settings.display.plot_time;
     let current: Vec<(String, Vec<[f64; 2]>)> = frame
         .views

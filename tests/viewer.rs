@@ -1,0 +1,189 @@
+//! The real viewer driven through egui_kittest: widgets are found by their
+//! accessibility labels and clicked; the tests then check the app state, the
+//! renderer behind it (what the render thread actually renders), and the
+//! files an export writes. The snapshot test renders the window headless
+//! through wgpu (llvmpipe without a GPU).
+
+use crate::common::{repo_path, temp_dir};
+use eframe::egui::{self, Vec2, pos2};
+use egui_kittest::kittest::Queryable;
+use egui_kittest::{Harness, SnapshotOptions};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+use tracelab::integrator::IntegratorKind;
+use tracelab::sampling::SamplerKind;
+use tracelab::viewer::{Launch, Window};
+
+const SIZE: Vec2 = Vec2::new(1280.0, 820.0);
+
+fn launch(export_dir: PathBuf, target_spp: u32) -> Launch {
+    Launch {
+        scene: Some(repo_path("scenes/cornell_box.toml")),
+        target_spp: Some(target_spp),
+        threads: 2,
+        fresh: true,
+        export_dir: Some(export_dir),
+        ..Default::default()
+    }
+}
+
+/// Steps the UI until `done` holds for the window (the renderer runs on its
+/// own threads meanwhile).
+fn step_until(harness: &mut Harness<'_, Window>, what: &str, done: impl Fn(&Window) -> bool) {
+    let start = Instant::now();
+    loop {
+        harness.step();
+        if done(harness.state()) {
+            return;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "timed out waiting for {what}"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+/// The renderer shows the current settings and has finished them.
+fn finished(w: &Window) -> bool {
+    let frame = w.app.frame();
+    frame.generation == w.app.live().generation()
+        && !frame.views.is_empty()
+        && frame.views.iter().all(|v| v.done)
+}
+
+#[test]
+fn controls_drive_the_renderer_and_export_writes_files() {
+    let dir = temp_dir("viewer-export");
+    let mut harness = Harness::builder()
+        .with_size(SIZE)
+        .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 4)));
+    step_until(&mut harness, "the first render", finished);
+    assert_eq!(harness.state().app.frame().views[0].stats.spp, 4);
+
+    // Switch the estimator.
+    harness.get_by_label("Light tracing").click();
+    step_until(&mut harness, "light tracing", |w| {
+        finished(w) && w.app.frame().views[0].settings.integrator.name() == "light"
+    });
+    assert_eq!(
+        harness.state().app.settings.a.integrator.kind,
+        IntegratorKind::Light
+    );
+
+    // Change the sample target.
+    harness.get_by_label("Target spp").set_value_accesskit(8.0);
+    step_until(&mut harness, "8 spp", |w| {
+        finished(w) && w.app.frame().views[0].stats.spp == 8
+    });
+    assert_eq!(harness.state().app.settings.target_spp, 8);
+
+    // Toggle stratification.
+    harness.get_by_label("Stratify samples").click();
+    step_until(&mut harness, "the stratified sampler", |w| {
+        finished(w) && w.app.frame().views[0].settings.sampler == SamplerKind::Stratified
+    });
+
+    // Start a side-by-side comparison: B is A with the other sampler.
+    harness.get_by_label("Side-by-side comparison").click();
+    step_until(&mut harness, "two views", |w| {
+        finished(w) && w.app.frame().views.len() == 2
+    });
+    let frame = harness.state().app.frame();
+    assert_eq!(frame.views[0].settings.sampler, SamplerKind::Stratified);
+    assert_eq!(frame.views[1].settings.sampler, SamplerKind::Independent);
+    assert!(frame.views.iter().all(|v| v.stats.spp == 8));
+
+    // Export: one PNG and one EXR per view, named by settings and spp.
+    harness.get_by_label("Export PNG").click();
+    harness.step();
+    harness.get_by_label("Export EXR").click();
+    harness.step();
+    let exports = harness.state().app.exports.clone();
+    assert_eq!(exports.len(), 4, "{exports:?}");
+    for path in &exports {
+        assert!(path.starts_with(&dir), "{}", path.display());
+        let name = path.file_name().unwrap().to_string_lossy();
+        assert!(name.starts_with("cornell-box_light-d8"), "{name}");
+        assert!(name.contains("_8spp"), "{name}");
+    }
+    let png = image::open(&exports[0]).unwrap();
+    assert_eq!((png.width(), png.height()), (256, 256));
+    let text = tracelab::viewer::export::read_png_text(&exports[0]).unwrap();
+    assert!(
+        text.iter().any(|(k, v)| k == "tracelab:spp" && v == "8"),
+        "{text:?}"
+    );
+    assert!(
+        text.iter()
+            .any(|(k, v)| k == "tracelab:sampler" && v == "stratified")
+    );
+    let exr = tracelab::image::Image::read(&exports[2]).unwrap();
+    assert_eq!(exr, frame.views[0].snapshot.image);
+
+    // Exporting again never overwrites: new names.
+    harness.get_by_label("Export PNG").click();
+    harness.step();
+    let again = &harness.state().app.exports[4];
+    assert!(
+        again.to_string_lossy().ends_with("-2.png"),
+        "{}",
+        again.display()
+    );
+    harness.state_mut().app.shutdown();
+}
+
+#[test]
+fn a_bad_scene_shows_an_error_and_keeps_the_last_good_one() {
+    let dir = temp_dir("viewer-bad-scene");
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "[camera]\neye = [0, 0]\n").unwrap();
+    let mut harness = Harness::builder()
+        .with_size(SIZE)
+        .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 2)));
+    step_until(&mut harness, "the first render", finished);
+    let good = harness.state().app.scene().unwrap().clone();
+
+    harness.state_mut().app.scene_field = bad.to_string_lossy().into_owned();
+    harness.get_by_label("Load").click();
+    harness.step();
+    harness.step();
+    let app = &harness.state().app;
+    assert_eq!(app.errors.len(), 1);
+    assert!(app.errors[0].contains("bad.toml:2"), "{}", app.errors[0]);
+    assert!(std::sync::Arc::ptr_eq(app.scene().unwrap(), &good));
+    // The error is on screen, and can be dismissed.
+    harness.get_by_label_contains("bad.toml:2");
+    harness.get_by_label("Dismiss").click();
+    harness.step();
+    assert!(harness.state().app.errors.is_empty());
+    harness.state_mut().app.shutdown();
+}
+
+#[test]
+fn window_layout_snapshot() {
+    // Paths shown in the panel must not depend on the checkout or the process.
+    let launch = Launch {
+        scene: Some(PathBuf::from("scenes/cornell_box.toml")),
+        export_dir: Some(std::env::temp_dir().join("tracelab-snapshot-exports")),
+        ..launch(PathBuf::new(), 16)
+    };
+    let mut harness = Harness::builder()
+        .with_size(SIZE)
+        .wgpu()
+        .build_eframe(|cc| Window::new(cc, launch));
+    step_until(&mut harness, "16 spp", finished);
+    harness.step();
+    // Timings, memory and the convergence curve vary from run to run: mask
+    // the statistics panel right of the controls (the image, the controls
+    // and the panel layout stay in the comparison).
+    harness.mask(egui::Rect::from_min_max(
+        pos2(312.0, 540.0),
+        pos2(SIZE.x, SIZE.y),
+    ));
+    harness.snapshot_options(
+        "viewer_cornell_box",
+        &SnapshotOptions::new().output_path(repo_path("tests/snapshots")),
+    );
+    harness.state_mut().app.shutdown();
+}
