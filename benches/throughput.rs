@@ -41,6 +41,7 @@ fn paths_per_second(threads: usize) -> f64 {
                 seed,
                 planned_spp: 32,
                 threads,
+                adaptive: None,
             };
             let session = Session::new(scene.clone(), settings).unwrap();
             for _ in 0..4 {

@@ -6,12 +6,15 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+use tracelab::convergence::{BenchConfig, Checkpoint, log_log_slope, mean_variance, measure};
 use tracelab::image::{Image, check_writable};
+use tracelab::plot::{Series, log_log_svg};
 use tracelab::integrator::{
     GlassShadows, IntegratorKind, IntegratorOptions, MisHeuristic, Strategy,
 };
-use tracelab::render::{RenderSettings, RenderStats, Session};
+use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
 use tracelab::sampling::SamplerKind;
+use tracelab::scene::light::LightSampling;
 use tracelab::scene::{Limits, Scene};
 use tracelab::{Error, Result};
 
@@ -30,6 +33,9 @@ enum Command {
     /// Open the live window (the default when no command is given).
     #[cfg(feature = "viewer")]
     View(ViewArgs),
+    /// Measure error against a reference at 1, 2, 4, ... spp for several
+    /// configurations; print a table, write CSV and log-log plots (SVG).
+    Bench(BenchArgs),
     /// Compare two images: RMSE, relative MSE and mean relative error (as tev computes them).
     Compare {
         /// The image to measure.
@@ -81,6 +87,58 @@ struct ViewArgs {
     export_dir: Option<PathBuf>,
 }
 
+#[derive(Args, Debug)]
+struct BenchArgs {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// Reference image (EXR); without it tracelab renders one (path tracing,
+    /// Sobol, --reference-spp) and caches it under target/.
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// Per-pixel variance of the reference's mean (EXR): its mean is taken
+    /// out of every MSE, so slopes are not flattened by the reference's noise.
+    #[arg(long, requires = "reference")]
+    reference_variance: Option<PathBuf>,
+    /// Samples per pixel of a rendered reference.
+    #[arg(long, default_value_t = 8192)]
+    reference_spp: u32,
+    /// A configuration `integrator:sampler[:key=value...]`, e.g. `path:sobol`,
+    /// `path:stratified:max-depth=1`, `mcrt:independent:shadow-rays=5:glossy-rays=5:max-depth=2`,
+    /// `light:independent`; keys: max-depth, rr-depth, rr=off, shadow-rays, glossy-rays,
+    /// strategy=bsdf|light|mis, light-sampling=area|solid-angle. Repeatable.
+    #[arg(long = "config", required = true)]
+    configs: Vec<String>,
+    /// Largest sample count measured (powers of two from 1).
+    #[arg(long, default_value_t = 256)]
+    max_spp: u32,
+    /// Fit the log-log slope from this many samples per pixel on.
+    #[arg(long, default_value_t = 4)]
+    slope_from: u32,
+    #[arg(long)]
+    width: Option<u32>,
+    #[arg(long)]
+    height: Option<u32>,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// CSV of every checkpoint.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Log-log plot (SVG) of RMSE against samples per pixel.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Log-log plot (SVG) of RMSE against render time.
+    #[arg(long)]
+    plot_time: Option<PathBuf>,
+    /// Log-log plot (SVG) of RMSE against rays per pixel (equal-cost comparison).
+    #[arg(long)]
+    plot_rays: Option<PathBuf>,
+    /// Title of the plots.
+    #[arg(long, default_value = "RMSE against the reference")]
+    title: String,
+}
+
 #[derive(ValueEnum, Clone, Copy, Debug)]
 enum StrategyArg {
     /// BSDF sampling only.
@@ -92,6 +150,14 @@ enum StrategyArg {
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
+enum LightSamplingArg {
+    /// Uniform by area: density d^2 / (cos A) in solid angle.
+    Area,
+    /// Uniform in solid angle: sphere cones, spherical triangles (Arvo).
+    SolidAngle,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
 enum GlassShadowsArg {
     Opaque,
     Tinted,
@@ -99,8 +165,14 @@ enum GlassShadowsArg {
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
 enum SamplerArg {
+    /// Independent uniform numbers.
     Independent,
+    /// Jittered strata in every dimension and pair, shuffled between dimensions.
     Stratified,
+    /// Correlated multi-jittered: jittered and Latin hypercube in every pair.
+    Multijitter,
+    /// Owen-scrambled Sobol, shuffled per dimension pair.
+    Sobol,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -145,6 +217,10 @@ struct RenderArgs {
     /// How light and BSDF samples are combined (none = light sampling only).
     #[arg(long, value_enum, default_value = "power")]
     mis: MisArg,
+    /// How area lights are sampled (default: the scene's, i.e. triangles by
+    /// area and spheres by solid angle unless its [lights] table says otherwise).
+    #[arg(long, value_enum)]
+    light_sampling: Option<LightSamplingArg>,
     /// MC ray tracing: light samples (shadow rays) per hit.
     #[arg(long, default_value_t = 1)]
     shadow_rays: u32,
@@ -168,6 +244,13 @@ struct RenderArgs {
     /// Worker threads (default: one per core).
     #[arg(long, default_value_t = 0)]
     threads: usize,
+    /// Adaptive sampling: stop sampling pixels whose relative standard error
+    /// falls below this (e.g. 0.02); biased, and reported as such.
+    #[arg(long)]
+    adaptive: Option<f32>,
+    /// Samples every pixel takes before adaptive sampling may stop it.
+    #[arg(long, default_value_t = 16)]
+    adaptive_min_spp: u32,
     /// Exposure in stops for PNG output.
     #[arg(long, default_value_t = 0.0)]
     exposure: f32,
@@ -187,6 +270,7 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Render(args)) => render(&args),
         Some(Command::Compare { image, reference }) => compare(&image, &reference),
+        Some(Command::Bench(args)) => bench(&args),
         #[cfg(feature = "viewer")]
         Some(Command::View(args)) => view(args),
         #[cfg(feature = "viewer")]
@@ -316,6 +400,12 @@ fn render(args: &RenderArgs) -> Result<()> {
             .map_err(|e| Error::new(format!("--width/--height: {e}")))?;
         scene.set_resolution(w, h);
     }
+    if let Some(mode) = args.light_sampling {
+        scene.set_light_sampling(match mode {
+            LightSamplingArg::Area => LightSampling::Area,
+            LightSamplingArg::SolidAngle => LightSampling::SolidAngle,
+        });
+    }
     for w in &scene.warnings {
         eprintln!("warning: {}: {w}", args.scene.display());
     }
@@ -325,7 +415,16 @@ fn render(args: &RenderArgs) -> Result<()> {
     let sampler = match args.sampler {
         SamplerArg::Independent => SamplerKind::Independent,
         SamplerArg::Stratified => SamplerKind::Stratified,
+        SamplerArg::Multijitter => SamplerKind::MultiJittered,
+        SamplerArg::Sobol => SamplerKind::Sobol,
     };
+    if let Some(a) = args.adaptive
+        && !(a.is_finite() && a > 0.0)
+    {
+        return Err(Error::new(format!(
+            "--adaptive must be a positive relative error, got {a}"
+        )));
+    }
     if let Some(r) = args.rays_per_pixel
         && !(r.is_finite() && r > 0.0)
     {
@@ -352,6 +451,10 @@ fn render(args: &RenderArgs) -> Result<()> {
         seed: args.seed,
         planned_spp: target_spp.unwrap_or(0),
         threads: args.threads,
+        adaptive: args.adaptive.map(|threshold| Adaptive {
+            threshold,
+            min_spp: args.adaptive_min_spp.max(2),
+        }),
     };
     let session = Session::new(Arc::new(scene), settings)?;
     let stats = match (target_spp, args.rays_per_pixel) {
@@ -500,6 +603,16 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         per_pixel(stats.rays.shadow),
         per_pixel(stats.rays.bounce)
     );
+    if let Some(a) = settings.adaptive {
+        let planned = stats.samples + stats.skipped;
+        eprintln!(
+            "adaptive sampling (biased): {:.1}% of {} planned samples skipped (relative error < {}, after {} spp)",
+            100.0 * stats.skipped as f64 / planned.max(1) as f64,
+            planned,
+            a.threshold,
+            a.min_spp
+        );
+    }
     println!(
         "spp {} | {:.3} s | {:.2} M rays (camera {:.2} M, shadow {:.2} M, bounce {:.2} M) | {:.2} Mrays/s | {:.3} M paths/s | non-finite {}",
         stats.spp,
@@ -512,6 +625,158 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         stats.samples as f64 / seconds * 1e-6,
         stats.non_finite
     );
+}
+
+fn bench(args: &BenchArgs) -> Result<()> {
+    let configs: Vec<BenchConfig> = args
+        .configs
+        .iter()
+        .map(|c| BenchConfig::parse(c))
+        .collect::<Result<_>>()?;
+    if args.max_spp == 0 || args.max_spp > 1 << 20 {
+        return Err(Error::new(format!(
+            "--max-spp must be in 1..=1048576, got {}",
+            args.max_spp
+        )));
+    }
+    for path in [&args.csv, &args.plot, &args.plot_time, &args.plot_rays]
+        .into_iter()
+        .flatten()
+    {
+        check_writable(path)?;
+    }
+    let mut scene = Scene::load(&args.scene)?;
+    if args.width.is_some() || args.height.is_some() {
+        let (w, h) = (
+            args.width.unwrap_or(scene.camera.width),
+            args.height.unwrap_or(scene.camera.height),
+        );
+        Limits::default()
+            .check_resolution(w, h)
+            .map_err(|e| Error::new(format!("--width/--height: {e}")))?;
+        scene.set_resolution(w, h);
+    }
+    let scene = Arc::new(scene);
+    let reference = match &args.reference {
+        Some(path) => Image::read(path)?,
+        None => cached_reference(&args.scene, &scene, args.reference_spp, args.threads)?,
+    };
+    let reference_mse = match &args.reference_variance {
+        Some(path) => mean_variance(&Image::read(path)?),
+        None => 0.0,
+    };
+    let mut csv = String::from(
+        "config,spp,seconds,rays_per_pixel,rmse,rmse_without_reference_noise,relative_mse,mean_relative_error\n",
+    );
+    let mut results = Vec::new();
+    for config in &configs {
+        eprintln!("measuring {} ...", config.label);
+        let points = measure(
+            &scene,
+            config,
+            &reference,
+            reference_mse,
+            args.max_spp,
+            args.seed,
+            args.threads,
+        )?;
+        println!("{}", config.label);
+        println!(
+            "  {:>7} {:>9} {:>10} {:>10} {:>14} {:>12}",
+            "spp", "seconds", "rays/px", "RMSE", "RMSE-ref.noise", "rel. MSE"
+        );
+        for p in &points {
+            println!(
+                "  {:>7} {:>9.3} {:>10.1} {:>10.6} {:>14.6} {:>12.6}",
+                p.spp, p.seconds, p.rays_per_pixel, p.error.rmse, p.rmse, p.error.relative_mse
+            );
+            csv += &format!(
+                "{},{},{:.6},{:.3},{:.8},{:.8},{:.8},{:.8}\n",
+                config.label,
+                p.spp,
+                p.seconds,
+                p.rays_per_pixel,
+                p.error.rmse,
+                p.rmse,
+                p.error.relative_mse,
+                p.error.mean_relative_error
+            );
+        }
+        match log_log_slope(&points, args.slope_from) {
+            Some(slope) => println!("  log-log slope of RMSE vs spp (from {} spp): {slope:.3}", args.slope_from),
+            None => println!("  (too few points for a slope)"),
+        }
+        results.push((config.label.clone(), points));
+    }
+    if let Some(path) = &args.csv {
+        tracelab::image::write_atomically(path, |tmp| {
+            std::fs::write(tmp, &csv).map_err(|e| e.to_string())
+        })?;
+        eprintln!("wrote {}", path.display());
+    }
+    let plots: [(&Option<PathBuf>, &str, fn(&Checkpoint) -> f64); 3] = [
+        (&args.plot, "samples per pixel", |p| f64::from(p.spp)),
+        (&args.plot_time, "seconds", |p| p.seconds),
+        (&args.plot_rays, "rays per pixel", |p| p.rays_per_pixel),
+    ];
+    for (path, x_label, x) in plots {
+        if let Some(path) = path {
+            let series: Vec<Series> = results
+                .iter()
+                .map(|(name, points)| Series {
+                    name: name.clone(),
+                    points: points.iter().map(|p| (x(p), p.rmse)).collect(),
+                })
+                .collect();
+            log_log_svg(path, &args.title, x_label, "RMSE", &series)?;
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+/// A high-sample path-traced reference for `scene`, cached under
+/// target/tracelab-references/ by scene file, size and sample count.
+fn cached_reference(
+    scene_path: &Path,
+    scene: &Arc<Scene>,
+    spp: u32,
+    threads: usize,
+) -> Result<Image> {
+    let stem = scene_path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/tracelab-references");
+    let path = dir.join(format!(
+        "{stem}_{}x{}_{spp}spp.exr",
+        scene.camera.width, scene.camera.height
+    ));
+    if path.is_file() {
+        eprintln!("using the cached reference {}", path.display());
+        return Image::read(&path);
+    }
+    eprintln!(
+        "no --reference: rendering one (path tracing, Sobol, {spp} spp) to {}",
+        path.display()
+    );
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| Error::at(&dir, None, format!("cannot create the cache: {e}")))?;
+    let session = Session::new(
+        scene.clone(),
+        RenderSettings {
+            integrator: IntegratorOptions::default().build(),
+            sampler: SamplerKind::Sobol,
+            seed: 0x5eed,
+            planned_spp: spp,
+            threads,
+            adaptive: None,
+        },
+    )?;
+    render_spp(&session, spp);
+    let image = session.snapshot().image;
+    image.write_exr(&path)?;
+    Ok(image)
 }
 
 fn compare(image: &Path, reference: &Path) -> Result<()> {

@@ -64,6 +64,31 @@ impl PixelSums {
         ]
     }
 
+    /// Standard error of the luminance mean over the luminance mean (infinite
+    /// with fewer than two samples or a black pixel): the adaptive-sampling test.
+    pub fn relative_standard_error(&self) -> f32 {
+        let weights = [0.2126, 0.7152, 0.0722];
+        if self.count < 2 {
+            return f32::INFINITY;
+        }
+        let n = self.count as f64;
+        let (mut sum, mut sum_sq) = (0.0, 0.0);
+        for c in 0..3 {
+            for d in 0..3 {
+                // Luminance sums from channel sums; the cross terms of the
+                // square are unknown, so bound them with Cauchy-Schwarz.
+                sum_sq += weights[c] * weights[d] * (self.sum_sq[c] * self.sum_sq[d]).sqrt();
+            }
+            sum += weights[c] * self.sum[c];
+        }
+        let mean = sum / n;
+        if mean <= 0.0 {
+            return f32::INFINITY;
+        }
+        let variance = ((sum_sq - sum * sum / n) / (n - 1.0)).max(0.0);
+        ((variance / n).sqrt() / mean) as f32
+    }
+
     /// Standard error of the mean from the unbiased sample variance
     /// s^2 = (sum_sq - sum^2 / n) / (n - 1); infinite with fewer than two samples.
     pub fn standard_error(&self) -> [f32; 3] {

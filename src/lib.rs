@@ -6,12 +6,14 @@
 //! Only `viewer` (behind the default `viewer` feature) imports egui.
 
 pub mod accel;
+pub mod convergence;
 pub mod error;
 pub mod film;
 pub mod image;
 pub mod integrator;
 pub mod live;
 pub mod math;
+pub mod plot;
 pub mod render;
 pub mod sampling;
 pub mod scene;

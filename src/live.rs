@@ -103,6 +103,9 @@ pub struct LiveRender {
 /// and turns between two configurations fine-grained.
 const PASS_TARGET: Duration = Duration::from_millis(40);
 
+/// Parts the first pass of new settings is split into.
+const FIRST_PASS_PARTS: u32 = 4;
+
 /// Most points a convergence curve keeps; older points are thinned out.
 const HISTORY_LIMIT: usize = 512;
 
@@ -281,6 +284,26 @@ fn render_loop(shared: &Shared, commands: &Receiver<Command>, pool: &Arc<rayon::
             k = k.min(target.saturating_sub(stats.spp)).max(1);
         }
         let start = Instant::now();
+        if stats.spp == 0 {
+            // The first pass of new settings comes in parts spread over the
+            // image, each published, so the change shows at once.
+            let parts = match session.settings().integrator {
+                crate::integrator::Integrator::Light(_) => 1,
+                _ => FIRST_PASS_PARTS,
+            };
+            let mut ok = true;
+            for part in 0..parts {
+                ok = session.render_pass_part(1, part, parts);
+                if !ok {
+                    break;
+                }
+                job.publish(next, shared);
+            }
+            if ok {
+                job.pass_sizes[next] = 1;
+            }
+            continue;
+        }
         if !session.render_pass(k) {
             continue;
         }
@@ -333,7 +356,9 @@ impl Job {
                 .map(|m| m.rmse),
         };
         let view = &mut self.frame.views[index];
-        view.history.push(point);
+        if stats.spp > 0 && view.history.last().is_none_or(|p| p.spp < stats.spp) {
+            view.history.push(point);
+        }
         if view.history.len() > HISTORY_LIMIT {
             // Keep the first point and every other one after it: the curve
             // stays spread over the whole run in log scale.
@@ -400,6 +425,7 @@ mod tests {
                 seed: 0,
                 planned_spp: 0,
                 threads: 0,
+                adaptive: None,
             },
             target_spp: Some(spp),
         }

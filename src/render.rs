@@ -30,6 +30,18 @@ pub struct RenderSettings {
     pub planned_spp: u32,
     /// Worker threads (0 = one per core).
     pub threads: usize,
+    /// Stop sampling pixels that have converged (off by default).
+    pub adaptive: Option<Adaptive>,
+}
+
+/// Adaptive sampling: a pixel with at least `min_spp` samples whose relative
+/// standard error (luminance) is below `threshold` gets no further samples.
+/// It trades a little bias for time: the error estimate of a few samples is
+/// itself noisy, and pixels that look converged by chance stop early.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Adaptive {
+    pub threshold: f32,
+    pub min_spp: u32,
 }
 
 /// Counters of a session so far.
@@ -42,6 +54,8 @@ pub struct RenderStats {
     pub rays: RayCounts,
     /// Samples that were NaN or infinite and were left out of the film.
     pub non_finite: u64,
+    /// Samples adaptive sampling did not take (converged pixels).
+    pub skipped: u64,
     /// Wall time spent inside passes.
     pub render_time: Duration,
 }
@@ -58,6 +72,7 @@ pub struct Session {
     shadow_rays: AtomicU64,
     bounce_rays: AtomicU64,
     non_finite: AtomicU64,
+    skipped: AtomicU64,
     render_nanos: AtomicU64,
     cancelled: AtomicBool,
 }
@@ -88,6 +103,7 @@ impl Session {
             shadow_rays: AtomicU64::new(0),
             bounce_rays: AtomicU64::new(0),
             non_finite: AtomicU64::new(0),
+            skipped: AtomicU64::new(0),
             render_nanos: AtomicU64::new(0),
             cancelled: AtomicBool::new(false),
         }
@@ -114,31 +130,51 @@ impl Session {
     /// Adds `spp` samples to every pixel. Returns false (and leaves the film
     /// with a partial pass that [`RenderStats::spp`] does not count) when cancelled.
     pub fn render_pass(&self, spp: u32) -> bool {
+        self.render_pass_part(spp, 0, 1)
+    }
+
+    /// Renders part `part` of `parts` of a pass of `spp` samples: the tiles
+    /// whose index is `part` modulo `parts`, spread over the image. The pass
+    /// counts (in [`RenderStats::spp`]) once its last part is done; the film
+    /// is the same as after one whole pass. A live view uses parts to show
+    /// the first pass of new settings sooner. Light tracing splats anywhere,
+    /// so it renders its whole pass with part 0 and skips the others.
+    pub fn render_pass_part(&self, spp: u32, part: u32, parts: u32) -> bool {
         let start = Instant::now();
         let first = self.spp.load(Ordering::Relaxed);
+        let parts = parts.max(1);
         if let Integrator::Light(tracer) = self.settings.integrator {
-            self.light_pass(&tracer, first, spp);
+            if part == 0 {
+                self.light_pass(&tracer, first, spp);
+            }
         } else {
-            self.camera_pass(first, spp);
+            self.camera_pass(first, spp, part, parts);
         }
         self.render_nanos
             .fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
         if self.cancelled.load(Ordering::Relaxed) {
             return false;
         }
-        self.spp.store(first + spp, Ordering::Relaxed);
+        let complete = match self.settings.integrator {
+            Integrator::Light(_) => part == 0,
+            _ => part + 1 == parts,
+        };
+        if complete {
+            self.spp.store(first + spp, Ordering::Relaxed);
+        }
         true
     }
 
-    /// Camera-driven estimators: samples `first..first + spp` of every pixel.
-    fn camera_pass(&self, first: u32, spp: u32) {
+    /// Camera-driven estimators: samples `first..first + spp` of every pixel
+    /// of the tiles in part `part` of `parts`.
+    fn camera_pass(&self, first: u32, spp: u32, part: u32, parts: u32) {
         let scene = &*self.scene;
         let settings = &self.settings;
         let deterministic = settings.integrator.is_deterministic();
         let width = self.film.width();
         self.pool.install(|| {
-            self.film.tiles().par_iter().for_each(|tile| {
-                if self.cancelled.load(Ordering::Relaxed) {
+            self.film.tiles().par_iter().enumerate().for_each(|(index, tile)| {
+                if index as u32 % parts != part || self.cancelled.load(Ordering::Relaxed) {
                     return;
                 }
                 let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
@@ -146,10 +182,18 @@ impl Session {
                     Sampler::new(settings.sampler, settings.seed, settings.planned_spp);
                 let mut counts = RayCounts::default();
                 let mut non_finite = 0u64;
+                let mut skipped = 0u64;
                 let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
                 for (i, pixel) in tile.pixels.iter_mut().enumerate() {
                     let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
                     let pixel_index = y * width + x;
+                    if let Some(a) = settings.adaptive
+                        && pixel.count >= a.min_spp
+                        && pixel.relative_standard_error() < a.threshold
+                    {
+                        skipped += u64::from(spp);
+                        continue;
+                    }
                     for s in first..first + spp {
                         sampler.start(pixel_index, s);
                         let mut film_point = Vec2::new(x as f32, y as f32) + sampler.next_2d();
@@ -170,6 +214,7 @@ impl Session {
                 }
                 drop(tile);
                 self.add_counts(counts.camera, &counts, non_finite);
+                self.skipped.fetch_add(skipped, Ordering::Relaxed);
             });
         });
     }
@@ -260,6 +305,7 @@ impl Session {
                 bounce: self.bounce_rays.load(Ordering::Relaxed),
             },
             non_finite: self.non_finite.load(Ordering::Relaxed),
+            skipped: self.skipped.load(Ordering::Relaxed),
             render_time: Duration::from_nanos(self.render_nanos.load(Ordering::Relaxed)),
         }
     }

@@ -15,7 +15,7 @@ use tracelab::accel::{Geometry, NO_LIGHT, TriangleInput};
 use tracelab::math::{Frame, Rgb};
 use tracelab::sampling::hash::{hash_combine, to_unit_float};
 use tracelab::sampling::warp::*;
-use tracelab::scene::light::{Light, Lights, SphereSampling};
+use tracelab::scene::light::{Light, Lights, LightSampling};
 use tracelab::scene::material::{Bsdf, fresnel_dielectric};
 
 /// Number of `assert_fits` calls below.
@@ -353,7 +353,7 @@ fn check_light(name: &str, seed: u64, reference: Vec3A, lights: &Lights, geometr
 
 /// A reference point, a big emissive triangle above it, and the lights and
 /// geometry to find where a direction lands on it.
-fn triangle_light() -> (Vec3A, Lights, Geometry) {
+fn triangle_light(sampling: LightSampling) -> (Vec3A, Lights, Geometry) {
     let reference = Vec3A::new(0.2, -0.1, 0.0);
     let [p0, p1, p2] = [
         Vec3A::new(-1.0, -1.5, 0.8),
@@ -371,6 +371,7 @@ fn triangle_light() -> (Vec3A, Lights, Geometry) {
         area: 0.5 * e1.cross(e2).length(),
         radiance: Rgb::ONE,
         two_sided: false,
+        sampling,
     };
     let geometry = Geometry::build(
         &[TriangleInput {
@@ -384,8 +385,24 @@ fn triangle_light() -> (Vec3A, Lights, Geometry) {
 
 #[test]
 fn triangle_light_area_sampling_in_solid_angle() {
-    let (reference, lights, geometry) = triangle_light();
+    let (reference, lights, geometry) = triangle_light(LightSampling::Area);
     check_light("triangle light", 8, reference, &lights, &geometry);
+}
+
+#[test]
+fn triangle_light_spherical_triangle_sampling() {
+    // Arvo's sampling: the density must be constant, 1 / solid angle.
+    let (reference, lights, geometry) = triangle_light(LightSampling::SolidAngle);
+    check_light("triangle light, solid angle", 12, reference, &lights, &geometry);
+    // A small far triangle (solid angle below the f32-safe range) falls back
+    // to area sampling consistently in sample and pdf.
+    let far = reference + Vec3A::new(0.0, 0.0, 300.0);
+    let (_, lights, _) = triangle_light(LightSampling::SolidAngle);
+    let s = lights.sample(far, 0.5, Vec2::new(0.3, 0.3));
+    if let Some(s) = s {
+        let pdf = lights.pdf(0, far, s.point, s.normal);
+        assert!((pdf - s.pdf).abs() <= 1e-3 * pdf, "{pdf} vs {}", s.pdf);
+    }
 }
 
 #[test]
@@ -429,7 +446,7 @@ fn sphere_light_solid_angle_sampling() {
     let reference = Vec3A::ZERO;
     let center = Vec3A::new(0.0, 0.0, 1.0);
     let radius = (1.0f32 - 0.825 * 0.825).sqrt();
-    let (sampling, seed) = (SphereSampling::SolidAngle, 10);
+    let (sampling, seed) = (LightSampling::SolidAngle, 10);
     let lights = Lights::new(vec![Light::Sphere {
         center,
         radius,

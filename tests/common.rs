@@ -40,6 +40,7 @@ pub fn render_with(
         seed,
         planned_spp: spp,
         threads,
+        adaptive: None,
     };
     let session = Session::new(Arc::new(scene), settings).expect("session starts");
     let mut done = 0;

@@ -14,7 +14,7 @@ use tracelab::integrator::{Integrator, MisHeuristic, PathTracer};
 use tracelab::math::Rgb;
 use tracelab::sampling::SamplerKind;
 use tracelab::scene::camera::Camera;
-use tracelab::scene::light::SphereSampling;
+use tracelab::scene::light::LightSampling;
 use tracelab::scene::material::{Bsdf, Material};
 use tracelab::scene::{Scene, SceneInput};
 
@@ -55,7 +55,8 @@ fn sphere_furnace() -> Scene {
             light: NO_LIGHT,
         }],
         point_lights: vec![],
-        sphere_sampling: SphereSampling::SolidAngle,
+        sphere_sampling: LightSampling::SolidAngle,
+        triangle_sampling: LightSampling::Area,
     })
     .unwrap()
 }
@@ -95,7 +96,8 @@ fn cube_furnace() -> Scene {
         triangles,
         spheres: vec![],
         point_lights: vec![],
-        sphere_sampling: SphereSampling::SolidAngle,
+        sphere_sampling: LightSampling::SolidAngle,
+        triangle_sampling: LightSampling::Area,
     })
     .unwrap()
 }
@@ -140,6 +142,17 @@ fn cube_furnace_with_nee_and_balance_mis() {
 #[test]
 fn cube_furnace_with_nee_without_mis() {
     check_furnace(cube_furnace(), true, MisHeuristic::None);
+}
+
+#[test]
+fn cube_furnace_with_spherical_triangle_light_sampling() {
+    // Every wall is a light sampled by its solid angle (the wall a point lies
+    // on subtends none and falls back to area sampling): MIS weights mix both.
+    for mis in [MisHeuristic::Power, MisHeuristic::None] {
+        let mut scene = cube_furnace();
+        scene.set_light_sampling(LightSampling::SolidAngle);
+        check_furnace(scene, true, mis);
+    }
 }
 
 #[test]

@@ -226,6 +226,7 @@ fn point_equivalent(light: &Light, reference: Vec3A) -> (Vec3A, Vec3A, Rgb) {
             area,
             radiance,
             two_sided,
+            ..
         } => {
             let centroid = p0 + (e1 + e2) / 3.0;
             let cos = normal.dot((reference - centroid).normalize_or_zero());

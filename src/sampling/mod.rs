@@ -6,6 +6,7 @@
 pub mod alias;
 pub mod hash;
 pub mod sampler;
+pub mod spherical_triangle;
 pub mod warp;
 
 pub use alias::AliasTable;

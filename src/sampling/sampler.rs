@@ -21,6 +21,15 @@ pub enum SamplerKind {
     /// shuffled independently per dimension (pbrt's padding), so every dimension
     /// stays stratified without the curse of dimensionality of a full grid.
     Stratified,
+    /// Correlated multi-jittered (Kensler 2013): 2D pairs are jittered on an
+    /// m x n grid *and* Latin hypercube in each axis (one sample per 1/N
+    /// column and row); 1D dimensions are Latin hypercube samples.
+    #[serde(alias = "cmj")]
+    MultiJittered,
+    /// Sobol (0,2)-sequence, Owen-scrambled with Laine-Karras hashing and
+    /// shuffled per dimension pair (Burley 2020, pbrt-v4's padded Sobol):
+    /// every power-of-two prefix is a stratified (0,m,2)-net in each pair.
+    Sobol,
 }
 
 impl SamplerKind {
@@ -29,8 +38,17 @@ impl SamplerKind {
         match self {
             SamplerKind::Independent => "independent",
             SamplerKind::Stratified => "stratified",
+            SamplerKind::MultiJittered => "multijitter",
+            SamplerKind::Sobol => "sobol",
         }
     }
+
+    pub const ALL: [SamplerKind; 4] = [
+        SamplerKind::Independent,
+        SamplerKind::Stratified,
+        SamplerKind::MultiJittered,
+        SamplerKind::Sobol,
+    ];
 }
 
 /// Default number of samples stratified together when a render has no planned
@@ -43,6 +61,8 @@ pub const DEFAULT_BATCH: u32 = 64;
 pub struct Sampler {
     kind: SamplerKind,
     seed_key: u64,
+    /// Key of (seed, pixel): seeds the Sobol scrambles of each dimension.
+    pixel_key: u64,
     /// Key of (seed, pixel, batch): seeds the per-dimension strata permutations.
     batch_key: u64,
     sample_key: u64,
@@ -74,6 +94,7 @@ impl Sampler {
         Sampler {
             kind,
             seed_key: mix64(seed ^ 0x5851_f42d_4c95_7f2d),
+            pixel_key: 0,
             batch_key: 0,
             sample_key: 0,
             sample_index: 0,
@@ -93,6 +114,7 @@ impl Sampler {
     #[inline]
     pub fn start(&mut self, pixel: u32, sample_index: u32) {
         let pixel_key = hash_combine(self.seed_key, pixel as u64);
+        self.pixel_key = pixel_key;
         self.sample_key = hash_combine(pixel_key, sample_index as u64);
         self.batch_key = hash_combine(
             pixel_key,
@@ -128,9 +150,15 @@ impl Sampler {
         let u = to_unit_float(h);
         match self.kind {
             SamplerKind::Independent => u,
-            SamplerKind::Stratified => {
+            SamplerKind::Stratified | SamplerKind::MultiJittered => {
                 let s = self.stratum(dim);
                 ((s as f32 + u) / self.batch as f32).min(ONE_MINUS_EPSILON)
+            }
+            SamplerKind::Sobol => {
+                let key = hash_combine(self.pixel_key, dim as u64);
+                let index = nested_uniform_scramble(self.sample_index, key as u32);
+                let x = nested_uniform_scramble(index.reverse_bits(), (key >> 32) as u32);
+                bits_to_unit_float(x)
             }
         }
     }
@@ -143,6 +171,29 @@ impl Sampler {
         let v = to_unit_float(h << 24);
         match self.kind {
             SamplerKind::Independent => Vec2::new(u, v),
+            SamplerKind::MultiJittered => {
+                // Kensler's cmj: a shuffled sample index picks a cell of the
+                // m x n grid; within it, the sub-cell offsets are permutations
+                // of the other axis, so the columns and rows of the fine
+                // N x N grid are each hit once.
+                let (m, n) = (self.grid_x, self.grid_y);
+                let key = hash_combine(self.batch_key, dim as u64);
+                let s = permute(self.sample_index % self.batch, self.batch, key as u32);
+                let (cx, cy) = (s % m, s / m);
+                let sx = permute(cx, m, (key >> 32) as u32 ^ 0x68bc_21eb);
+                let sy = permute(cy, n, (key >> 32) as u32 ^ 0x02e5_be93);
+                Vec2::new(
+                    ((cx as f32 + (sy as f32 + u) / n as f32) / m as f32).min(ONE_MINUS_EPSILON),
+                    ((cy as f32 + (sx as f32 + v) / m as f32) / n as f32).min(ONE_MINUS_EPSILON),
+                )
+            }
+            SamplerKind::Sobol => {
+                let key = hash_combine(self.pixel_key, dim as u64);
+                let index = nested_uniform_scramble(self.sample_index, key as u32);
+                let x = nested_uniform_scramble(index.reverse_bits(), (key >> 32) as u32);
+                let y = nested_uniform_scramble(sobol_dimension_1(index), mix64(key) as u32);
+                Vec2::new(bits_to_unit_float(x), bits_to_unit_float(y))
+            }
             SamplerKind::Stratified => {
                 let s = self.stratum(dim);
                 let (sx, sy) = (s % self.grid_x, s / self.grid_x);
@@ -157,6 +208,50 @@ impl Sampler {
 
 /// The largest float below one.
 pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// The top 24 bits of a 32-bit fixed-point fraction as a float in [0, 1).
+#[inline]
+fn bits_to_unit_float(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// The second dimension of the Sobol sequence (as bits of a fraction): its
+/// generator matrix is Pascal's triangle mod 2, whose columns follow
+/// v_0 = 2^31, v_{k+1} = v_k ^ (v_k >> 1).
+#[inline]
+fn sobol_dimension_1(mut index: u32) -> u32 {
+    let mut v = 1u32 << 31;
+    let mut x = 0;
+    while index != 0 {
+        if index & 1 != 0 {
+            x ^= v;
+        }
+        index >>= 1;
+        v ^= v >> 1;
+    }
+    x
+}
+
+/// Laine-Karras hash: a random permutation of a 32-bit word in which each
+/// output bit depends only on the input bits at or below it.
+#[inline]
+fn laine_karras(mut x: u32, seed: u32) -> u32 {
+    x = x.wrapping_add(seed);
+    x ^= x.wrapping_mul(0x6c50_b47c);
+    x ^= x.wrapping_mul(0xb82f_1e52);
+    x ^= x.wrapping_mul(0xc7af_e638);
+    x ^= x.wrapping_mul(0x8d22_f6e6);
+    x
+}
+
+/// Owen's nested uniform scramble of a fraction's bits (Burley 2020): each
+/// digit is flipped by a hash of the digits above it. Applied to a sample
+/// index it shuffles the sequence while mapping every aligned power-of-two
+/// block onto another, so prefixes of 2^k samples stay nets.
+#[inline]
+fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
+    laine_karras(x.reverse_bits(), seed).reverse_bits()
+}
 
 #[cfg(test)]
 mod tests {
@@ -210,6 +305,74 @@ mod tests {
             cells[(s.next_1d() * 16.0) as usize] += 1;
         }
         assert!(cells.iter().all(|&c| c == 1), "{cells:?}");
+    }
+
+    /// Points of `kind` for samples 0..n of one pixel, from one 2D request
+    /// after `skip` 1D requests.
+    fn points(kind: SamplerKind, n: u32, skip: u32, first: u32) -> Vec<Vec2> {
+        let mut s = Sampler::new(kind, 11, n);
+        (first..first + n)
+            .map(|i| {
+                s.start(42, i);
+                for _ in 0..skip {
+                    s.next_1d();
+                }
+                s.next_2d()
+            })
+            .collect()
+    }
+
+    fn counts(points: &[Vec2], nx: u32, ny: u32) -> Vec<u32> {
+        let mut c = vec![0; (nx * ny) as usize];
+        for p in points {
+            c[(p.x * nx as f32) as usize + nx as usize * (p.y * ny as f32) as usize] += 1;
+        }
+        c
+    }
+
+    #[test]
+    fn sobol_prefixes_are_nets_in_every_elementary_interval_shape() {
+        // 256 points of a (0,8,2)-net: every 2^a x 2^b box with a + b = 8
+        // holds exactly one, for every dimension pair and every aligned block
+        // of 256 samples (progressive rendering past any power of two).
+        for skip in [0, 1, 5] {
+            for first in [0, 256, 768] {
+                let p = points(SamplerKind::Sobol, 256, skip, first);
+                for a in 0..=8 {
+                    let c = counts(&p, 1 << a, 1 << (8 - a));
+                    assert!(c.iter().all(|&c| c == 1), "skip {skip} first {first} 2^{a}: {c:?}");
+                }
+            }
+        }
+        // 1D requests: one point per 1/256 interval.
+        let mut s = Sampler::new(SamplerKind::Sobol, 3, 0);
+        let mut cells = vec![0; 256];
+        for i in 0..256 {
+            s.start(9, i);
+            s.next_2d();
+            cells[(s.next_1d() * 256.0) as usize] += 1;
+        }
+        assert!(cells.iter().all(|&c| c == 1), "{cells:?}");
+    }
+
+    #[test]
+    fn multi_jittered_is_jittered_and_latin_hypercube() {
+        for (n, m) in [(256, 16), (24, 4)] {
+            let p = points(SamplerKind::MultiJittered, n, 3, 0);
+            let grid = counts(&p, m, n / m);
+            assert!(grid.iter().all(|&c| c == 1), "grid {grid:?}");
+            assert!(counts(&p, n, 1).iter().all(|&c| c == 1), "columns");
+            assert!(counts(&p, 1, n).iter().all(|&c| c == 1), "rows");
+        }
+    }
+
+    #[test]
+    fn different_pixels_and_dimensions_get_different_scrambles() {
+        for kind in [SamplerKind::Sobol, SamplerKind::MultiJittered] {
+            let a = points(kind, 16, 0, 0);
+            let b = points(kind, 16, 1, 0);
+            assert_ne!(a, b, "{kind:?}");
+        }
     }
 
     #[test]

@@ -39,10 +39,11 @@
 //! ior = 1.5
 //!
 //! [lights]
-//! sphere_sampling = "solid-angle"   # or "area"
+//! sphere_sampling = "solid-angle"   # or "area" (default solid-angle)
+//! triangle_sampling = "area"        # or "solid-angle" (default area, as Mitsuba)
 //! ```
 
-use crate::scene::light::SphereSampling;
+use crate::scene::light::LightSampling;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use toml::Spanned;
@@ -177,9 +178,24 @@ pub struct MaterialDesc {
 }
 
 /// `[lights]`: how lights are sampled.
-#[derive(Debug, Deserialize, Default)]
+#[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightOptions {
     #[serde(default)]
-    pub sphere_sampling: SphereSampling,
+    pub sphere_sampling: LightSampling,
+    #[serde(default = "area")]
+    pub triangle_sampling: LightSampling,
+}
+
+fn area() -> LightSampling {
+    LightSampling::Area
+}
+
+impl Default for LightOptions {
+    fn default() -> Self {
+        LightOptions {
+            sphere_sampling: LightSampling::SolidAngle,
+            triangle_sampling: LightSampling::Area,
+        }
+    }
 }

@@ -7,7 +7,7 @@
 //! the shading point, so the integrators can combine them with BSDF densities.
 
 use crate::math::{Frame, Rgb, gamma, luminance};
-use crate::sampling::AliasTable;
+use crate::sampling::{AliasTable, spherical_triangle};
 use crate::sampling::warp::{
     cosine_hemisphere_pdf, square_to_cosine_hemisphere, square_to_uniform_cone,
     square_to_uniform_sphere, square_to_uniform_triangle, uniform_cone_pdf,
@@ -15,13 +15,15 @@ use crate::sampling::warp::{
 use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
 
-/// How points on spherical lights are chosen.
+/// How points on area lights are chosen for next-event estimation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
-pub enum SphereSampling {
-    /// Uniform over the sphere's area (half the samples face away and are wasted).
+pub enum LightSampling {
+    /// Uniform over the light's area (for spheres, half the samples face
+    /// away and are wasted), density d^2 / (cos A) in solid angle.
     Area,
-    /// Uniform over the cone of directions the sphere subtends (no waste).
+    /// Uniform over the solid angle the light subtends: the cone of a sphere,
+    /// the spherical triangle of a triangle (Arvo), density 1 / solid angle.
     #[default]
     SolidAngle,
 }
@@ -38,6 +40,7 @@ pub enum Light {
         area: f32,
         radiance: Rgb,
         two_sided: bool,
+        sampling: LightSampling,
     },
     /// An emissive sphere, emitting outwards (and inwards when two-sided).
     Sphere {
@@ -45,7 +48,7 @@ pub enum Light {
         radius: f32,
         radiance: Rgb,
         two_sided: bool,
-        sampling: SphereSampling,
+        sampling: LightSampling,
     },
     /// An isotropic point light of `intensity` (W/sr per channel).
     Point { position: Vec3A, intensity: Rgb },
@@ -114,7 +117,17 @@ impl Light {
                 area,
                 radiance,
                 two_sided,
+                sampling,
             } => {
+                if sampling == LightSampling::SolidAngle {
+                    let vertices = [p0, p0 + e1, p0 + e2];
+                    let omega = spherical_triangle::solid_angle(reference, vertices);
+                    if spherical_triangle::usable(omega) {
+                        return triangle_solid_angle_sample(
+                            reference, p0, e1, e2, normal, radiance, two_sided, u,
+                        );
+                    }
+                }
                 let b = square_to_uniform_triangle(u);
                 let point = p0 + b.x * e1 + b.y * e2;
                 let error = gamma(6) * (p0.abs() + (b.x * e1).abs() + (b.y * e2).abs());
@@ -130,7 +143,7 @@ impl Light {
                 let to_center = center - reference;
                 let dc2 = to_center.length_squared();
                 let inside = dc2 <= radius * radius * (1.0 + 1e-4);
-                if sampling == SphereSampling::SolidAngle && !inside {
+                if sampling == LightSampling::SolidAngle && !inside {
                     let dc = dc2.sqrt();
                     let sin2_max = (radius * radius / dc2).min(1.0);
                     let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
@@ -199,7 +212,22 @@ impl Light {
         let dist2 = to_light.length_squared();
         let cos_light = normal.dot(to_light).abs() / dist2.sqrt();
         match *self {
-            Light::Triangle { area, .. } => dist2 / (cos_light * area),
+            Light::Triangle {
+                p0,
+                e1,
+                e2,
+                area,
+                sampling,
+                ..
+            } => {
+                if sampling == LightSampling::SolidAngle {
+                    let omega = spherical_triangle::solid_angle(reference, [p0, p0 + e1, p0 + e2]);
+                    if spherical_triangle::usable(omega) {
+                        return 1.0 / omega;
+                    }
+                }
+                dist2 / (cos_light * area)
+            }
             Light::Sphere {
                 center,
                 radius,
@@ -208,7 +236,7 @@ impl Light {
             } => {
                 let dc2 = (center - reference).length_squared();
                 let inside = dc2 <= radius * radius * (1.0 + 1e-4);
-                if sampling == SphereSampling::SolidAngle && !inside {
+                if sampling == LightSampling::SolidAngle && !inside {
                     let cos_max = (1.0 - (radius * radius / dc2).min(1.0)).max(0.0).sqrt();
                     uniform_cone_pdf(cos_max)
                 } else {
@@ -218,6 +246,54 @@ impl Light {
             Light::Point { .. } => 0.0,
         }
     }
+}
+
+/// A direction uniform in the solid angle of a triangle light, with the point
+/// where it meets the triangle (found as barycentrics, so that the point lies
+/// on the triangle with the usual error bound).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn triangle_solid_angle_sample(
+    reference: Vec3A,
+    p0: Vec3A,
+    e1: Vec3A,
+    e2: Vec3A,
+    normal: Vec3A,
+    radiance: Rgb,
+    two_sided: bool,
+    u: Vec2,
+) -> Option<LightSample> {
+    let (wi, pdf) = spherical_triangle::sample(reference, [p0, p0 + e1, p0 + e2], u)?;
+    let cos_light = -normal.dot(wi);
+    if !(cos_light > 0.0 || (two_sided && cos_light < 0.0)) {
+        return None;
+    }
+    // Möller-Trumbore for the barycentrics of the hit of reference + t wi.
+    let pvec = wi.cross(e2);
+    let det = e1.dot(pvec);
+    if det == 0.0 {
+        return None;
+    }
+    let tvec = reference - p0;
+    let b1 = (tvec.dot(pvec) / det).clamp(0.0, 1.0);
+    let qvec = tvec.cross(e1);
+    let b2 = (wi.dot(qvec) / det).clamp(0.0, 1.0 - b1);
+    let point = p0 + b1 * e1 + b2 * e2;
+    let error = gamma(6) * (p0.abs() + (b1 * e1).abs() + (b2 * e2).abs());
+    let distance = (point - reference).length();
+    if !(distance > 0.0 && pdf.is_finite()) {
+        return None;
+    }
+    Some(LightSample {
+        point,
+        error,
+        normal,
+        wi,
+        distance,
+        radiance,
+        pdf,
+        delta: false,
+    })
 }
 
 /// Rounding error bound of a point re-projected onto a sphere (pbrt-v4
@@ -342,6 +418,7 @@ impl Light {
                 area,
                 radiance,
                 two_sided,
+                ..
             } => {
                 let b = square_to_uniform_triangle(u_position);
                 let point = p0 + b.x * e1 + b.y * e2;
@@ -416,6 +493,20 @@ impl Lights {
         let powers: Vec<f32> = lights.iter().map(Light::power).collect();
         let selection = AliasTable::new(&powers);
         Lights { lights, selection }
+    }
+
+    /// The same lights with every area light sampled by `mode`.
+    pub fn with_sampling(&self, mode: LightSampling) -> Lights {
+        let mut lights = self.lights.clone();
+        for light in &mut lights {
+            if let Light::Triangle { sampling, .. } | Light::Sphere { sampling, .. } = light {
+                *sampling = mode;
+            }
+        }
+        Lights {
+            lights,
+            selection: self.selection.clone(),
+        }
     }
 
     /// The lights, indexed by the light ids stored on emissive primitives.

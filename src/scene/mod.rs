@@ -11,7 +11,7 @@ pub mod obj;
 use crate::accel::{Geometry, Sphere, TriangleInput};
 use crate::error::{Error, Result};
 use camera::Camera;
-use light::{Light, Lights, SphereSampling};
+use light::{Light, Lights, LightSampling};
 use material::Material;
 use std::path::Path;
 use std::sync::Arc;
@@ -53,7 +53,8 @@ pub struct SceneInput {
     pub triangles: Vec<TriangleInput>,
     pub spheres: Vec<Sphere>,
     pub point_lights: Vec<Light>,
-    pub sphere_sampling: SphereSampling,
+    pub sphere_sampling: LightSampling,
+    pub triangle_sampling: LightSampling,
 }
 
 /// A scene ready to render.
@@ -140,6 +141,7 @@ impl Scene {
                     area: 0.5 * cross.length(),
                     radiance: material.emission,
                     two_sided: material.two_sided_emission,
+                    sampling: input.triangle_sampling,
                 });
             }
         }
@@ -169,6 +171,11 @@ impl Scene {
             lights,
             warnings,
         })
+    }
+
+    /// Samples every area light by `mode` (the CLI's `--light-sampling`).
+    pub fn set_light_sampling(&mut self, mode: LightSampling) {
+        self.lights = self.lights.with_sampling(mode);
     }
 
     /// Overrides the image size (keeping the field of view).

@@ -368,6 +368,7 @@ impl ViewerApp {
                         seed: c.seed,
                         planned_spp: target.unwrap_or(0),
                         threads: 0,
+                        adaptive: None,
                     },
                     target_spp: if integrator.is_deterministic() {
                         Some(1)

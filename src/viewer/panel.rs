@@ -93,7 +93,7 @@ fn compare_section(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing
         app.settings.b = Config {
             sampler: match app.settings.a.sampler {
                 SamplerKind::Independent => SamplerKind::Stratified,
-                SamplerKind::Stratified => SamplerKind::Independent,
+                _ => SamplerKind::Independent,
             },
             ..app.settings.a
         };
@@ -170,12 +170,14 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
         }
         IntegratorKind::Light => roulette(ui, &mut options.russian_roulette, &mut options.rr_depth),
     }
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("Sampler");
         ui.radio_value(&mut config.sampler, SamplerKind::Independent, "Independent");
         ui.radio_value(&mut config.sampler, SamplerKind::Stratified, "Stratified");
+        ui.radio_value(&mut config.sampler, SamplerKind::MultiJittered, "Multi-jittered");
+        ui.radio_value(&mut config.sampler, SamplerKind::Sobol, "Sobol");
     });
-    let mut stratified = config.sampler == SamplerKind::Stratified;
+    let mut stratified = config.sampler != SamplerKind::Independent;
     if ui.checkbox(&mut stratified, "Stratify samples").changed() {
         config.sampler = if stratified {
             SamplerKind::Stratified

@@ -1,0 +1,246 @@
+//! Convergence measurements: error against a reference as samples (or time,
+//! or rays) grow, for any estimator configuration, and the slope of the
+//! log-log curve. `tracelab bench` prints, writes CSV and plots these.
+
+use crate::error::{Error, Result};
+use crate::image::{ErrorMetrics, Image};
+use crate::integrator::{IntegratorKind, IntegratorOptions, Strategy};
+use crate::render::{RenderSettings, Session};
+use crate::sampling::SamplerKind;
+use crate::scene::Scene;
+use crate::scene::light::LightSampling;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// One configuration to measure, as `integrator:sampler[:key=value...]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchConfig {
+    pub label: String,
+    pub integrator: IntegratorOptions,
+    pub sampler: SamplerKind,
+    pub light_sampling: Option<LightSampling>,
+}
+
+impl BenchConfig {
+    /// Parses `path:sobol`, `mcrt:independent:shadow-rays=1:glossy-rays=1`,
+    /// `path:stratified:max-depth=1:strategy=light`, `light:independent`.
+    pub fn parse(text: &str) -> Result<BenchConfig> {
+        let err = |m: String| Error::new(format!("--config `{text}`: {m}"));
+        let mut parts = text.split(':');
+        let mut integrator = IntegratorOptions {
+            kind: match parts.next().unwrap_or("") {
+                "whitted" => IntegratorKind::Whitted,
+                "mcrt" => IntegratorKind::Mcrt,
+                "path" => IntegratorKind::Path,
+                "light" => IntegratorKind::Light,
+                other => {
+                    return Err(err(format!(
+                        "unknown integrator `{other}` (whitted, mcrt, path, light)"
+                    )));
+                }
+            },
+            ..Default::default()
+        };
+        let sampler = match parts.next().unwrap_or("independent") {
+            "independent" => SamplerKind::Independent,
+            "stratified" => SamplerKind::Stratified,
+            "multijitter" => SamplerKind::MultiJittered,
+            "sobol" => SamplerKind::Sobol,
+            other => {
+                return Err(err(format!(
+                    "unknown sampler `{other}` (independent, stratified, multijitter, sobol)"
+                )));
+            }
+        };
+        let mut light_sampling = None;
+        for option in parts {
+            let (key, value) = option
+                .split_once('=')
+                .ok_or_else(|| err(format!("`{option}` is not key=value")))?;
+            let number = || {
+                value
+                    .parse::<u32>()
+                    .map_err(|_| err(format!("`{key}` needs a whole number, got `{value}`")))
+            };
+            match key {
+                "max-depth" => integrator.max_depth = number()?,
+                "rr-depth" => integrator.rr_depth = number()?,
+                "rr" => integrator.russian_roulette = value != "off",
+                "shadow-rays" => integrator.shadow_rays = number()?,
+                "glossy-rays" => integrator.glossy_rays = number()?,
+                "strategy" => {
+                    integrator.strategy = match value {
+                        "bsdf" => Strategy::Bsdf,
+                        "light" => Strategy::Light,
+                        "mis" => Strategy::Mis,
+                        _ => return Err(err(format!("strategy `{value}` (bsdf, light, mis)"))),
+                    }
+                }
+                "light-sampling" => {
+                    light_sampling = Some(match value {
+                        "area" => LightSampling::Area,
+                        "solid-angle" => LightSampling::SolidAngle,
+                        _ => return Err(err(format!("light-sampling `{value}` (area, solid-angle)"))),
+                    })
+                }
+                _ => return Err(err(format!("unknown option `{key}`"))),
+            }
+        }
+        Ok(BenchConfig {
+            label: text.to_string(),
+            integrator,
+            sampler,
+            light_sampling,
+        })
+    }
+}
+
+/// One measurement.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Checkpoint {
+    pub spp: u32,
+    pub seconds: f64,
+    pub rays_per_pixel: f64,
+    pub error: ErrorMetrics,
+    /// RMSE with the reference's own noise taken out: sqrt(MSE - mean
+    /// reference variance), when the variance is known; else the RMSE.
+    pub rmse: f64,
+}
+
+/// Renders `config` separately at 1, 2, 4, ... `max_spp` samples per pixel
+/// (each render plans its own count, so stratified samplers are measured at
+/// their best) and compares each image with `reference`.
+#[allow(clippy::too_many_arguments)]
+pub fn measure(
+    scene: &Arc<Scene>,
+    config: &BenchConfig,
+    reference: &Image,
+    reference_mse: f64,
+    max_spp: u32,
+    seed: u64,
+    threads: usize,
+) -> Result<Vec<Checkpoint>> {
+    let scene = match config.light_sampling {
+        Some(mode) => {
+            let mut s = (**scene).clone();
+            s.set_light_sampling(mode);
+            Arc::new(s)
+        }
+        None => scene.clone(),
+    };
+    let pixels = f64::from(scene.camera.width) * f64::from(scene.camera.height);
+    let pool = crate::render::thread_pool(threads)?;
+    let mut out = Vec::new();
+    let mut spp = 1;
+    while spp <= max_spp {
+        let settings = RenderSettings {
+            integrator: config.integrator.build(),
+            sampler: config.sampler,
+            seed,
+            planned_spp: spp,
+            threads,
+            adaptive: None,
+        };
+        let session = Session::with_pool(scene.clone(), settings, pool.clone());
+        let start = Instant::now();
+        let mut done = 0;
+        while done < spp {
+            let k = (spp - done).min(64);
+            session.render_pass(k);
+            done += k;
+        }
+        let seconds = start.elapsed().as_secs_f64();
+        let stats = session.stats();
+        let error = session.snapshot().image.compare(reference)?;
+        out.push(Checkpoint {
+            spp,
+            seconds,
+            rays_per_pixel: stats.rays.total() as f64 / pixels,
+            error,
+            rmse: (error.rmse * error.rmse - reference_mse).max(0.0).sqrt(),
+        });
+        if config.integrator.build().is_deterministic() {
+            break;
+        }
+        spp *= 2;
+    }
+    Ok(out)
+}
+
+/// Mean over pixels and channels of a per-pixel variance image: the MSE a
+/// reference with that variance adds to every comparison.
+pub fn mean_variance(variance: &Image) -> f64 {
+    let n = (variance.pixels.len() * 3).max(1) as f64;
+    variance
+        .pixels
+        .iter()
+        .flat_map(|p| p.iter())
+        .map(|v| f64::from(*v))
+        .sum::<f64>()
+        / n
+}
+
+/// Least-squares slope of log(rmse) against log(spp) over the checkpoints
+/// with at least `from_spp` samples (the asymptotic rate).
+pub fn log_log_slope(points: &[Checkpoint], from_spp: u32) -> Option<f64> {
+    let xy: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|p| p.spp >= from_spp && p.rmse > 0.0)
+        .map(|p| (f64::from(p.spp).ln(), p.rmse.ln()))
+        .collect();
+    if xy.len() < 2 {
+        return None;
+    }
+    let n = xy.len() as f64;
+    let (mx, my) = (
+        xy.iter().map(|p| p.0).sum::<f64>() / n,
+        xy.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let sxy: f64 = xy.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = xy.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn configs_parse_with_options_and_reject_typos() {
+        let c = BenchConfig::parse("mcrt:independent:shadow-rays=5:glossy-rays=2:max-depth=3")
+            .unwrap();
+        assert_eq!(c.integrator.kind, IntegratorKind::Mcrt);
+        assert_eq!((c.integrator.shadow_rays, c.integrator.glossy_rays), (5, 2));
+        assert_eq!(c.integrator.max_depth, 3);
+        let c = BenchConfig::parse("path:sobol:strategy=light:light-sampling=solid-angle").unwrap();
+        assert_eq!(c.sampler, SamplerKind::Sobol);
+        assert_eq!(c.integrator.strategy, Strategy::Light);
+        assert_eq!(c.light_sampling, Some(LightSampling::SolidAngle));
+        assert!(BenchConfig::parse("paht:sobol").is_err());
+        assert!(BenchConfig::parse("path:sobel").is_err());
+        assert!(BenchConfig::parse("path:sobol:depth=3").is_err());
+        assert!(BenchConfig::parse("path:sobol:max-depth=x").is_err());
+    }
+
+    #[test]
+    fn slope_of_a_power_law_is_its_exponent() {
+        let points: Vec<Checkpoint> = (0..8)
+            .map(|k| {
+                let spp = 1u32 << k;
+                let rmse = 0.3 * f64::from(spp).powf(-0.75);
+                Checkpoint {
+                    rmse,
+                    spp,
+                    seconds: 0.0,
+                    rays_per_pixel: 0.0,
+                    error: ErrorMetrics {
+                        rmse,
+                        relative_mse: 0.0,
+                        mean_relative_error: 0.0,
+                    },
+                }
+            })
+            .collect();
+        assert!((log_log_slope(&points, 1).unwrap() + 0.75).abs() < 1e-9);
+    }
+}
