@@ -29,6 +29,12 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn paths_per_second(threads: usize) -> f64 {
+    paths_per_second_with(threads, false)
+}
+
+/// `general`: force the general path loop instead of the one specialised for
+/// the Cornell box (Lambertian only, no specular surfaces).
+fn paths_per_second_with(threads: usize, general: bool) -> f64 {
     let scene = Arc::new(
         Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml"))
             .unwrap(),
@@ -36,7 +42,10 @@ fn paths_per_second(threads: usize) -> f64 {
     let runs = (0..5)
         .map(|seed| {
             let settings = RenderSettings {
-                integrator: Integrator::Path(PathTracer::default()),
+                integrator: Integrator::Path(PathTracer {
+                    general,
+                    ..PathTracer::default()
+                }),
                 sampler: SamplerKind::Independent,
                 seed,
                 planned_spp: 32,
@@ -160,6 +169,19 @@ fn main() {
             paths_per_second(threads) * 1e-6
         );
     }
+    // Specialisation: interleaved runs so that drift hits both alike.
+    let (mut special, mut general) = (Vec::new(), Vec::new());
+    for _ in 0..3 {
+        special.push(paths_per_second_with(2, false));
+        general.push(paths_per_second_with(2, true));
+    }
+    let (special, general) = (median(special), median(general));
+    println!(
+        "Cornell box, 2 threads: specialised loop {:.3} M paths/s, general loop {:.3} M paths/s ({:+.1}%)",
+        special * 1e-6,
+        general * 1e-6,
+        100.0 * (special / general - 1.0)
+    );
     let cornell =
         Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml"))
             .unwrap();

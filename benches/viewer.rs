@@ -52,7 +52,9 @@ fn percentile(mut v: Vec<f64>, q: f64) -> f64 {
 
 fn main() {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    println!("viewer responsiveness, 512x512 Cornell box, {cores} cores, kittest (no GPU painting)");
+    println!(
+        "viewer responsiveness, 512x512 Cornell box, {cores} cores, kittest (no GPU painting)"
+    );
     let mut h = harness();
     let rss_start = resident_memory_mib().unwrap_or(f64::NAN);
 

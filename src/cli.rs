@@ -8,10 +8,10 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tracelab::convergence::{BenchConfig, Checkpoint, log_log_slope, mean_variance, measure};
 use tracelab::image::{Image, check_writable};
-use tracelab::plot::{Series, log_log_svg};
 use tracelab::integrator::{
     GlassShadows, IntegratorKind, IntegratorOptions, MisHeuristic, Strategy,
 };
+use tracelab::plot::{Series, log_log_svg};
 use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
 use tracelab::sampling::SamplerKind;
 use tracelab::scene::light::LightSampling;
@@ -73,7 +73,7 @@ struct ViewArgs {
     /// Samples per pixel to wait for before --screenshot.
     #[arg(long, default_value_t = 64, requires = "screenshot")]
     after_spp: u32,
-    /// Start a side-by-side comparison (B = A with the stratified sampler).
+    /// Start a side-by-side comparison (B = A with the Sobol sampler).
     #[arg(long)]
     compare: bool,
     /// Render threads (default: one per core).
@@ -102,6 +102,10 @@ struct BenchArgs {
     /// Samples per pixel of a rendered reference.
     #[arg(long, default_value_t = 8192)]
     reference_spp: u32,
+    /// Configuration of a rendered reference (match the depth of the
+    /// configurations measured).
+    #[arg(long, default_value = "path:sobol")]
+    reference_config: String,
     /// A configuration `integrator:sampler[:key=value...]`, e.g. `path:sobol`,
     /// `path:stratified:max-depth=1`, `mcrt:independent:shadow-rays=5:glossy-rays=5:max-depth=2`,
     /// `light:independent`; keys: max-depth, rr-depth, rr=off, shadow-rays, glossy-rays,
@@ -227,6 +231,10 @@ struct RenderArgs {
     /// MC ray tracing: BSDF samples (branching rays) per hit.
     #[arg(long, default_value_t = 1)]
     glossy_rays: u32,
+    /// Path tracing: run the general loop, not the one specialised for the
+    /// scene's features (to measure what specialisation saves).
+    #[arg(long)]
+    general: bool,
     /// Whitted: constant ambient radiance times the diffuse albedo.
     #[arg(long, default_value_t = 0.0)]
     ambient: f32,
@@ -555,6 +563,7 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
             GlassShadowsArg::Opaque => GlassShadows::Opaque,
             GlassShadowsArg::Tinted => GlassShadows::Tinted,
         },
+        general: args.general,
     })
 }
 
@@ -603,6 +612,14 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         per_pixel(stats.rays.shadow),
         per_pixel(stats.rays.bounce)
     );
+    if let tracelab::integrator::Integrator::Path(p) = settings.integrator {
+        let skipped = session.scene().features.skipped();
+        if p.general {
+            eprintln!("general path loop (--general): nothing skipped");
+        } else {
+            eprintln!("specialised for this scene: skipped {}", skipped.join(", "));
+        }
+    }
     if let Some(a) = settings.adaptive {
         let planned = stats.samples + stats.skipped;
         eprintln!(
@@ -659,7 +676,13 @@ fn bench(args: &BenchArgs) -> Result<()> {
     let scene = Arc::new(scene);
     let reference = match &args.reference {
         Some(path) => Image::read(path)?,
-        None => cached_reference(&args.scene, &scene, args.reference_spp, args.threads)?,
+        None => cached_reference(
+            &args.scene,
+            &scene,
+            &BenchConfig::parse(&args.reference_config)?,
+            args.reference_spp,
+            args.threads,
+        )?,
     };
     let reference_mse = match &args.reference_variance {
         Some(path) => mean_variance(&Image::read(path)?),
@@ -703,7 +726,10 @@ fn bench(args: &BenchArgs) -> Result<()> {
             );
         }
         match log_log_slope(&points, args.slope_from) {
-            Some(slope) => println!("  log-log slope of RMSE vs spp (from {} spp): {slope:.3}", args.slope_from),
+            Some(slope) => println!(
+                "  log-log slope of RMSE vs spp (from {} spp): {slope:.3}",
+                args.slope_from
+            ),
             None => println!("  (too few points for a slope)"),
         }
         results.push((config.label.clone(), points));
@@ -740,6 +766,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
 fn cached_reference(
     scene_path: &Path,
     scene: &Arc<Scene>,
+    config: &BenchConfig,
     spp: u32,
     threads: usize,
 ) -> Result<Image> {
@@ -748,8 +775,13 @@ fn cached_reference(
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene".into());
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/tracelab-references");
+    let config_name: String = config
+        .label
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+        .collect();
     let path = dir.join(format!(
-        "{stem}_{}x{}_{spp}spp.exr",
+        "{stem}_{}x{}_{config_name}_{spp}spp.exr",
         scene.camera.width, scene.camera.height
     ));
     if path.is_file() {
@@ -757,7 +789,8 @@ fn cached_reference(
         return Image::read(&path);
     }
     eprintln!(
-        "no --reference: rendering one (path tracing, Sobol, {spp} spp) to {}",
+        "no --reference: rendering one ({}, {spp} spp) to {}",
+        config.label,
         path.display()
     );
     std::fs::create_dir_all(&dir)
@@ -765,8 +798,8 @@ fn cached_reference(
     let session = Session::new(
         scene.clone(),
         RenderSettings {
-            integrator: IntegratorOptions::default().build(),
-            sampler: SamplerKind::Sobol,
+            integrator: config.integrator.build(),
+            sampler: config.sampler,
             seed: 0x5eed,
             planned_spp: spp,
             threads,

@@ -80,7 +80,11 @@ impl BenchConfig {
                     light_sampling = Some(match value {
                         "area" => LightSampling::Area,
                         "solid-angle" => LightSampling::SolidAngle,
-                        _ => return Err(err(format!("light-sampling `{value}` (area, solid-angle)"))),
+                        _ => {
+                            return Err(err(format!(
+                                "light-sampling `{value}` (area, solid-angle)"
+                            )));
+                        }
                     })
                 }
                 _ => return Err(err(format!("unknown option `{key}`"))),
@@ -207,8 +211,8 @@ mod tests {
 
     #[test]
     fn configs_parse_with_options_and_reject_typos() {
-        let c = BenchConfig::parse("mcrt:independent:shadow-rays=5:glossy-rays=2:max-depth=3")
-            .unwrap();
+        let c =
+            BenchConfig::parse("mcrt:independent:shadow-rays=5:glossy-rays=2:max-depth=3").unwrap();
         assert_eq!(c.integrator.kind, IntegratorKind::Mcrt);
         assert_eq!((c.integrator.shadow_rays, c.integrator.glossy_rays), (5, 2));
         assert_eq!(c.integrator.max_depth, 3);

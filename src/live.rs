@@ -12,7 +12,6 @@
 use crate::error::Result;
 use crate::film::FilmSnapshot;
 use crate::image::Image;
-use crate::math::luminance;
 use crate::render::{RenderSettings, RenderStats, Session, thread_pool};
 use crate::scene::Scene;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
@@ -47,7 +46,7 @@ pub struct LiveConfig {
 pub struct ErrorPoint {
     pub spp: u32,
     pub seconds: f64,
-    /// Mean relative standard error of the pixels (the film's own noise estimate).
+    /// RMSE expected from the film's own variance ([`estimated_rmse`]).
     pub noise: f64,
     /// RMSE against the reference, when one is set and matches the image size.
     pub rmse: Option<f64>,
@@ -348,7 +347,7 @@ impl Job {
         let point = ErrorPoint {
             spp: stats.spp,
             seconds: stats.render_time.as_secs_f64(),
-            noise: mean_relative_standard_error(&snapshot),
+            noise: estimated_rmse(&snapshot),
             rmse: self
                 .reference
                 .as_ref()
@@ -378,29 +377,29 @@ impl Job {
     }
 }
 
-/// Mean over pixels of luminance(standard error) / luminance(mean), with the
-/// mean floored at 1% of the image's average luminance so that dark pixels
-/// (and pixels still black after a few samples) neither vanish from the
-/// average nor dominate it. Pixels with fewer than two samples are skipped.
-pub fn mean_relative_standard_error(snapshot: &FilmSnapshot) -> f64 {
-    let image_mean = luminance(snapshot.image.mean().map(|v| v as f32).into());
-    let floor = 0.01 * image_mean.max(1e-12);
+/// The RMSE the film expects against the truth: sqrt of the mean over
+/// pixels and channels of the squared standard error. Each s^2 / n is an
+/// unbiased estimate of its pixel's squared error, so the mean is unbiased at
+/// any sample count (a mean of per-pixel *relative* errors is not: ratios and
+/// square roots of few samples are biased low). It assumes independent
+/// samples, so it overstates the error of stratified and Sobol sampling;
+/// with a reference loaded the true RMSE is shown as well.
+pub fn estimated_rmse(snapshot: &FilmSnapshot) -> f64 {
     let mut sum = 0.0f64;
     let mut n = 0usize;
-    for (mean, se) in snapshot
-        .image
-        .pixels
-        .iter()
-        .zip(&snapshot.standard_error.pixels)
-    {
-        let s = luminance((*se).into());
-        if s.is_finite() {
-            let m = luminance((*mean).into()).max(0.0);
-            sum += f64::from(s / (m + floor));
-            n += 1;
+    for se in &snapshot.standard_error.pixels {
+        for &v in se {
+            if v.is_finite() {
+                sum += f64::from(v) * f64::from(v);
+                n += 1;
+            }
         }
     }
-    if n == 0 { f64::NAN } else { sum / n as f64 }
+    if n == 0 {
+        f64::NAN
+    } else {
+        (sum / n as f64).sqrt()
+    }
 }
 
 #[cfg(test)]

@@ -52,8 +52,16 @@ pub fn log_log_svg(
     let (x0, x1, y0, y1) = (x0 / 1.2, x1 * 1.2, y0 / 1.5, y1 * 1.5);
     let guides = series.first().and_then(|s| s.points.first().copied());
     write_atomically(path, |tmp| {
-        draw(tmp, title, x_label, y_label, series, (x0, x1, y0, y1), guides)
-            .map_err(|e| e.to_string())
+        draw(
+            tmp,
+            title,
+            x_label,
+            y_label,
+            series,
+            (x0, x1, y0, y1),
+            guides,
+        )
+        .map_err(|e| e.to_string())
     })
 }
 
@@ -90,7 +98,9 @@ fn draw(
                     ShapeStyle::from(&RGBColor(170, 170, 170)).stroke_width(1),
                 ))?
                 .label(name)
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RGBColor(170, 170, 170)));
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], RGBColor(170, 170, 170))
+                });
         }
     }
     for (i, s) in series.iter().enumerate() {
@@ -102,7 +112,10 @@ fn draw(
             ))?
             .label(s.name.as_str())
             .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], ShapeStyle::from(&color).stroke_width(2))
+                PathElement::new(
+                    vec![(x, y), (x + 18, y)],
+                    ShapeStyle::from(&color).stroke_width(2),
+                )
             });
         chart.draw_series(s.points.iter().map(|p| Circle::new(*p, 3, color.filled())))?;
     }

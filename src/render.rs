@@ -173,49 +173,53 @@ impl Session {
         let deterministic = settings.integrator.is_deterministic();
         let width = self.film.width();
         self.pool.install(|| {
-            self.film.tiles().par_iter().enumerate().for_each(|(index, tile)| {
-                if index as u32 % parts != part || self.cancelled.load(Ordering::Relaxed) {
-                    return;
-                }
-                let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
-                let mut sampler =
-                    Sampler::new(settings.sampler, settings.seed, settings.planned_spp);
-                let mut counts = RayCounts::default();
-                let mut non_finite = 0u64;
-                let mut skipped = 0u64;
-                let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
-                for (i, pixel) in tile.pixels.iter_mut().enumerate() {
-                    let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
-                    let pixel_index = y * width + x;
-                    if let Some(a) = settings.adaptive
-                        && pixel.count >= a.min_spp
-                        && pixel.relative_standard_error() < a.threshold
-                    {
-                        skipped += u64::from(spp);
-                        continue;
+            self.film
+                .tiles()
+                .par_iter()
+                .enumerate()
+                .for_each(|(index, tile)| {
+                    if index as u32 % parts != part || self.cancelled.load(Ordering::Relaxed) {
+                        return;
                     }
-                    for s in first..first + spp {
-                        sampler.start(pixel_index, s);
-                        let mut film_point = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-                        let mut lens = sampler.next_2d();
-                        if deterministic {
-                            film_point = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                            lens = Vec2::splat(0.5);
+                    let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
+                    let mut sampler =
+                        Sampler::new(settings.sampler, settings.seed, settings.planned_spp);
+                    let mut counts = RayCounts::default();
+                    let mut non_finite = 0u64;
+                    let mut skipped = 0u64;
+                    let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
+                    for (i, pixel) in tile.pixels.iter_mut().enumerate() {
+                        let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
+                        let pixel_index = y * width + x;
+                        if let Some(a) = settings.adaptive
+                            && pixel.count >= a.min_spp
+                            && pixel.relative_standard_error() < a.threshold
+                        {
+                            skipped += u64::from(spp);
+                            continue;
                         }
-                        let ray = scene.camera.generate_ray(film_point, lens);
-                        counts.camera += 1;
-                        let value =
-                            settings
-                                .integrator
-                                .radiance(scene, ray, &mut sampler, &mut counts);
-                        non_finite += u64::from(!value.is_finite());
-                        pixel.add(value);
+                        for s in first..first + spp {
+                            sampler.start(pixel_index, s);
+                            let mut film_point = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+                            let mut lens = sampler.next_2d();
+                            if deterministic {
+                                film_point = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                                lens = Vec2::splat(0.5);
+                            }
+                            let ray = scene.camera.generate_ray(film_point, lens);
+                            counts.camera += 1;
+                            let value =
+                                settings
+                                    .integrator
+                                    .radiance(scene, ray, &mut sampler, &mut counts);
+                            non_finite += u64::from(!value.is_finite());
+                            pixel.add(value);
+                        }
                     }
-                }
-                drop(tile);
-                self.add_counts(counts.camera, &counts, non_finite);
-                self.skipped.fetch_add(skipped, Ordering::Relaxed);
-            });
+                    drop(tile);
+                    self.add_counts(counts.camera, &counts, non_finite);
+                    self.skipped.fetch_add(skipped, Ordering::Relaxed);
+                });
         });
     }
 

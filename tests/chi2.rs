@@ -15,7 +15,7 @@ use tracelab::accel::{Geometry, NO_LIGHT, TriangleInput};
 use tracelab::math::{Frame, Rgb};
 use tracelab::sampling::hash::{hash_combine, to_unit_float};
 use tracelab::sampling::warp::*;
-use tracelab::scene::light::{Light, Lights, LightSampling};
+use tracelab::scene::light::{Light, LightSampling, Lights};
 use tracelab::scene::material::{Bsdf, fresnel_dielectric};
 
 /// Number of `assert_fits` calls below.
@@ -393,7 +393,13 @@ fn triangle_light_area_sampling_in_solid_angle() {
 fn triangle_light_spherical_triangle_sampling() {
     // Arvo's sampling: the density must be constant, 1 / solid angle.
     let (reference, lights, geometry) = triangle_light(LightSampling::SolidAngle);
-    check_light("triangle light, solid angle", 12, reference, &lights, &geometry);
+    check_light(
+        "triangle light, solid angle",
+        12,
+        reference,
+        &lights,
+        &geometry,
+    );
     // A small far triangle (solid angle below the f32-safe range) falls back
     // to area sampling consistently in sample and pdf.
     let far = reference + Vec3A::new(0.0, 0.0, 300.0);

@@ -178,7 +178,7 @@ fn window_layout_snapshot() {
     // the statistics panel right of the controls (the image, the controls
     // and the panel layout stay in the comparison).
     harness.mask(egui::Rect::from_min_max(
-        pos2(312.0, 540.0),
+        pos2(312.0, 570.0),
         pos2(SIZE.x, SIZE.y),
     ));
     harness.snapshot_options(

@@ -68,6 +68,8 @@ pub struct IntegratorOptions {
     /// Whitted's constant ambient radiance (grey).
     pub ambient: f32,
     pub glass_shadows: GlassShadows,
+    /// Path tracing: the general loop even where a specialised one applies.
+    pub general: bool,
 }
 
 impl Default for IntegratorOptions {
@@ -83,6 +85,7 @@ impl Default for IntegratorOptions {
             glossy_rays: 1,
             ambient: 0.0,
             glass_shadows: GlassShadows::Opaque,
+            general: false,
         }
     }
 }
@@ -116,6 +119,7 @@ impl IntegratorOptions {
                     Strategy::Light => MisHeuristic::None,
                     _ => mis,
                 },
+                general: self.general,
             }),
             IntegratorKind::Light => Integrator::Light(LightTracer {
                 max_depth: self.max_depth,

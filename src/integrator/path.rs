@@ -12,8 +12,12 @@ use super::{MisHeuristic, RayCounts};
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::sampling::Sampler;
+use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::scene::Scene;
 use crate::scene::light::LightSample;
+use crate::scene::material::{Bsdf, BsdfSample};
+use glam::{Vec2, Vec3A};
+use std::f32::consts::FRAC_1_PI;
 
 /// Settings of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +33,9 @@ pub struct PathTracer {
     pub nee: bool,
     /// How NEE and BSDF sampling share direct light when NEE is on.
     pub mis: MisHeuristic,
+    /// Use the general loop even where the scene allows a specialised one
+    /// (for measuring what specialisation saves).
+    pub general: bool,
 }
 
 impl Default for PathTracer {
@@ -39,6 +46,7 @@ impl Default for PathTracer {
             russian_roulette: true,
             nee: true,
             mis: MisHeuristic::Power,
+            general: false,
         }
     }
 }
@@ -59,8 +67,29 @@ impl PathTracer {
         )
     }
 
-    /// One radiance sample along `ray`.
+    /// One radiance sample along `ray`, by the loop specialised for what
+    /// the scene uses (see [`crate::scene::Features`]).
+    #[inline]
     pub fn radiance(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
+        let f = scene.features;
+        if self.general || f.specular() {
+            self.trace::<true, false>(scene, ray, sampler, counts)
+        } else if f.diffuse_only() {
+            self.trace::<false, true>(scene, ray, sampler, counts)
+        } else {
+            self.trace::<false, false>(scene, ray, sampler, counts)
+        }
+    }
+
+    /// The path loop. `SPECULAR`: the scene may have mirror or glass
+    /// surfaces. `DIFFUSE_ONLY`: every BSDF is Lambertian.
+    fn trace<const SPECULAR: bool, const DIFFUSE_ONLY: bool>(
         &self,
         scene: &Scene,
         mut ray: Ray,
@@ -114,15 +143,15 @@ impl PathTracer {
             let u_bsdf = sampler.next_2d();
             let u_roulette = sampler.next_1d();
 
-            if self.nee && !bsdf.is_specular() {
+            if self.nee && !(SPECULAR && bsdf.is_specular()) {
                 if let Some(ls) = scene.lights.sample(hit.point, u_light_select, u_light) {
                     let wi = frame.to_local(ls.wi);
-                    let f = bsdf.eval(wo, wi);
+                    let f = eval::<DIFFUSE_ONLY>(&bsdf, wo, wi);
                     if f.max_element() > 0.0 {
                         let weight = if ls.delta || self.mis == MisHeuristic::None {
                             1.0
                         } else {
-                            self.mis.weight(ls.pdf, bsdf.pdf(wo, wi))
+                            self.mis.weight(ls.pdf, pdf::<DIFFUSE_ONLY>(&bsdf, wo, wi))
                         };
                         counts.shadow += 1;
                         if !scene.geometry.occluded(&shadow_ray(&hit, &ls)) {
@@ -132,11 +161,11 @@ impl PathTracer {
                 }
             }
 
-            let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
+            let Some(sample) = sample::<DIFFUSE_ONLY>(&bsdf, wo, u_lobe, u_bsdf) else {
                 break;
             };
             beta *= sample.weight;
-            specular_bounce = sample.specular;
+            specular_bounce = SPECULAR && sample.specular;
             prev_bsdf_pdf = sample.pdf;
             prev_point = hit.point;
             bounces += 1;
@@ -163,6 +192,56 @@ impl PathTracer {
         }
         radiance
     }
+}
+
+/// BSDF evaluation; Lambertian inline when the scene has nothing else.
+#[inline(always)]
+fn eval<const DIFFUSE_ONLY: bool>(bsdf: &Bsdf, wo: Vec3A, wi: Vec3A) -> Rgb {
+    if DIFFUSE_ONLY && let Bsdf::Diffuse { albedo } = *bsdf {
+        return if wo.z * wi.z > 0.0 {
+            albedo * FRAC_1_PI
+        } else {
+            Rgb::ZERO
+        };
+    }
+    bsdf.eval(wo, wi)
+}
+
+#[inline(always)]
+fn pdf<const DIFFUSE_ONLY: bool>(bsdf: &Bsdf, wo: Vec3A, wi: Vec3A) -> f32 {
+    if DIFFUSE_ONLY && matches!(bsdf, Bsdf::Diffuse { .. }) {
+        return if wo.z * wi.z > 0.0 {
+            wi.z.abs() * FRAC_1_PI
+        } else {
+            0.0
+        };
+    }
+    bsdf.pdf(wo, wi)
+}
+
+#[inline(always)]
+fn sample<const DIFFUSE_ONLY: bool>(
+    bsdf: &Bsdf,
+    wo: Vec3A,
+    u_lobe: f32,
+    u: Vec2,
+) -> Option<BsdfSample> {
+    if DIFFUSE_ONLY && let Bsdf::Diffuse { albedo } = *bsdf {
+        let mut wi = square_to_cosine_hemisphere(u);
+        if wo.z < 0.0 {
+            wi.z = -wi.z;
+        }
+        if wi.z == 0.0 || wo.z == 0.0 {
+            return None;
+        }
+        return Some(BsdfSample {
+            wi,
+            weight: albedo,
+            pdf: wi.z.abs() * FRAC_1_PI,
+            specular: false,
+        });
+    }
+    bsdf.sample(wo, u_lobe, u)
 }
 
 /// Shadow ray from a surface hit to a sampled light point, both ends moved

@@ -340,7 +340,10 @@ mod tests {
                 let p = points(SamplerKind::Sobol, 256, skip, first);
                 for a in 0..=8 {
                     let c = counts(&p, 1 << a, 1 << (8 - a));
-                    assert!(c.iter().all(|&c| c == 1), "skip {skip} first {first} 2^{a}: {c:?}");
+                    assert!(
+                        c.iter().all(|&c| c == 1),
+                        "skip {skip} first {first} 2^{a}: {c:?}"
+                    );
                 }
             }
         }

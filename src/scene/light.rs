@@ -7,11 +7,11 @@
 //! the shading point, so the integrators can combine them with BSDF densities.
 
 use crate::math::{Frame, Rgb, gamma, luminance};
-use crate::sampling::{AliasTable, spherical_triangle};
 use crate::sampling::warp::{
     cosine_hemisphere_pdf, square_to_cosine_hemisphere, square_to_uniform_cone,
     square_to_uniform_sphere, square_to_uniform_triangle, uniform_cone_pdf,
 };
+use crate::sampling::{AliasTable, spherical_triangle};
 use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
 

@@ -11,8 +11,8 @@ pub mod obj;
 use crate::accel::{Geometry, Sphere, TriangleInput};
 use crate::error::{Error, Result};
 use camera::Camera;
-use light::{Light, Lights, LightSampling};
-use material::Material;
+use light::{Light, LightSampling, Lights};
+use material::{Bsdf, Material};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -57,6 +57,72 @@ pub struct SceneInput {
     pub triangle_sampling: LightSampling,
 }
 
+/// What a scene uses, detected at load, so that estimators can run a hot
+/// loop specialised for it (no specular branches without mirrors or glass,
+/// Lambertian-only BSDF code when every material is diffuse).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Features {
+    pub mirror: bool,
+    pub dielectric: bool,
+    pub glossy: bool,
+    pub point_lights: bool,
+    pub spheres: bool,
+    pub area_lights: usize,
+}
+
+impl Features {
+    fn detect(materials: &[Material], geometry: &Geometry, lights: &Lights) -> Features {
+        let used = |f: &dyn Fn(&Bsdf) -> bool| materials.iter().any(|m| f(&m.bsdf));
+        Features {
+            mirror: used(&|b| matches!(b, Bsdf::Mirror { .. })),
+            dielectric: used(&|b| matches!(b, Bsdf::Dielectric { .. })),
+            glossy: used(&|b| matches!(b, Bsdf::Glossy { .. })),
+            point_lights: lights
+                .as_slice()
+                .iter()
+                .any(|l| matches!(l, Light::Point { .. })),
+            spheres: !geometry.spheres().is_empty(),
+            area_lights: lights
+                .as_slice()
+                .iter()
+                .filter(|l| !matches!(l, Light::Point { .. }))
+                .count(),
+        }
+    }
+
+    /// True when some surface is a mirror or glass.
+    pub fn specular(&self) -> bool {
+        self.mirror || self.dielectric
+    }
+
+    /// True when every material is Lambertian.
+    pub fn diffuse_only(&self) -> bool {
+        !self.specular() && !self.glossy
+    }
+
+    /// What the specialised code paths leave out, for render summaries.
+    pub fn skipped(&self) -> Vec<&'static str> {
+        let mut v = Vec::new();
+        if !self.dielectric {
+            v.push("refraction");
+        }
+        if !self.specular() {
+            v.push("specular-bounce branches");
+        }
+        if self.diffuse_only() {
+            v.push("non-Lambertian BSDF code");
+        }
+        if !self.point_lights {
+            v.push("point lights");
+        }
+        if !self.spheres {
+            v.push("sphere intersection");
+        }
+        v.push("time dimension (static scene)");
+        v
+    }
+}
+
 /// A scene ready to render.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -65,6 +131,7 @@ pub struct Scene {
     pub geometry: Arc<Geometry>,
     pub materials: Vec<Material>,
     pub lights: Lights,
+    pub features: Features,
     /// Things the user should know that did not stop loading (dropped triangles, ...).
     pub warnings: Vec<String>,
 }
@@ -164,8 +231,10 @@ impl Scene {
         if lights.is_empty() {
             warnings.push("the scene has no light source: the image will be black".into());
         }
+        let features = Features::detect(&input.materials, &geometry, &lights);
         Ok(Scene {
             camera: input.camera,
+            features,
             geometry: Arc::new(geometry),
             materials: input.materials,
             lights,

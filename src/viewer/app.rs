@@ -29,7 +29,7 @@ pub struct Launch {
     /// Save the window here once every view has `after_spp` samples, then quit.
     pub screenshot: Option<PathBuf>,
     pub after_spp: u32,
-    /// Open a side-by-side comparison (A as given, B stratified).
+    /// Open a side-by-side comparison (A as given, B with the Sobol sampler).
     pub compare: bool,
     /// Render threads (0 = one per core).
     pub threads: usize,
@@ -167,7 +167,7 @@ impl ViewerApp {
         if launch.compare {
             settings.compare = true;
             settings.b = Config {
-                sampler: crate::sampling::SamplerKind::Stratified,
+                sampler: crate::sampling::SamplerKind::Sobol,
                 ..settings.a
             };
         }

@@ -139,7 +139,7 @@ fn layout(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing) {
     // A fixed height: the plot fills it, and the image above keeps its place.
     egui::Panel::bottom("statistics")
         .resizable(false)
-        .exact_size(270.0)
+        .exact_size(250.0)
         .show(ui, |ui| {
             stats::stats_panel(ui, app);
             stats::convergence_plot(ui, app);

@@ -89,10 +89,10 @@ fn compare_section(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing
     let was = app.settings.compare;
     ui.checkbox(&mut app.settings.compare, "Side-by-side comparison");
     if app.settings.compare && !was {
-        // B starts as a copy of A with the other sampler: one change to study.
+        // B starts as a copy of A with another sampler: one change to study.
         app.settings.b = Config {
             sampler: match app.settings.a.sampler {
-                SamplerKind::Independent => SamplerKind::Stratified,
+                SamplerKind::Independent => SamplerKind::Sobol,
                 _ => SamplerKind::Independent,
             },
             ..app.settings.a
@@ -174,7 +174,11 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
         ui.label("Sampler");
         ui.radio_value(&mut config.sampler, SamplerKind::Independent, "Independent");
         ui.radio_value(&mut config.sampler, SamplerKind::Stratified, "Stratified");
-        ui.radio_value(&mut config.sampler, SamplerKind::MultiJittered, "Multi-jittered");
+        ui.radio_value(
+            &mut config.sampler,
+            SamplerKind::MultiJittered,
+            "Multi-jittered",
+        );
         ui.radio_value(&mut config.sampler, SamplerKind::Sobol, "Sobol");
     });
     let mut stratified = config.sampler != SamplerKind::Independent;

@@ -159,7 +159,7 @@ impl Default for Settings {
             scene_path: "scenes/cornell_box.toml".into(),
             a: Config::default(),
             b: Config {
-                sampler: SamplerKind::Stratified,
+                sampler: SamplerKind::Sobol,
                 ..Config::default()
             },
             compare: false,

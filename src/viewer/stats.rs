@@ -48,7 +48,7 @@ fn view_summary(name: &str, view: &LiveView, app: &ViewerApp) -> String {
     let pixels = view.snapshot.samples.len().max(1) as f64;
     let last = view.history.last();
     let mut text = format!(
-        "{name} {} spp | {:.2} s | {:.2} M samples/s | {:.1} M rays/s | rays/px {:.0} (cam {:.0}, shadow {:.0}, bounce {:.0}) | noise {:.2}%",
+        "{name} {} spp | {:.2} s | {:.2} M samples/s | {:.1} M rays/s | rays/px {:.0} (cam {:.0}, shadow {:.0}, bounce {:.0}) | est. RMSE {:.5}",
         s.spp,
         s.render_time.as_secs_f64(),
         s.samples as f64 / seconds * 1e-6,
@@ -57,7 +57,7 @@ fn view_summary(name: &str, view: &LiveView, app: &ViewerApp) -> String {
         s.rays.camera as f64 / pixels,
         s.rays.shadow as f64 / pixels,
         s.rays.bounce as f64 / pixels,
-        last.map_or(f64::NAN, |p| p.noise * 100.0),
+        last.map_or(f64::NAN, |p| p.noise),
     );
     if let Some(rmse) = last.and_then(|p| p.rmse) {
         text += &format!(" | RMSE {rmse:.5}");
@@ -104,7 +104,7 @@ pub fn convergence_plot(ui: &mut egui::Ui, app: &mut ViewerApp) {
         ui.label(if use_rmse {
             "RMSE vs reference"
         } else {
-            "Noise (mean relative std. error)"
+            "Estimated RMSE (film variance; load a reference for the true RMSE)"
         });
         ui.radio_value(&mut app.settings.display.plot_time, false, "vs spp");
         ui.radio_value(&mut app.settings.display.plot_time, true, "vs time");
