@@ -75,6 +75,7 @@ fn main() {
 
     // 2. Setting changes: time to the first frame of the new settings on screen.
     let mut latencies = Vec::new();
+    let mut latencies_path = Vec::new();
     for i in 0..100u64 {
         {
             let settings = &mut h.state_mut().app.settings;
@@ -97,7 +98,11 @@ fn main() {
             let f = app.frame();
             if f.generation == app.live().generation() && f.views.iter().all(|v| v.stats.spp >= 1) {
                 // The frame just built uploaded it (update_textures runs every frame).
-                latencies.push(changed.elapsed().as_secs_f64() * 1e3);
+                let ms = changed.elapsed().as_secs_f64() * 1e3;
+                latencies.push(ms);
+                if i % 3 != 0 {
+                    latencies_path.push(ms);
+                }
                 break;
             }
         }
@@ -110,6 +115,11 @@ fn main() {
         percentile(latencies.clone(), 0.5),
         percentile(latencies.clone(), 0.95),
         percentile(latencies, 1.0)
+    );
+    println!(
+        "  of which path tracing: median {:.0} ms, p95 {:.0} ms; light tracing (whole first pass at once) the rest",
+        percentile(latencies_path.clone(), 0.5),
+        percentile(latencies_path, 0.95)
     );
     let rss_changes = resident_memory_mib().unwrap_or(f64::NAN);
 
@@ -145,9 +155,17 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(30);
     h.state_mut().app.settings.compare = false;
-    let until = Instant::now() + Duration::from_secs(soak);
-    while Instant::now() < until {
+    let soak_start = Instant::now();
+    let mut next_report = 120;
+    while soak_start.elapsed() < Duration::from_secs(soak) {
         frame(&mut h);
+        if soak_start.elapsed() >= Duration::from_secs(next_report) {
+            println!(
+                "  after {next_report} s: {:.0} MiB",
+                resident_memory_mib().unwrap_or(f64::NAN)
+            );
+            next_report += 120;
+        }
     }
     println!(
         "resident memory: {rss_start:.0} MiB at start, {rss_changes:.0} MiB after 100 setting changes, {:.0} MiB after {soak} s more rendering ({} spp)",

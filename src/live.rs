@@ -82,6 +82,7 @@ enum Command {
         reference: Option<Arc<Image>>,
         requested: Instant,
     },
+    SetReference(Option<Arc<Image>>),
     Stop,
 }
 
@@ -148,6 +149,12 @@ impl LiveRender {
             requested: Instant::now(),
         });
         self.generation
+    }
+
+    /// Sets the image that RMSE is measured against from the next pass on,
+    /// without restarting.
+    pub fn set_reference(&mut self, reference: Option<Arc<Image>>) {
+        let _ = self.commands.send(Command::SetReference(reference));
     }
 
     /// The generation of the last restart.
@@ -224,6 +231,12 @@ fn render_loop(shared: &Shared, commands: &Receiver<Command>, pool: &Arc<rayon::
         };
         match command {
             Some(Command::Stop) => return,
+            Some(Command::SetReference(reference)) => {
+                if let Some(job) = job.as_mut() {
+                    job.reference = reference;
+                }
+                continue;
+            }
             Some(Command::Restart {
                 generation,
                 configs,

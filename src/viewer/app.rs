@@ -253,19 +253,37 @@ impl ViewerApp {
         if path.is_empty() {
             self.reference = None;
             self.settings.reference_path.clear();
-            self.force_restart();
+            self.live.set_reference(None);
             return;
         }
         match Image::read(Path::new(path)) {
             Ok(image) => {
-                self.reference = Some(Arc::new(image));
+                let image = Arc::new(image);
+                self.reference = Some(image.clone());
+                self.live.set_reference(Some(image));
                 self.settings.reference_path = path.to_string();
-                self.force_restart();
             }
             Err(e) => {
                 self.reference = None;
                 self.errors.push(e.to_string());
             }
+        }
+    }
+
+    /// Freezes view `index`'s current image as the reference (a long
+    /// tracelab render serves as well as an external one).
+    pub fn use_view_as_reference(&mut self, index: usize) {
+        let frame = self.live.latest();
+        if let Some(view) = frame.views.get(index) {
+            let reference = Arc::new(view.snapshot.image.clone());
+            self.reference = Some(reference.clone());
+            self.live.set_reference(Some(reference));
+            self.settings.reference_path.clear();
+            self.toast(format!(
+                "reference: image {} at {} spp (from now on; render with another seed for an independent estimate)",
+                if index == 0 { "A" } else { "B" },
+                view.stats.spp
+            ));
         }
     }
 

@@ -287,6 +287,13 @@ fn reference_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
             app.settings.reference_path = path;
         }
     });
+    if ui
+        .button("Use image A as reference")
+        .on_hover_text("Freeze the current image A (e.g. a long render) as the reference for RMSE")
+        .clicked()
+    {
+        app.use_view_as_reference(0);
+    }
 }
 
 fn export_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
