@@ -398,16 +398,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     };
     let load_start = Instant::now();
     let mut scene = Scene::load_with_limits(&args.scene, &limits)?;
-    if args.width.is_some() || args.height.is_some() {
-        let (w, h) = (
-            args.width.unwrap_or(scene.camera.width),
-            args.height.unwrap_or(scene.camera.height),
-        );
-        limits
-            .check_resolution(w, h)
-            .map_err(|e| Error::new(format!("--width/--height: {e}")))?;
-        scene.set_resolution(w, h);
-    }
+    override_resolution(&mut scene, args.width, args.height, &limits)?;
     if let Some(mode) = args.light_sampling {
         scene.set_light_sampling(match mode {
             LightSamplingArg::Area => LightSampling::Area,
@@ -477,6 +468,27 @@ fn render(args: &RenderArgs) -> Result<()> {
     }
     print_summary(&session, &stats, load_time);
     eprintln!("wrote {}", args.out.display());
+    Ok(())
+}
+
+/// Applies `--width`/`--height` (either alone keeps the other side).
+fn override_resolution(
+    scene: &mut Scene,
+    width: Option<u32>,
+    height: Option<u32>,
+    limits: &Limits,
+) -> Result<()> {
+    if width.is_none() && height.is_none() {
+        return Ok(());
+    }
+    let (w, h) = (
+        width.unwrap_or(scene.camera.width),
+        height.unwrap_or(scene.camera.height),
+    );
+    limits
+        .check_resolution(w, h)
+        .map_err(|e| Error::new(format!("--width/--height: {e}")))?;
+    scene.set_resolution(w, h);
     Ok(())
 }
 
@@ -663,16 +675,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
         check_writable(path)?;
     }
     let mut scene = Scene::load(&args.scene)?;
-    if args.width.is_some() || args.height.is_some() {
-        let (w, h) = (
-            args.width.unwrap_or(scene.camera.width),
-            args.height.unwrap_or(scene.camera.height),
-        );
-        Limits::default()
-            .check_resolution(w, h)
-            .map_err(|e| Error::new(format!("--width/--height: {e}")))?;
-        scene.set_resolution(w, h);
-    }
+    override_resolution(&mut scene, args.width, args.height, &Limits::default())?;
     let scene = Arc::new(scene);
     let reference = match &args.reference {
         Some(path) => Image::read(path)?,

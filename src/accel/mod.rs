@@ -58,6 +58,18 @@ pub struct SurfaceHit {
     pub light: u32,
 }
 
+impl SurfaceHit {
+    /// A ray leaving the surface in `direction`, its origin moved off the
+    /// surface by the hit's error bound (see [`crate::math::offset_ray_origin`]).
+    #[inline]
+    pub fn spawn_ray(&self, direction: Vec3A) -> Ray {
+        Ray::new(
+            crate::math::offset_ray_origin(self.point, self.error, self.normal, direction),
+            direction,
+        )
+    }
+}
+
 /// Per-triangle data read once per hit.
 #[derive(Clone, Copy, Debug)]
 struct TriangleShading {

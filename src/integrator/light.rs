@@ -16,7 +16,7 @@
 //! radiance scaling at refraction does not apply to particles (Veach's
 //! thesis, 5.2).
 
-use super::RayCounts;
+use super::{RayCounts, survives_roulette};
 use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
@@ -164,21 +164,17 @@ impl LightTracer {
             };
             beta *= importance_weight(bsdf, w_prev, sample.wi, sample.weight);
             bounces += 1;
-            if self.russian_roulette && bounces > self.rr_depth {
-                let q = beta.max_element().min(0.95);
-                if u_roulette >= q {
-                    break;
-                }
-                beta /= q;
+            if self.russian_roulette
+                && bounces > self.rr_depth
+                && !survives_roulette(&mut beta, u_roulette)
+            {
+                break;
             }
             if beta.max_element() <= 0.0 {
                 break;
             }
             let wi_world = frame.to_world(sample.wi);
-            ray = Ray::new(
-                offset_ray_origin(hit.point, hit.error, hit.normal, wi_world),
-                wi_world,
-            );
+            ray = hit.spawn_ray(wi_world);
             counts.bounce += 1;
         }
     }

@@ -12,7 +12,7 @@
 
 use super::{MisHeuristic, RayCounts};
 use crate::accel::{NO_LIGHT, SurfaceHit};
-use crate::math::{Frame, Ray, Rgb, offset_ray_origin};
+use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 
@@ -152,10 +152,7 @@ impl McRayTracer {
                 continue;
             };
             let wi_world = frame.to_world(sample.wi);
-            let ray = Ray::new(
-                offset_ray_origin(hit.point, hit.error, hit.normal, wi_world),
-                wi_world,
-            );
+            let ray = hit.spawn_ray(wi_world);
             counts.bounce += 1;
             let Some(next) = scene.geometry.intersect(&ray) else {
                 continue;

@@ -41,6 +41,20 @@ impl RayCounts {
     }
 }
 
+/// Russian roulette (after the first `rr_depth` bounces): the path survives
+/// with probability q = min(max(beta), 0.95) (Mitsuba's choice) and is
+/// reweighted by 1/q, which keeps the estimate unbiased while paths that
+/// carry little energy end early. Returns false when the path ends.
+#[inline]
+pub(crate) fn survives_roulette(beta: &mut Rgb, u: f32) -> bool {
+    let q = beta.max_element().min(0.95);
+    if u >= q {
+        return false;
+    }
+    *beta /= q;
+    true
+}
+
 /// A configured estimator.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Integrator {

@@ -8,9 +8,9 @@
 //!                               + w_bsdf * Le(x_{k+1})          (BSDF ray hits a light) ]
 //! where beta_k is the product of f cos / p_bsdf (and 1/q of roulette) so far.
 
-use super::{MisHeuristic, RayCounts};
+use super::{MisHeuristic, RayCounts, survives_roulette};
 use crate::accel::{NO_LIGHT, SurfaceHit};
-use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
+use crate::math::{Frame, Ray, Rgb, ray_between};
 use crate::sampling::Sampler;
 use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::scene::Scene;
@@ -170,24 +170,18 @@ impl PathTracer {
             prev_point = hit.point;
             bounces += 1;
 
-            if self.russian_roulette && bounces > self.rr_depth {
-                // Survive with probability q, reweight by 1/q: unbiased, and paths
-                // carrying little energy end early (Mitsuba's q = min(max(beta), 0.95)).
-                let q = beta.max_element().min(0.95);
-                if u_roulette >= q {
-                    break;
-                }
-                beta /= q;
+            if self.russian_roulette
+                && bounces > self.rr_depth
+                && !survives_roulette(&mut beta, u_roulette)
+            {
+                break;
             }
             if beta.max_element() <= 0.0 {
                 break;
             }
 
             let wi_world = frame.to_world(sample.wi);
-            ray = Ray::new(
-                offset_ray_origin(hit.point, hit.error, hit.normal, wi_world),
-                wi_world,
-            );
+            ray = hit.spawn_ray(wi_world);
             counts.bounce += 1;
         }
         radiance

@@ -127,8 +127,7 @@ impl WhittedTracer {
         counts: &mut RayCounts,
     ) -> Rgb {
         counts.bounce += 1;
-        let origin = offset_ray_origin(hit.point, hit.error, hit.normal, direction);
-        self.trace(scene, Ray::new(origin, direction), depth + 1, counts)
+        self.trace(scene, hit.spawn_ray(direction), depth + 1, counts)
     }
 
     /// Direct light from every light, each treated as a point.
