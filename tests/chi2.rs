@@ -19,7 +19,7 @@ use tracelab::scene::light::{Light, LightSampling, Lights};
 use tracelab::scene::material::{Bsdf, fresnel_dielectric};
 
 /// Number of `assert_fits` calls below.
-const TESTS_IN_FILE: f64 = 12.0;
+const TESTS_IN_FILE: f64 = 26.0;
 const COS_BINS: usize = 20;
 const PHI_BINS: usize = 40;
 const SUBDIVISIONS: usize = 16;
@@ -541,4 +541,103 @@ fn chi_square_survival_function_is_right() {
     assert!((gamma_q(1.0, 1.0) - (-1.0f64).exp()).abs() < 1e-10);
     assert!((gamma_q(5.0, 18.307 / 2.0) - 0.05).abs() < 1e-4);
     assert!((gamma_q(50.0, 40.0) - 0.929_665).abs() < 1e-5);
+}
+
+#[test]
+fn thin_lens_points_are_uniform_over_the_aperture() {
+    // Ray origins of a thin-lens camera, in units of the aperture radius on
+    // the lens plane, histogrammed in rings and sectors: a uniform disk puts
+    // (r2^2 - r1^2) / sectors of the samples in each cell.
+    use tracelab::scene::camera::Camera;
+    let radius = 0.25;
+    let camera = Camera::look_at(
+        Vec3A::new(0.3, -0.2, 5.0),
+        Vec3A::ZERO,
+        Vec3A::Y,
+        40.0,
+        64,
+        64,
+        radius,
+        5.0,
+    );
+    let (rings, sectors) = (10, 16);
+    let mut observed = vec![0.0; rings * sectors];
+    for i in 0..SAMPLES {
+        let film = Vec2::new(uniform(14, i, 0) * 64.0, uniform(14, i, 1) * 64.0);
+        let lens = Vec2::new(uniform(14, i, 2), uniform(14, i, 3));
+        let ray = camera.generate_ray(film, lens);
+        let offset = ray.origin - camera.eye;
+        let (x, y) = (
+            offset.dot(camera.right) / radius,
+            offset.dot(camera.up) / radius,
+        );
+        let r = (x * x + y * y).sqrt();
+        assert!(r <= 1.0 + 1e-5, "lens point outside the aperture: {r}");
+        let ring = ((r * rings as f32) as usize).min(rings - 1);
+        let phi = (y.atan2(x) as f64 + 2.0 * PI) % (2.0 * PI);
+        let sector = ((phi / (2.0 * PI) * sectors as f64) as usize).min(sectors - 1);
+        observed[ring * sectors + sector] += 1.0;
+    }
+    let expected: Vec<f64> = (0..rings * sectors)
+        .map(|k| {
+            let ring = (k / sectors) as f64 / rings as f64;
+            let next = ring + 1.0 / rings as f64;
+            (next * next - ring * ring) / sectors as f64 * SAMPLES as f64
+        })
+        .collect();
+    assert_fits("thin lens aperture", &observed, &expected);
+}
+
+#[test]
+fn every_sampler_is_uniform_in_1d_and_2d_projections() {
+    // Numbers from many pixels and samples, in a 1D dimension and a 2D pair
+    // deep in the path: each sampler must be uniform there (stratified ones
+    // fit better than chance, which the upper-tail test accepts).
+    use tracelab::sampling::{Sampler, SamplerKind};
+    for kind in SamplerKind::ALL {
+        let spp = 16;
+        let mut sampler = Sampler::new(kind, 5, spp);
+        let bins_1d = 64;
+        let bins_2d = 16;
+        let mut observed_1d = vec![0.0; bins_1d];
+        let mut observed_2d = vec![0.0; bins_2d * bins_2d];
+        // Two different dimensions must be independent of each other.
+        let mut observed_cross = vec![0.0; bins_2d * bins_2d];
+        let pixels = 8192;
+        for pixel in 0..pixels {
+            for s in 0..spp {
+                sampler.start(pixel, s);
+                for _ in 0..3 {
+                    sampler.next_2d();
+                }
+                let u = sampler.next_1d();
+                let p = sampler.next_2d();
+                let w = sampler.next_1d();
+                let bin = |v: f32| ((v * bins_2d as f32) as usize).min(bins_2d - 1);
+                observed_cross[bin(w) * bins_2d + bin(u)] += 1.0;
+                observed_1d[((u * bins_1d as f32) as usize).min(bins_1d - 1)] += 1.0;
+                let (x, y) = (
+                    ((p.x * bins_2d as f32) as usize).min(bins_2d - 1),
+                    ((p.y * bins_2d as f32) as usize).min(bins_2d - 1),
+                );
+                observed_2d[y * bins_2d + x] += 1.0;
+            }
+        }
+        let n = f64::from(pixels * spp);
+        assert_fits(
+            &format!("{kind:?} sampler, 1D"),
+            &observed_1d,
+            &vec![n / bins_1d as f64; bins_1d],
+        );
+        assert_fits(
+            &format!("{kind:?} sampler, 2D"),
+            &observed_2d,
+            &vec![n / (bins_2d * bins_2d) as f64; bins_2d * bins_2d],
+        );
+        assert_fits(
+            &format!("{kind:?} sampler, two 1D dimensions jointly"),
+            &observed_cross,
+            &vec![n / (bins_2d * bins_2d) as f64; bins_2d * bins_2d],
+        );
+    }
 }

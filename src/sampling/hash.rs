@@ -31,6 +31,42 @@ pub fn to_unit_float(h: u64) -> f32 {
     ((h >> 40) as u32) as f32 * (1.0 / 16_777_216.0)
 }
 
+/// Up to this size, permutations are drawn uniformly from all n! by their
+/// Lehmer code: Kensler's hash reaches only a few of them for tiny n (its
+/// mixing steps shift the few index bits away), which correlates the strata
+/// of different pixels and dimensions.
+const SMALL_PERMUTATION: u32 = 8;
+
+/// Element `i` of the permutation of `[0, n)` numbered `hash(seed) mod n!`.
+#[inline]
+fn small_permute(i: u32, n: u32, seed: u32) -> u32 {
+    let factorial = |k: u32| (1..=k).product::<u32>();
+    let mut code =
+        (mix64(u64::from(seed) ^ 0x2545_f491_4f6c_dd1d) % u64::from(factorial(n))) as u32;
+    let mut available = (1u32 << n) - 1;
+    for position in 0..n {
+        let weight = factorial(n - 1 - position);
+        let mut k = code / weight;
+        code %= weight;
+        // The k-th element still available.
+        let mut element = 0;
+        loop {
+            if available & (1 << element) != 0 {
+                if k == 0 {
+                    break;
+                }
+                k -= 1;
+            }
+            element += 1;
+        }
+        if position == i {
+            return element;
+        }
+        available &= !(1 << element);
+    }
+    unreachable!("i < n")
+}
+
 /// A pseudo-random permutation of `[0, n)` evaluated one element at a time, with
 /// no table: `permute(i, n, seed)` is the image of `i`. Cycle-walking over the
 /// next power of two with an invertible hash, after Kensler, "Correlated
@@ -40,6 +76,9 @@ pub fn permute(mut i: u32, n: u32, seed: u32) -> u32 {
     debug_assert!(n > 0 && i < n);
     if n == 1 {
         return 0;
+    }
+    if n <= SMALL_PERMUTATION {
+        return small_permute(i, n, seed);
     }
     let mut w = n - 1;
     w |= w >> 1;
