@@ -51,6 +51,7 @@ fn paths_per_second_with(threads: usize, general: bool) -> f64 {
                 planned_spp: 32,
                 threads,
                 adaptive: None,
+                domains: Default::default(),
             };
             let session = Session::new(scene.clone(), settings).unwrap();
             for _ in 0..4 {

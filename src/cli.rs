@@ -13,7 +13,7 @@ use tracelab::integrator::{
 };
 use tracelab::plot::{Series, log_log_svg};
 use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
-use tracelab::sampling::SamplerKind;
+use tracelab::sampling::{Domains, SamplerKind};
 use tracelab::scene::light::LightSampling;
 use tracelab::scene::{Limits, Scene};
 use tracelab::{Error, Result};
@@ -109,7 +109,7 @@ struct BenchArgs {
     /// A configuration `integrator:sampler[:key=value...]`, e.g. `path:sobol`,
     /// `path:stratified:max-depth=1`, `mcrt:independent:shadow-rays=5:glossy-rays=5:max-depth=2`,
     /// `light:independent`; keys: max-depth, rr-depth, rr=off, shadow-rays, glossy-rays,
-    /// strategy=bsdf|light|mis, light-sampling=area|solid-angle. Repeatable.
+    /// strategy=bsdf|light|mis, light-sampling=area|solid-angle, domains=pixel+light. Repeatable.
     #[arg(long = "config", required = true)]
     configs: Vec<String>,
     /// Largest sample count measured (powers of two from 1).
@@ -203,6 +203,10 @@ struct RenderArgs {
     rays_per_pixel: Option<f64>,
     #[arg(long, value_enum, default_value = "independent")]
     sampler: SamplerArg,
+    /// Domains the sampler applies to, the rest independent: any of
+    /// pixel,lens,light,bsdf (default all).
+    #[arg(long, value_parser = parse_domains)]
+    domains: Option<Domains>,
     /// Maximum bounces (1 = direct lighting); Mitsuba's max_depth is one more.
     #[arg(long, default_value_t = 8)]
     max_depth: u32,
@@ -454,6 +458,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             threshold,
             min_spp: args.adaptive_min_spp.max(2),
         }),
+        domains: args.domains.unwrap_or_default(),
     };
     let session = Session::new(Arc::new(scene), settings)?;
     let stats = match (target_spp, args.rays_per_pixel) {
@@ -469,6 +474,10 @@ fn render(args: &RenderArgs) -> Result<()> {
     print_summary(&session, &stats, load_time);
     eprintln!("wrote {}", args.out.display());
     Ok(())
+}
+
+fn parse_domains(text: &str) -> std::result::Result<Domains, String> {
+    Domains::parse(text, ',')
 }
 
 /// Applies `--width`/`--height` (either alone keeps the other side).
@@ -807,6 +816,7 @@ fn cached_reference(
             planned_spp: spp,
             threads,
             adaptive: None,
+            domains: config.domains,
         },
     )?;
     render_spp(&session, spp);

@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 use crate::image::{ErrorMetrics, Image};
 use crate::integrator::{IntegratorKind, IntegratorOptions, Strategy};
 use crate::render::{RenderSettings, Session};
-use crate::sampling::SamplerKind;
+use crate::sampling::{Domains, SamplerKind};
 use crate::scene::Scene;
 use crate::scene::light::LightSampling;
 use std::sync::Arc;
@@ -19,6 +19,7 @@ pub struct BenchConfig {
     pub integrator: IntegratorOptions,
     pub sampler: SamplerKind,
     pub light_sampling: Option<LightSampling>,
+    pub domains: Domains,
 }
 
 impl BenchConfig {
@@ -53,6 +54,7 @@ impl BenchConfig {
             }
         };
         let mut light_sampling = None;
+        let mut domains = Domains::ALL;
         for option in parts {
             let (key, value) = option
                 .split_once('=')
@@ -87,6 +89,7 @@ impl BenchConfig {
                         }
                     })
                 }
+                "domains" => domains = Domains::parse(value, '+').map_err(err)?,
                 _ => return Err(err(format!("unknown option `{key}`"))),
             }
         }
@@ -95,6 +98,7 @@ impl BenchConfig {
             integrator,
             sampler,
             light_sampling,
+            domains,
         })
     }
 }
@@ -144,6 +148,7 @@ pub fn measure(
             planned_spp: spp,
             threads,
             adaptive: None,
+            domains: config.domains,
         };
         let session = Session::with_pool(scene.clone(), settings, pool.clone());
         let start = Instant::now();

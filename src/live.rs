@@ -438,6 +438,7 @@ mod tests {
                 planned_spp: 0,
                 threads: 0,
                 adaptive: None,
+                domains: Default::default(),
             },
             target_spp: Some(spp),
         }

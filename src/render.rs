@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::film::{Film, FilmSnapshot};
 use crate::integrator::{Integrator, LightTracer, RayCounts};
 use crate::math::Rgb;
-use crate::sampling::{Sampler, SamplerKind};
+use crate::sampling::{Domain, Domains, Sampler, SamplerKind};
 use crate::scene::Scene;
 use glam::Vec2;
 use rayon::prelude::*;
@@ -32,6 +32,8 @@ pub struct RenderSettings {
     pub threads: usize,
     /// Stop sampling pixels that have converged (off by default).
     pub adaptive: Option<Adaptive>,
+    /// Domains the sampler applies to; the others are independent.
+    pub domains: Domains,
 }
 
 /// Adaptive sampling: a pixel with at least `min_spp` samples whose relative
@@ -183,7 +185,8 @@ impl Session {
                     }
                     let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
                     let mut sampler =
-                        Sampler::new(settings.sampler, settings.seed, settings.planned_spp);
+                        Sampler::new(settings.sampler, settings.seed, settings.planned_spp)
+                            .with_domains(settings.domains);
                     let mut counts = RayCounts::default();
                     let mut non_finite = 0u64;
                     let mut skipped = 0u64;
@@ -200,8 +203,9 @@ impl Session {
                         }
                         for s in first..first + spp {
                             sampler.start(pixel_index, s);
-                            let mut film_point = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-                            let mut lens = sampler.next_2d();
+                            let mut film_point =
+                                Vec2::new(x as f32, y as f32) + sampler.next_2d_for(Domain::Pixel);
+                            let mut lens = sampler.next_2d_for(Domain::Lens);
                             if deterministic {
                                 film_point = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
                                 lens = Vec2::splat(0.5);
@@ -244,7 +248,8 @@ impl Session {
                     (t.x0, t.y0, t.width, t.height)
                 };
                 let mut sampler =
-                    Sampler::new(settings.sampler, settings.seed, settings.planned_spp);
+                    Sampler::new(settings.sampler, settings.seed, settings.planned_spp)
+                        .with_domains(settings.domains);
                 let mut counts = RayCounts::default();
                 let mut non_finite = 0u64;
                 for i in 0..tile_width * tile_height {

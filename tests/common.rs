@@ -41,6 +41,7 @@ pub fn render_with(
         planned_spp: spp,
         threads,
         adaptive: None,
+        domains: Default::default(),
     };
     let session = Session::new(Arc::new(scene), settings).expect("session starts");
     let mut done = 0;

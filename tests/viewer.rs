@@ -44,6 +44,18 @@ fn step_until(harness: &mut Harness<'_, Window>, what: &str, done: impl Fn(&Wind
     }
 }
 
+/// Scrolls the side panel to the widget labelled `label` and clicks it, as a
+/// user would.
+fn click(harness: &mut Harness<'_, Window>, label: &str) {
+    harness.get_by_label(label).scroll_to_me();
+    // Let the scroll animation settle before clicking.
+    for _ in 0..30 {
+        harness.step();
+    }
+    harness.get_by_label(label).click();
+    harness.step();
+}
+
 /// The renderer shows the current settings and has finished them.
 fn finished(w: &Window) -> bool {
     let frame = w.app.frame();
@@ -95,10 +107,8 @@ fn controls_drive_the_renderer_and_export_writes_files() {
     assert!(frame.views.iter().all(|v| v.stats.spp == 8));
 
     // Export: one PNG and one EXR per view, named by settings and spp.
-    harness.get_by_label("Export PNG").click();
-    harness.step();
-    harness.get_by_label("Export EXR").click();
-    harness.step();
+    click(&mut harness, "Export PNG");
+    click(&mut harness, "Export EXR");
     let exports = harness.state().app.exports.clone();
     assert_eq!(exports.len(), 4, "{exports:?}");
     for path in &exports {
@@ -122,8 +132,7 @@ fn controls_drive_the_renderer_and_export_writes_files() {
     assert_eq!(exr, frame.views[0].snapshot.image);
 
     // Exporting again never overwrites: new names.
-    harness.get_by_label("Export PNG").click();
-    harness.step();
+    click(&mut harness, "Export PNG");
     let again = &harness.state().app.exports[4];
     assert!(
         again.to_string_lossy().ends_with("-2.png"),

@@ -18,7 +18,7 @@
 
 use super::{RayCounts, survives_roulette};
 use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
-use crate::sampling::Sampler;
+use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
 use glam::{Vec2, Vec3A};
@@ -71,10 +71,10 @@ impl LightTracer {
         counts: &mut RayCounts,
         mut splat: impl FnMut(Splat),
     ) {
-        let u_select = sampler.next_1d();
-        let u_position = sampler.next_2d();
-        let u_direction = sampler.next_2d();
-        let u_lens = sampler.next_2d();
+        let u_select = sampler.next_1d_for(Domain::Light);
+        let u_position = sampler.next_2d_for(Domain::Light);
+        let u_direction = sampler.next_2d_for(Domain::Light);
+        let u_lens = sampler.next_2d_for(Domain::Lens);
         let Some(emission) = scene
             .lights
             .sample_emission(u_select, u_position, u_direction)
@@ -130,9 +130,9 @@ impl LightTracer {
             let frame = Frame::from_normal(hit.normal);
             // Direction back towards where the particle came from.
             let w_prev = frame.to_local(-ray.direction);
-            let u_lens = sampler.next_2d();
-            let u_lobe = sampler.next_1d();
-            let u_bsdf = sampler.next_2d();
+            let u_lens = sampler.next_2d_for(Domain::Lens);
+            let u_lobe = sampler.next_1d_for(Domain::Bsdf);
+            let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
             let u_roulette = sampler.next_1d();
 
             if !bsdf.is_specular()

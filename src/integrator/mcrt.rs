@@ -13,7 +13,7 @@
 use super::{MisHeuristic, RayCounts};
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb};
-use crate::sampling::Sampler;
+use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 
 use super::path::shadow_ray;
@@ -124,8 +124,8 @@ impl McRayTracer {
         let mut radiance = Rgb::ZERO;
 
         for _ in 0..n_light {
-            let u_select = sampler.next_1d();
-            let u_light = sampler.next_2d();
+            let u_select = sampler.next_1d_for(Domain::Light);
+            let u_light = sampler.next_2d_for(Domain::Light);
             let Some(ls) = scene.lights.sample(hit.point, u_select, u_light) else {
                 continue;
             };
@@ -146,8 +146,8 @@ impl McRayTracer {
         }
 
         for _ in 0..n_bsdf {
-            let u_lobe = sampler.next_1d();
-            let u_bsdf = sampler.next_2d();
+            let u_lobe = sampler.next_1d_for(Domain::Bsdf);
+            let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
             let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
                 continue;
             };

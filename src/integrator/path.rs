@@ -11,8 +11,8 @@
 use super::{MisHeuristic, RayCounts, survives_roulette};
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, ray_between};
-use crate::sampling::Sampler;
 use crate::sampling::warp::square_to_cosine_hemisphere;
+use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::scene::light::LightSample;
 use crate::scene::material::{Bsdf, BsdfSample};
@@ -137,10 +137,10 @@ impl PathTracer {
             let wo = frame.to_local(wo_world);
             // Every vertex consumes the same dimensions, so that stratified
             // samplers keep dimensions aligned across samples.
-            let u_light_select = sampler.next_1d();
-            let u_light = sampler.next_2d();
-            let u_lobe = sampler.next_1d();
-            let u_bsdf = sampler.next_2d();
+            let u_light_select = sampler.next_1d_for(Domain::Light);
+            let u_light = sampler.next_2d_for(Domain::Light);
+            let u_lobe = sampler.next_1d_for(Domain::Bsdf);
+            let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
             let u_roulette = sampler.next_1d();
 
             if self.nee && !(SPECULAR && bsdf.is_specular()) {

@@ -10,4 +10,4 @@ pub mod spherical_triangle;
 pub mod warp;
 
 pub use alias::AliasTable;
-pub use sampler::{Sampler, SamplerKind};
+pub use sampler::{Domain, Domains, Sampler, SamplerKind};

@@ -51,6 +51,85 @@ impl SamplerKind {
     ];
 }
 
+/// The sampling domains a path draws numbers for. A sampler stratifies (or
+/// uses its low-discrepancy points in) the domains selected in
+/// [`Domains`]; the others get independent numbers, so each domain's effect
+/// on the noise can be seen alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Domain {
+    /// Position inside the pixel (antialiasing).
+    Pixel,
+    /// Point on the thin lens (depth of field).
+    Lens,
+    /// Light choice and point on the light (and particle emission).
+    Light,
+    /// BSDF lobe and direction.
+    Bsdf,
+    /// Everything else (Russian roulette).
+    Other,
+}
+
+/// A set of [`Domain`]s.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Domains {
+    pub pixel: bool,
+    pub lens: bool,
+    pub light: bool,
+    pub bsdf: bool,
+}
+
+impl Domains {
+    pub const ALL: Domains = Domains {
+        pixel: true,
+        lens: true,
+        light: true,
+        bsdf: true,
+    };
+
+    #[inline]
+    pub fn contains(&self, domain: Domain) -> bool {
+        match domain {
+            Domain::Pixel => self.pixel,
+            Domain::Lens => self.lens,
+            Domain::Light => self.light,
+            Domain::Bsdf => self.bsdf,
+            Domain::Other => true,
+        }
+    }
+}
+
+impl Domains {
+    /// Parses names separated by `sep` (`pixel`, `lens`, `light`, `bsdf`).
+    pub fn parse(text: &str, sep: char) -> Result<Domains, String> {
+        let mut d = Domains {
+            pixel: false,
+            lens: false,
+            light: false,
+            bsdf: false,
+        };
+        for name in text.split(sep).map(str::trim).filter(|n| !n.is_empty()) {
+            match name {
+                "pixel" => d.pixel = true,
+                "lens" => d.lens = true,
+                "light" => d.light = true,
+                "bsdf" => d.bsdf = true,
+                other => {
+                    return Err(format!(
+                        "unknown sampling domain `{other}` (pixel, lens, light, bsdf)"
+                    ));
+                }
+            }
+        }
+        Ok(d)
+    }
+}
+
+impl Default for Domains {
+    fn default() -> Self {
+        Domains::ALL
+    }
+}
+
 /// Default number of samples stratified together when a render has no planned
 /// sample count (time-limited or unlimited progressive rendering).
 pub const DEFAULT_BATCH: u32 = 64;
@@ -76,6 +155,8 @@ pub struct Sampler {
     /// stratum is used (an unused stratum would bias the estimate).
     grid_x: u32,
     grid_y: u32,
+    /// Domains that use `kind`; the rest are independent.
+    domains: Domains,
 }
 
 impl Sampler {
@@ -102,6 +183,35 @@ impl Sampler {
             batch,
             grid_x,
             grid_y: batch / grid_x,
+            domains: Domains::ALL,
+        }
+    }
+
+    /// The same sampler applied only to `domains`.
+    pub fn with_domains(mut self, domains: Domains) -> Self {
+        self.domains = domains;
+        self
+    }
+
+    /// One number in [0, 1) for `domain`: from this sampler where the domain
+    /// is selected, independent otherwise. Consumes one dimension either way.
+    #[inline]
+    pub fn next_1d_for(&mut self, domain: Domain) -> f32 {
+        if self.domains.contains(domain) {
+            self.next_1d()
+        } else {
+            to_unit_float(self.next_hash().0)
+        }
+    }
+
+    /// Two numbers in [0, 1)² for `domain` (see [`Sampler::next_1d_for`]).
+    #[inline]
+    pub fn next_2d_for(&mut self, domain: Domain) -> Vec2 {
+        if self.domains.contains(domain) {
+            self.next_2d()
+        } else {
+            let h = self.next_hash().0;
+            Vec2::new(to_unit_float(h), to_unit_float(h << 24))
         }
     }
 

@@ -387,6 +387,7 @@ impl ViewerApp {
                         planned_spp: target.unwrap_or(0),
                         threads: 0,
                         adaptive: None,
+                        domains: c.domains,
                     },
                     target_spp: if integrator.is_deterministic() {
                         Some(1)

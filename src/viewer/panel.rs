@@ -189,6 +189,16 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
             SamplerKind::Independent
         };
     }
+    ui.add_enabled_ui(config.sampler != SamplerKind::Independent, |ui| {
+        ui.horizontal_wrapped(|ui| {
+            ui.label("Domains");
+            let d = &mut config.domains;
+            ui.checkbox(&mut d.pixel, "Pixel");
+            ui.checkbox(&mut d.lens, "Lens");
+            ui.checkbox(&mut d.light, "Light");
+            ui.checkbox(&mut d.bsdf, "BSDF");
+        });
+    });
     ui.horizontal(|ui| {
         let label = ui.label("Seed");
         ui.add(egui::DragValue::new(&mut config.seed))

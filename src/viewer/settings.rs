@@ -4,7 +4,7 @@
 
 use crate::integrator::IntegratorOptions;
 use crate::live::Lock;
-use crate::sampling::SamplerKind;
+use crate::sampling::{Domains, SamplerKind};
 use serde::{Deserialize, Serialize};
 
 /// One configuration of the estimator (A, or B when comparing).
@@ -13,6 +13,8 @@ use serde::{Deserialize, Serialize};
 pub struct Config {
     pub integrator: IntegratorOptions,
     pub sampler: SamplerKind,
+    /// Domains the sampler applies to (the rest are independent).
+    pub domains: Domains,
     pub seed: u64,
 }
 
@@ -21,6 +23,7 @@ impl Default for Config {
         Config {
             integrator: IntegratorOptions::default(),
             sampler: SamplerKind::Independent,
+            domains: Domains::ALL,
             seed: 0,
         }
     }
@@ -41,7 +44,23 @@ impl Config {
             }
             crate::integrator::IntegratorKind::Light => format!("light d{}", i.max_depth),
         };
-        format!("{estimator} {}", self.sampler.name())
+        let d = self.domains;
+        let partial = if self.sampler != SamplerKind::Independent && d != Domains::ALL {
+            let names: Vec<&str> = [
+                (d.pixel, "pixel"),
+                (d.lens, "lens"),
+                (d.light, "light"),
+                (d.bsdf, "bsdf"),
+            ]
+            .iter()
+            .filter(|(on, _)| *on)
+            .map(|(_, n)| *n)
+            .collect();
+            format!(" [{}]", names.join("+"))
+        } else {
+            String::new()
+        };
+        format!("{estimator} {}{partial}", self.sampler.name())
     }
 }
 
