@@ -48,22 +48,22 @@ fn view_summary(name: &str, view: &LiveView, app: &ViewerApp) -> String {
     let pixels = view.snapshot.samples.len().max(1) as f64;
     let last = view.history.last();
     let mut text = format!(
-        "{name} {} spp | {:.2} s | {:.2} M samples/s | {:.1} M rays/s | rays/px {:.0} (cam {:.0}, shadow {:.0}, bounce {:.0}) | est. RMSE {:.5}",
+        "{name} {} spp | {:.2} s | est. RMSE {:.5}{} | {:.2} M samples/s | {:.1} M rays/s | rays/px {:.0} (cam {:.0}, shadow {:.0}, bounce {:.0})",
         s.spp,
         s.render_time.as_secs_f64(),
+        last.map_or(f64::NAN, |p| p.noise),
+        match last.and_then(|p| p.rmse) {
+            Some(rmse) => format!(" | RMSE {rmse:.5}"),
+            None if app.reference().is_some() => " | RMSE n/a (size differs)".into(),
+            None => String::new(),
+        },
         s.samples as f64 / seconds * 1e-6,
         s.rays.total() as f64 / seconds * 1e-6,
         s.rays.total() as f64 / pixels,
         s.rays.camera as f64 / pixels,
         s.rays.shadow as f64 / pixels,
         s.rays.bounce as f64 / pixels,
-        last.map_or(f64::NAN, |p| p.noise),
     );
-    if let Some(rmse) = last.and_then(|p| p.rmse) {
-        text += &format!(" | RMSE {rmse:.5}");
-    } else if app.reference().is_some() {
-        text += " | RMSE n/a (size differs)";
-    }
     if s.non_finite > 0 {
         text += &format!(" | non-finite {}", s.non_finite);
     }
