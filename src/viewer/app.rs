@@ -6,9 +6,9 @@
 
 use super::display::render_view;
 use super::export::{export_path, write_color_image, write_exr};
+use super::launch::{Launch, list_scene_files, resolve_scene_path};
 use super::settings::{Config, Display, Settings};
 use crate::image::Image;
-use crate::integrator::IntegratorKind;
 use crate::live::{ErrorPoint, LiveConfig, LiveFrame, LiveRender};
 use crate::render::RenderSettings;
 use crate::scene::camera::Camera;
@@ -18,25 +18,6 @@ use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-
-/// How the viewer was started (command line or tests).
-#[derive(Clone, Debug, Default)]
-pub struct Launch {
-    /// Scene to open (otherwise the last one, or the Cornell box).
-    pub scene: Option<PathBuf>,
-    pub integrator: Option<IntegratorKind>,
-    pub target_spp: Option<u32>,
-    /// Save the window here once every view has `after_spp` samples, then quit.
-    pub screenshot: Option<PathBuf>,
-    pub after_spp: u32,
-    /// Open a side-by-side comparison (A as given, B with the Sobol sampler).
-    pub compare: bool,
-    /// Render threads (0 = one per core).
-    pub threads: usize,
-    /// Start from default settings instead of the saved ones.
-    pub fresh: bool,
-    pub export_dir: Option<PathBuf>,
-}
 
 /// A convergence curve of a configuration that is no longer rendering.
 #[derive(Clone, Debug)]
@@ -706,38 +687,4 @@ fn percentile(values: impl Iterator<Item = f32>, q: f32) -> Option<f32> {
     v.sort_by(f32::total_cmp);
     let i = ((v.len() - 1) as f32 * q).round() as usize;
     Some(v[i])
-}
-
-/// A relative scene path that does not exist here is looked up in the source
-/// tree, so `cargo run` works from any directory.
-fn resolve_scene_path(path: &str) -> String {
-    let p = Path::new(path);
-    if p.is_relative() && !p.exists() {
-        let in_tree = Path::new(env!("CARGO_MANIFEST_DIR")).join(p);
-        if in_tree.exists() {
-            return in_tree.to_string_lossy().into_owned();
-        }
-    }
-    path.to_string()
-}
-
-/// The `.toml` files in `scenes/` (relative to the working directory, or to
-/// the source tree when run from elsewhere).
-fn list_scene_files() -> Vec<String> {
-    let local = Path::new("scenes");
-    let dir = if local.is_dir() {
-        local.to_path_buf()
-    } else {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
-    };
-    let mut files: Vec<String> = std::fs::read_dir(&dir)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .map(|p| p.to_string_lossy().into_owned())
-        .collect();
-    files.sort();
-    files
 }

@@ -5,17 +5,20 @@
 //! Files: `settings.rs` (persisted plain data), `app.rs` (state and actions),
 //! `panel.rs` (side panel), `image_view.rs` (image, zoom, inspector, split),
 //! `stats.rs` (statistics and convergence plot), `display.rs` (tone mapping
-//! and false colour), `export.rs` (PNG/EXR files).
+//! and false colour), `export.rs` (PNG/EXR files), `launch.rs` (start-up
+//! options, scene lookup).
 
 pub mod app;
 pub mod display;
 pub mod export;
 pub mod image_view;
+pub mod launch;
 pub mod panel;
 pub mod settings;
 pub mod stats;
 
-pub use app::{Launch, ViewerApp};
+pub use app::ViewerApp;
+pub use launch::Launch;
 
 use crate::error::{Error, Result};
 use eframe::egui::{self, Color32, Key, RichText};
