@@ -20,6 +20,7 @@ use super::{RayCounts, survives_roulette};
 use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
+use crate::scene::camera::CameraConnection;
 use crate::scene::material::Bsdf;
 use glam::{Vec2, Vec3A};
 
@@ -86,24 +87,21 @@ impl LightTracer {
         // The light point seen directly: Le |cos| / p_position * We / p_cam.
         if let Some(c) = camera.connect(emission.point, u_lens) {
             let le = emission.emitted_towards(c.wi);
-            if le.max_element() > 0.0 {
-                counts.shadow += 1;
-                let ray = ray_between(
+            if le.max_element() > 0.0
+                && sees_lens(
+                    scene,
                     emission.point,
                     emission.error,
                     emission.normal,
-                    c.lens_point,
-                    Vec3A::ZERO,
-                    Vec3A::ZERO,
-                );
-                if !scene.geometry.occluded(&ray) {
-                    let value =
-                        le * (emission.cos_at_light(c.wi) * c.weight / emission.pdf_position);
-                    splat(Splat {
-                        film: c.film,
-                        value,
-                    });
-                }
+                    &c,
+                    counts,
+                )
+            {
+                let value = le * (emission.cos_at_light(c.wi) * c.weight / emission.pdf_position);
+                splat(Splat {
+                    film: c.film,
+                    value,
+                });
             }
         }
 
@@ -140,22 +138,13 @@ impl LightTracer {
             {
                 let w_cam = frame.to_local(c.wi);
                 let f = bsdf.eval(w_cam, w_prev);
-                if f.max_element() > 0.0 {
-                    counts.shadow += 1;
-                    let ray = ray_between(
-                        hit.point,
-                        hit.error,
-                        hit.normal,
-                        c.lens_point,
-                        Vec3A::ZERO,
-                        Vec3A::ZERO,
-                    );
-                    if !scene.geometry.occluded(&ray) {
-                        splat(Splat {
-                            film: c.film,
-                            value: beta * f * (w_cam.z.abs() * c.weight),
-                        });
-                    }
+                if f.max_element() > 0.0
+                    && sees_lens(scene, hit.point, hit.error, hit.normal, &c, counts)
+                {
+                    splat(Splat {
+                        film: c.film,
+                        value: beta * f * (w_cam.z.abs() * c.weight),
+                    });
                 }
             }
 
@@ -178,6 +167,29 @@ impl LightTracer {
             counts.bounce += 1;
         }
     }
+}
+
+/// Casts the connection from a surface point to the lens point (a shadow
+/// ray, counted) and says whether nothing is in between.
+#[inline]
+fn sees_lens(
+    scene: &Scene,
+    point: Vec3A,
+    error: Vec3A,
+    normal: Vec3A,
+    connection: &CameraConnection,
+    counts: &mut RayCounts,
+) -> bool {
+    counts.shadow += 1;
+    let ray = ray_between(
+        point,
+        error,
+        normal,
+        connection.lens_point,
+        Vec3A::ZERO,
+        Vec3A::ZERO,
+    );
+    !scene.geometry.occluded(&ray)
 }
 
 /// The sample weight f cos / p in importance transport: as for radiance,
