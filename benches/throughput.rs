@@ -160,29 +160,62 @@ fn report_geometry(name: &str, geometry: &Geometry, rays: &[Ray], build: Duratio
 }
 
 fn main() {
+    // `cargo bench --bench throughput -- NAME` runs the sections whose name
+    // contains NAME: paths, specialisation, rays.
+    let filter: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
+    let wanted = |section: &str| filter.is_empty() || filter.iter().any(|f| section.contains(f));
     println!(
         "machine: {} logical CPUs",
         std::thread::available_parallelism().map_or(0, |n| n.get())
     );
+    if wanted("paths") {
+        paths();
+    }
+    if wanted("specialisation") {
+        specialisation();
+    }
+    if wanted("rays") {
+        rays();
+    }
+}
+
+fn paths() {
     for threads in [1, 2] {
         println!(
             "Cornell box 256x256, path tracing (8 bounces, NEE+MIS), {threads} thread(s): {:.3} M paths/s",
             paths_per_second(threads) * 1e-6
         );
     }
-    // Specialisation: interleaved runs so that drift hits both alike.
+}
+
+/// The loop specialised for the Cornell box against the general one, in
+/// interleaved runs so that drift hits both alike; each run is itself the
+/// median of 5 renders.
+fn specialisation() {
     let (mut special, mut general) = (Vec::new(), Vec::new());
-    for _ in 0..3 {
+    for _ in 0..7 {
         special.push(paths_per_second_with(2, false));
         general.push(paths_per_second_with(2, true));
     }
+    let ratios: Vec<f64> = special.iter().zip(&general).map(|(s, g)| s / g).collect();
     let (special, general) = (median(special), median(general));
     println!(
-        "Cornell box, 2 threads: specialised loop {:.3} M paths/s, general loop {:.3} M paths/s ({:+.1}%)",
+        "Cornell box, 2 threads: specialised loop {:.3} M paths/s, general loop {:.3} M paths/s ({:+.1}%; per-pair ratios {})",
         special * 1e-6,
         general * 1e-6,
-        100.0 * (special / general - 1.0)
+        100.0 * (special / general - 1.0),
+        ratios
+            .iter()
+            .map(|r| format!("{:+.1}%", 100.0 * (r - 1.0)))
+            .collect::<Vec<_>>()
+            .join(" ")
     );
+}
+
+fn rays() {
     let cornell =
         Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml"))
             .unwrap();

@@ -18,6 +18,9 @@ pub struct Ray {
     pub origin: Vec3A,
     pub direction: Vec3A,
     pub t_max: f32,
+    /// Instant within the shutter interval at which the ray samples a moving
+    /// scene; every ray of one path carries its camera ray's time.
+    pub time: f32,
 }
 
 impl Ray {
@@ -28,7 +31,14 @@ impl Ray {
             origin,
             direction,
             t_max: f32::INFINITY,
+            time: 0.0,
         }
+    }
+
+    /// The same ray at `time`.
+    #[inline]
+    pub fn at_time(self, time: f32) -> Self {
+        Ray { time, ..self }
     }
 
     /// Point at parameter `t`.
@@ -140,7 +150,8 @@ pub const SHADOW_EPSILON: f32 = 1e-4;
 
 /// A shadow ray between two surface points, each given with its error bound
 /// and geometric normal (a zero normal and error for points in free space).
-/// Both ends are moved off their surfaces towards each other.
+/// Both ends are moved off their surfaces towards each other. The ray is at
+/// time 0: a caller in a moving scene sets the path's time with [`Ray::at_time`].
 #[inline]
 pub fn ray_between(
     from: Vec3A,
@@ -158,6 +169,7 @@ pub fn ray_between(
         origin,
         direction: d / distance,
         t_max: distance * (1.0 - SHADOW_EPSILON),
+        time: 0.0,
     }
 }
 

@@ -9,7 +9,7 @@
 
 use crate::error::{Error, Result};
 use crate::film::{Film, FilmSnapshot};
-use crate::integrator::{Integrator, LightTracer, RayCounts};
+use crate::integrator::{Integrator, LightTracer, RayCounts, sample_time};
 use crate::math::Rgb;
 use crate::sampling::{Domain, Domains, Sampler, SamplerKind};
 use crate::scene::Scene;
@@ -173,6 +173,7 @@ impl Session {
         let scene = &*self.scene;
         let settings = &self.settings;
         let deterministic = settings.integrator.is_deterministic();
+        let general = settings.integrator.is_general();
         let width = self.film.width();
         self.pool.install(|| {
             self.film
@@ -206,11 +207,15 @@ impl Session {
                             let mut film_point =
                                 Vec2::new(x as f32, y as f32) + sampler.next_2d_for(Domain::Pixel);
                             let mut lens = sampler.next_2d_for(Domain::Lens);
+                            let mut time = sample_time(scene, &mut sampler, general);
                             if deterministic {
+                                // One ray through the pixel centre, lens
+                                // centre, at mid-exposure.
                                 film_point = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
                                 lens = Vec2::splat(0.5);
+                                time = scene.camera.time(0.5);
                             }
-                            let ray = scene.camera.generate_ray(film_point, lens);
+                            let ray = scene.camera.generate_ray(film_point, lens).at_time(time);
                             counts.camera += 1;
                             let value =
                                 settings

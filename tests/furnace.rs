@@ -55,6 +55,7 @@ fn sphere_furnace() -> Scene {
             light: NO_LIGHT,
         }],
         point_lights: vec![],
+        moving: vec![],
         sphere_sampling: LightSampling::SolidAngle,
         triangle_sampling: LightSampling::Area,
     })
@@ -96,6 +97,7 @@ fn cube_furnace() -> Scene {
         triangles,
         spheres: vec![],
         point_lights: vec![],
+        moving: vec![],
         sphere_sampling: LightSampling::SolidAngle,
         triangle_sampling: LightSampling::Area,
     })

@@ -17,6 +17,8 @@ mod estimators;
 mod strategies;
 // Same seed, same film, whatever the thread count or pass split.
 mod determinism;
+// Motion blur: a moving occluder against a case solved by hand.
+mod motion;
 // Every scene in scenes/ renders without non-finite samples.
 mod scenes;
 // The command line: renders, comparisons and every kind of bad input.

@@ -149,7 +149,7 @@ struct RenderArgs {
     #[arg(long, value_enum, default_value = "independent")]
     sampler: SamplerArg,
     /// Domains the sampler applies to, the rest independent: any of
-    /// pixel,lens,light,bsdf (default all).
+    /// pixel,lens,time,light,bsdf (default all).
     #[arg(long, value_parser = parse_domains)]
     domains: Option<Domains>,
     /// Maximum bounces (1 = direct lighting); Mitsuba's max_depth is one more.
@@ -180,8 +180,8 @@ struct RenderArgs {
     /// MC ray tracing: BSDF samples (branching rays) per hit.
     #[arg(long, default_value_t = 1)]
     glossy_rays: u32,
-    /// Path tracing: run the general loop, not the one specialised for the
-    /// scene's features (to measure what specialisation saves).
+    /// Path tracing and Whitted: run the general code, not the code
+    /// specialised for the scene's features (to measure what that saves).
     #[arg(long)]
     general: bool,
     /// Whitted: constant ambient radiance times the diffuse albedo.
@@ -578,10 +578,13 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         per_pixel(stats.rays.shadow),
         per_pixel(stats.rays.bounce)
     );
-    if let tracelab::integrator::Integrator::Path(p) = settings.integrator {
+    if matches!(
+        settings.integrator,
+        tracelab::integrator::Integrator::Path(_) | tracelab::integrator::Integrator::Whitted(_)
+    ) {
         let skipped = session.scene().features.skipped();
-        if p.general {
-            eprintln!("general path loop (--general): nothing skipped");
+        if settings.integrator.is_general() {
+            eprintln!("general code (--general): nothing skipped");
         } else {
             eprintln!("specialised for this scene: skipped {}", skipped.join(", "));
         }

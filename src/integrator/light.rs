@@ -76,6 +76,7 @@ impl LightTracer {
         let u_position = sampler.next_2d_for(Domain::Light);
         let u_direction = sampler.next_2d_for(Domain::Light);
         let u_lens = sampler.next_2d_for(Domain::Lens);
+        let time = super::sample_time(scene, sampler, false);
         let Some(emission) = scene
             .lights
             .sample_emission(u_select, u_position, u_direction)
@@ -94,6 +95,7 @@ impl LightTracer {
                     emission.error,
                     emission.normal,
                     &c,
+                    time,
                     counts,
                 )
             {
@@ -114,7 +116,8 @@ impl LightTracer {
                 emission.direction,
             ),
             emission.direction,
-        );
+        )
+        .at_time(time);
         counts.camera += 1;
         let mut bounces = 0;
         while bounces < self.max_depth {
@@ -139,7 +142,7 @@ impl LightTracer {
                 let w_cam = frame.to_local(c.wi);
                 let f = bsdf.eval(w_cam, w_prev);
                 if f.max_element() > 0.0
-                    && sees_lens(scene, hit.point, hit.error, hit.normal, &c, counts)
+                    && sees_lens(scene, hit.point, hit.error, hit.normal, &c, time, counts)
                 {
                     splat(Splat {
                         film: c.film,
@@ -178,6 +181,7 @@ fn sees_lens(
     error: Vec3A,
     normal: Vec3A,
     connection: &CameraConnection,
+    time: f32,
     counts: &mut RayCounts,
 ) -> bool {
     counts.shadow += 1;
@@ -188,7 +192,8 @@ fn sees_lens(
         connection.lens_point,
         Vec3A::ZERO,
         Vec3A::ZERO,
-    );
+    )
+    .at_time(time);
     !scene.geometry.occluded(&ray)
 }
 

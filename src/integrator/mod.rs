@@ -21,7 +21,7 @@ pub use path::PathTracer;
 pub use whitted::{GlassShadows, WhittedTracer};
 
 use crate::math::{Ray, Rgb};
-use crate::sampling::Sampler;
+use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 
 /// Rays cast, by kind; kept per thread and summed after each tile. For light
@@ -53,6 +53,19 @@ pub(crate) fn survives_roulette(beta: &mut Rgb, u: f32) -> bool {
     }
     *beta /= q;
     true
+}
+
+/// The time of a path: uniform over the shutter interval when something
+/// moves while the shutter is open, else the shutter's opening without
+/// consuming a dimension (a static scene has no time dimension). `always`
+/// draws the time anyway, as a renderer without feature detection would.
+#[inline]
+pub fn sample_time(scene: &Scene, sampler: &mut Sampler, always: bool) -> f32 {
+    if scene.features.motion || always {
+        scene.camera.time(sampler.next_1d_for(Domain::Time))
+    } else {
+        scene.camera.shutter_open
+    }
 }
 
 /// A configured estimator.
@@ -108,5 +121,15 @@ impl Integrator {
     /// ray through the pixel centre), so one sample per pixel is the image.
     pub fn is_deterministic(&self) -> bool {
         matches!(self, Integrator::Whitted(_))
+    }
+
+    /// True when the estimator runs its general loop even where the scene
+    /// allows a specialised one (for measuring what specialisation saves).
+    pub fn is_general(&self) -> bool {
+        match self {
+            Integrator::Path(p) => p.general,
+            Integrator::Whitted(w) => w.general,
+            _ => false,
+        }
     }
 }

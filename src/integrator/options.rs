@@ -68,7 +68,8 @@ pub struct IntegratorOptions {
     /// Whitted's constant ambient radiance (grey).
     pub ambient: f32,
     pub glass_shadows: GlassShadows,
-    /// Path tracing: the general loop even where a specialised one applies.
+    /// Path tracing and Whitted: the general code even where a specialised
+    /// one applies.
     pub general: bool,
 }
 
@@ -103,6 +104,7 @@ impl IntegratorOptions {
                 max_depth: self.max_depth,
                 ambient: Rgb::splat(self.ambient.max(0.0)),
                 glass_shadows: self.glass_shadows,
+                general: self.general,
             }),
             IntegratorKind::Mcrt => Integrator::Mcrt(McRayTracer {
                 max_depth: self.max_depth,

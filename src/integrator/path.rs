@@ -245,4 +245,5 @@ pub fn shadow_ray(hit: &SurfaceHit, ls: &LightSample) -> Ray {
     ray_between(
         hit.point, hit.error, hit.normal, ls.point, ls.error, ls.normal,
     )
+    .at_time(hit.time)
 }

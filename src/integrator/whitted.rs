@@ -39,6 +39,9 @@ pub struct WhittedTracer {
     /// Constant ambient radiance, multiplied by the diffuse albedo.
     pub ambient: Rgb,
     pub glass_shadows: GlassShadows,
+    /// Trace tinted shadow rays surface by surface even in a scene without
+    /// glass (for measuring what skipping them saves).
+    pub general: bool,
 }
 
 impl Default for WhittedTracer {
@@ -47,6 +50,7 @@ impl Default for WhittedTracer {
             max_depth: 8,
             ambient: Rgb::ZERO,
             glass_shadows: GlassShadows::Opaque,
+            general: false,
         }
     }
 }
@@ -161,7 +165,8 @@ impl WhittedTracer {
                 shadow_target,
                 Vec3A::ZERO,
                 Vec3A::ZERO,
-            );
+            )
+            .at_time(hit.time);
             let visibility = self.transmittance(scene, ray, counts);
             sum += f * intensity * visibility * (wi.z.abs() / dist2);
         }
@@ -169,10 +174,14 @@ impl WhittedTracer {
     }
 
     /// Fraction of light passing along a shadow ray: 0 or 1, or the product
-    /// of glass tints with [`GlassShadows::Tinted`].
+    /// of glass tints with [`GlassShadows::Tinted`]. Without glass in the
+    /// scene a tinted shadow ray is an any-hit query, which may stop at the
+    /// first blocker, instead of a walk from surface to surface.
     fn transmittance(&self, scene: &Scene, mut ray: Ray, counts: &mut RayCounts) -> Rgb {
         counts.shadow += 1;
-        if self.glass_shadows == GlassShadows::Opaque {
+        let through_glass = self.glass_shadows == GlassShadows::Tinted
+            && (scene.features.dielectric || self.general);
+        if !through_glass {
             return if scene.geometry.occluded(&ray) {
                 Rgb::ZERO
             } else {
@@ -198,8 +207,8 @@ impl WhittedTracer {
             }
             ray = Ray {
                 origin,
-                direction: ray.direction,
                 t_max: remaining,
+                ..ray
             };
             counts.shadow += 1;
         }

@@ -61,6 +61,8 @@ pub enum Domain {
     Pixel,
     /// Point on the thin lens (depth of field).
     Lens,
+    /// Instant within the shutter interval (motion blur).
+    Time,
     /// Light choice and point on the light (and particle emission).
     Light,
     /// BSDF lobe and direction.
@@ -74,6 +76,9 @@ pub enum Domain {
 pub struct Domains {
     pub pixel: bool,
     pub lens: bool,
+    /// Missing in settings saved before the time domain existed.
+    #[serde(default = "yes")]
+    pub time: bool,
     pub light: bool,
     pub bsdf: bool,
 }
@@ -82,6 +87,7 @@ impl Domains {
     pub const ALL: Domains = Domains {
         pixel: true,
         lens: true,
+        time: true,
         light: true,
         bsdf: true,
     };
@@ -91,6 +97,7 @@ impl Domains {
         match domain {
             Domain::Pixel => self.pixel,
             Domain::Lens => self.lens,
+            Domain::Time => self.time,
             Domain::Light => self.light,
             Domain::Bsdf => self.bsdf,
             Domain::Other => true,
@@ -99,11 +106,12 @@ impl Domains {
 }
 
 impl Domains {
-    /// Parses names separated by `sep` (`pixel`, `lens`, `light`, `bsdf`).
+    /// Parses names separated by `sep` (`pixel`, `lens`, `time`, `light`, `bsdf`).
     pub fn parse(text: &str, sep: char) -> Result<Domains, String> {
         let mut d = Domains {
             pixel: false,
             lens: false,
+            time: false,
             light: false,
             bsdf: false,
         };
@@ -111,17 +119,22 @@ impl Domains {
             match name {
                 "pixel" => d.pixel = true,
                 "lens" => d.lens = true,
+                "time" => d.time = true,
                 "light" => d.light = true,
                 "bsdf" => d.bsdf = true,
                 other => {
                     return Err(format!(
-                        "unknown sampling domain `{other}` (pixel, lens, light, bsdf)"
+                        "unknown sampling domain `{other}` (pixel, lens, time, light, bsdf)"
                     ));
                 }
             }
         }
         Ok(d)
     }
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Default for Domains {

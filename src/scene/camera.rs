@@ -20,6 +20,10 @@ pub struct Camera {
     pub aperture_radius: f32,
     /// Distance along the view direction of the plane in focus.
     pub focus_distance: f32,
+    /// Shutter interval: the film integrates over times in [open, close).
+    /// Equal ends give an instantaneous exposure (no motion blur).
+    pub shutter_open: f32,
+    pub shutter_close: f32,
 }
 
 impl Camera {
@@ -48,7 +52,28 @@ impl Camera {
             height,
             aperture_radius,
             focus_distance,
+            shutter_open: 0.0,
+            shutter_close: 0.0,
         }
+    }
+
+    /// The same camera with the shutter open over [open, close).
+    pub fn with_shutter(mut self, open: f32, close: f32) -> Self {
+        self.shutter_open = open;
+        self.shutter_close = close;
+        self
+    }
+
+    /// True when the exposure spans an interval of time.
+    pub fn has_shutter_interval(&self) -> bool {
+        self.shutter_close > self.shutter_open
+    }
+
+    /// The time for `u` in [0, 1): uniform over the shutter interval (a box
+    /// shutter, as Mitsuba's and pbrt's default).
+    #[inline]
+    pub fn time(&self, u: f32) -> f32 {
+        self.shutter_open + u * (self.shutter_close - self.shutter_open)
     }
 
     /// Primary ray through the film position `film` (in pixels, origin at the

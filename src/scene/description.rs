@@ -11,6 +11,7 @@
 //! height = 256
 //! aperture_radius = 0.0    # thin lens; 0 = pinhole
 //! focus_distance = 800     # default: distance from eye to look_at
+//! shutter = [0, 1]         # exposure interval; default [0, 0] (instantaneous)
 //!
 //! [[mesh]]
 //! file = "cornell_box.obj" # relative to this file; materials from its MTL
@@ -18,6 +19,7 @@
 //! rotate = [0, 30, 0]      # degrees about x, then y, then z
 //! translate = [0, 0, 0]
 //! material = "glass"       # optional: override every face's material
+//! velocity = [0, 0, 0]     # motion per unit time (meshes, spheres, quads; not emitters)
 //!
 //! [[sphere]]
 //! center = [0, 1, 0]
@@ -81,6 +83,8 @@ pub struct CameraDesc {
     #[serde(default)]
     pub aperture_radius: f32,
     pub focus_distance: Option<f32>,
+    #[serde(default)]
+    pub shutter: [f32; 2],
 }
 
 fn default_up() -> [f32; 3] {
@@ -113,6 +117,8 @@ pub struct MeshDesc {
     #[serde(default)]
     pub translate: [f32; 3],
     pub material: Option<String>,
+    #[serde(default)]
+    pub velocity: [f32; 3],
 }
 
 /// `[[sphere]]`.
@@ -122,6 +128,8 @@ pub struct SphereDesc {
     pub center: [f32; 3],
     pub radius: f32,
     pub material: String,
+    #[serde(default)]
+    pub velocity: [f32; 3],
 }
 
 /// `[[quad]]`: the parallelogram `corner + s u + t v`.
@@ -132,6 +140,8 @@ pub struct QuadDesc {
     pub u: [f32; 3],
     pub v: [f32; 3],
     pub material: String,
+    #[serde(default)]
+    pub velocity: [f32; 3],
 }
 
 /// `[[point_light]]`.

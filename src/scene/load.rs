@@ -4,7 +4,7 @@
 use super::description::*;
 use super::material::{Bsdf, Material};
 use super::obj::load_obj;
-use super::{Limits, SceneInput};
+use super::{Limits, MovingInput, SceneInput};
 use crate::accel::{NO_LIGHT, Sphere, TriangleInput};
 use crate::error::{Error, Result, line_of};
 use crate::math::Rgb;
@@ -56,6 +56,26 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
     };
 
     let mut triangles: Vec<TriangleInput> = Vec::new();
+    let mut spheres = Vec::new();
+    let mut moving: Vec<MovingInput> = Vec::new();
+    // Where an object's primitives go: the static lists, or a moving object
+    // of its own. Lights may not move (their sampling assumes fixed positions).
+    let motion_of = |velocity: [f32; 3],
+                     span: std::ops::Range<usize>,
+                     emissive: bool|
+     -> Result<Option<Vec3A>> {
+        let v = finite3("velocity", velocity).map_err(|m| at(span.clone(), m))?;
+        if v == Vec3A::ZERO {
+            return Ok(None);
+        }
+        if emissive {
+            return Err(at(
+                span,
+                "`velocity`: emitters cannot move (light sampling assumes fixed lights)".into(),
+            ));
+        }
+        Ok(Some(v))
+    };
     for mesh in &file.mesh {
         let desc = mesh.get_ref();
         let obj_path = dir.join(&desc.file);
@@ -89,6 +109,7 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
             obj_ids.push(id);
         }
         let mut default_id = None;
+        let mut mesh_triangles = Vec::with_capacity(obj.triangles.len());
         for (vertices, mtl) in obj.triangles {
             let material = match (override_id, mtl) {
                 (Some(id), _) => id,
@@ -99,8 +120,8 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
                 }),
             };
             let vertices = vertices.map(|v| transform.transform_point3a(v));
-            triangles.push(TriangleInput { vertices, material });
-            if triangles.len() > limits.max_triangles {
+            mesh_triangles.push(TriangleInput { vertices, material });
+            if triangles.len() + mesh_triangles.len() > limits.max_triangles {
                 return Err(at(
                     mesh.span(),
                     format!(
@@ -109,6 +130,17 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
                     ),
                 ));
             }
+        }
+        let emissive = mesh_triangles
+            .iter()
+            .any(|t| materials[t.material as usize].is_emissive());
+        match motion_of(desc.velocity, mesh.span(), emissive)? {
+            Some(velocity) => moving.push(MovingInput {
+                triangles: mesh_triangles,
+                spheres: Vec::new(),
+                velocity,
+            }),
+            None => triangles.extend(mesh_triangles),
         }
     }
 
@@ -122,17 +154,27 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
                 "quad: `corner`, `u` and `v` must be finite".into(),
             ));
         }
-        triangles.push(TriangleInput {
-            vertices: [c, c + u, c + u + v],
-            material,
-        });
-        triangles.push(TriangleInput {
-            vertices: [c, c + u + v, c + v],
-            material,
-        });
+        let halves = [
+            TriangleInput {
+                vertices: [c, c + u, c + u + v],
+                material,
+            },
+            TriangleInput {
+                vertices: [c, c + u + v, c + v],
+                material,
+            },
+        ];
+        let emissive = materials[material as usize].is_emissive();
+        match motion_of(q.velocity, quad.span(), emissive)? {
+            Some(velocity) => moving.push(MovingInput {
+                triangles: halves.to_vec(),
+                spheres: Vec::new(),
+                velocity,
+            }),
+            None => triangles.extend(halves),
+        }
     }
 
-    let mut spheres = Vec::new();
     for sphere in &file.sphere {
         let s = sphere.get_ref();
         let material = lookup(&s.material, sphere.span(), &by_name)?;
@@ -146,12 +188,21 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
                 ),
             ));
         }
-        spheres.push(Sphere {
+        let primitive = Sphere {
             center,
             radius: s.radius,
             material,
             light: NO_LIGHT,
-        });
+        };
+        let emissive = materials[material as usize].is_emissive();
+        match motion_of(s.velocity, sphere.span(), emissive)? {
+            Some(velocity) => moving.push(MovingInput {
+                triangles: Vec::new(),
+                spheres: vec![primitive],
+                velocity,
+            }),
+            None => spheres.push(primitive),
+        }
     }
 
     let mut point_lights = Vec::new();
@@ -177,6 +228,7 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         triangles,
         spheres,
         point_lights,
+        moving,
         sphere_sampling: file.lights.sphere_sampling,
         triangle_sampling: file.lights.triangle_sampling,
     })
@@ -229,6 +281,13 @@ fn build_camera(
     if !(focus.is_finite() && focus > 0.0) {
         return Err(format!("`camera.focus_distance` must be > 0, got {focus}"));
     }
+    let [open, close] = c.shutter;
+    if !(open.is_finite() && close.is_finite() && close >= open) {
+        return Err(format!(
+            "`camera.shutter` must be [open, close] with finite open <= close, got {:?}",
+            c.shutter
+        ));
+    }
     Ok(Camera::look_at(
         eye,
         look_at,
@@ -238,7 +297,8 @@ fn build_camera(
         c.height,
         c.aperture_radius,
         focus,
-    ))
+    )
+    .with_shutter(open, close))
 }
 
 fn mesh_transform(m: &MeshDesc) -> std::result::Result<Mat4, String> {

@@ -11,6 +11,7 @@ pub mod obj;
 use crate::accel::{Geometry, Sphere, TriangleInput};
 use crate::error::{Error, Result};
 use camera::Camera;
+use glam::Vec3A;
 use light::{Light, LightSampling, Lights};
 use material::{Bsdf, Material};
 use std::path::Path;
@@ -53,8 +54,18 @@ pub struct SceneInput {
     pub triangles: Vec<TriangleInput>,
     pub spheres: Vec<Sphere>,
     pub point_lights: Vec<Light>,
+    /// Objects in linear motion.
+    pub moving: Vec<MovingInput>,
     pub sphere_sampling: LightSampling,
     pub triangle_sampling: LightSampling,
+}
+
+/// One object moving by `velocity` per unit of time, given at time 0.
+#[derive(Clone, Debug)]
+pub struct MovingInput {
+    pub triangles: Vec<TriangleInput>,
+    pub spheres: Vec<Sphere>,
+    pub velocity: Vec3A,
 }
 
 /// What a scene uses, detected at load, so that estimators can run a hot
@@ -68,10 +79,17 @@ pub struct Features {
     pub point_lights: bool,
     pub spheres: bool,
     pub area_lights: usize,
+    /// Something moves while the shutter is open: camera rays need a time.
+    pub motion: bool,
 }
 
 impl Features {
-    fn detect(materials: &[Material], geometry: &Geometry, lights: &Lights) -> Features {
+    fn detect(
+        materials: &[Material],
+        geometry: &Geometry,
+        lights: &Lights,
+        camera: &Camera,
+    ) -> Features {
         let used = |f: &dyn Fn(&Bsdf) -> bool| materials.iter().any(|m| f(&m.bsdf));
         Features {
             mirror: used(&|b| matches!(b, Bsdf::Mirror { .. })),
@@ -81,12 +99,13 @@ impl Features {
                 .as_slice()
                 .iter()
                 .any(|l| matches!(l, Light::Point { .. })),
-            spheres: !geometry.spheres().is_empty(),
+            spheres: geometry.has_spheres(),
             area_lights: lights
                 .as_slice()
                 .iter()
                 .filter(|l| !matches!(l, Light::Point { .. }))
                 .count(),
+            motion: geometry.has_motion() && camera.has_shutter_interval(),
         }
     }
 
@@ -105,6 +124,7 @@ impl Features {
         let mut v = Vec::new();
         if !self.dielectric {
             v.push("refraction");
+            v.push("transparent-shadow tests");
         }
         if !self.specular() {
             v.push("specular-bounce branches");
@@ -118,8 +138,44 @@ impl Features {
         if !self.spheres {
             v.push("sphere intersection");
         }
-        v.push("time dimension (static scene)");
+        if !self.motion {
+            v.push("time dimension (static scene)");
+        }
         v
+    }
+}
+
+/// Counts of degenerate primitives dropped at build.
+#[derive(Default)]
+struct Dropped {
+    triangles: usize,
+    triangle_total: usize,
+    spheres: usize,
+}
+
+impl Dropped {
+    /// Keeps triangles with a representable area and normal: a zero-area one
+    /// has no normal, no hits and emits nothing.
+    fn triangles(&mut self, all: Vec<TriangleInput>) -> Vec<TriangleInput> {
+        let total = all.len();
+        let kept: Vec<TriangleInput> = all
+            .into_iter()
+            .filter(|t| {
+                let [a, b, c] = t.vertices;
+                let n = (b - a).cross(c - a);
+                n.length_squared() > 0.0 && n.is_finite() && n.normalize().is_finite()
+            })
+            .collect();
+        self.triangle_total += total;
+        self.triangles += total - kept.len();
+        kept
+    }
+
+    fn spheres(&mut self, all: Vec<Sphere>) -> Vec<Sphere> {
+        let total = all.len();
+        let kept: Vec<Sphere> = all.into_iter().filter(|s| s.radius > 0.0).collect();
+        self.spheres += total - kept.len();
+        kept
     }
 }
 
@@ -151,35 +207,29 @@ impl Scene {
     /// the BVHs and turns every emissive primitive into a light.
     pub fn build(input: SceneInput) -> Result<Scene> {
         let mut warnings = Vec::new();
-        let total = input.triangles.len();
-        let triangles: Vec<TriangleInput> = input
-            .triangles
+        let mut dropped = Dropped::default();
+        let triangles = dropped.triangles(input.triangles);
+        let spheres = dropped.spheres(input.spheres);
+        let moving: Vec<(Vec<TriangleInput>, Vec<Sphere>, Vec3A)> = input
+            .moving
             .into_iter()
-            .filter(|t| {
-                let [a, b, c] = t.vertices;
-                let n = (b - a).cross(c - a);
-                // Zero or non-representable area: no normal, no hits, no light.
-                n.length_squared() > 0.0 && n.is_finite() && n.normalize().is_finite()
+            .map(|m| {
+                (
+                    dropped.triangles(m.triangles),
+                    dropped.spheres(m.spheres),
+                    m.velocity,
+                )
             })
             .collect();
-        let dropped = total - triangles.len();
-        if dropped > 0 {
+        if dropped.triangles > 0 {
             let emitters_hint = "(zero-area emitters among them emit nothing)";
             warnings.push(format!(
-                "dropped {dropped} degenerate triangle(s) of {total} {emitters_hint}"
+                "dropped {} degenerate triangle(s) of {} {emitters_hint}",
+                dropped.triangles, dropped.triangle_total
             ));
         }
-        let sphere_total = input.spheres.len();
-        let spheres: Vec<Sphere> = input
-            .spheres
-            .into_iter()
-            .filter(|s| s.radius > 0.0)
-            .collect();
-        if spheres.len() < sphere_total {
-            warnings.push(format!(
-                "dropped {} sphere(s) of radius 0",
-                sphere_total - spheres.len()
-            ));
+        if dropped.spheres > 0 {
+            warnings.push(format!("dropped {} sphere(s) of radius 0", dropped.spheres));
         }
         if let Some(bad) = triangles
             .iter()
@@ -192,6 +242,11 @@ impl Scene {
         }
 
         let mut geometry = Geometry::build(&triangles, spheres);
+        for (triangles, spheres, velocity) in moving {
+            if !(triangles.is_empty() && spheres.is_empty()) {
+                geometry.add_moving(Geometry::build(&triangles, spheres), velocity);
+            }
+        }
         let mut lights = Vec::new();
         for i in 0..geometry.triangle_count() {
             let material = &input.materials[geometry.triangle_material(i) as usize];
@@ -231,7 +286,7 @@ impl Scene {
         if lights.is_empty() {
             warnings.push("the scene has no light source: the image will be black".into());
         }
-        let features = Features::detect(&input.materials, &geometry, &lights);
+        let features = Features::detect(&input.materials, &geometry, &lights, &input.camera);
         Ok(Scene {
             camera: input.camera,
             features,

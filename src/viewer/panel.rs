@@ -195,6 +195,7 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
             let d = &mut config.domains;
             ui.checkbox(&mut d.pixel, "Pixel");
             ui.checkbox(&mut d.lens, "Lens");
+            ui.checkbox(&mut d.time, "Time");
             ui.checkbox(&mut d.light, "Light");
             ui.checkbox(&mut d.bsdf, "BSDF");
         });

@@ -49,6 +49,7 @@ impl Config {
             let names: Vec<&str> = [
                 (d.pixel, "pixel"),
                 (d.lens, "lens"),
+                (d.time, "time"),
                 (d.light, "light"),
                 (d.bsdf, "bsdf"),
             ]
