@@ -17,6 +17,7 @@ pub mod plot;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod stress;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 

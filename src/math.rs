@@ -144,6 +144,50 @@ pub fn offset_ray_origin(p: Vec3A, p_error: Vec3A, n: Vec3A, w: Vec3A) -> Vec3A 
     )
 }
 
+/// How spawned rays leave a surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum OffsetMode {
+    /// By the point's rounding-error bound: correct at any scene scale.
+    #[default]
+    Robust,
+    /// By a fixed distance along the normal, the classic "epsilon": too
+    /// small for large or far-away scenes (shadow acne), too large for small
+    /// ones (light leaks, missing contact shadows). Kept to show exactly that.
+    Fixed(f32),
+}
+
+impl OffsetMode {
+    /// Parses `robust` or `fixed:EPS`.
+    pub fn parse(text: &str) -> Result<OffsetMode, String> {
+        if text == "robust" {
+            return Ok(OffsetMode::Robust);
+        }
+        let eps = text
+            .strip_prefix("fixed:")
+            .and_then(|e| e.parse::<f32>().ok())
+            .filter(|e| e.is_finite() && *e >= 0.0);
+        eps.map(OffsetMode::Fixed)
+            .ok_or_else(|| format!("`{text}`: expected `robust` or `fixed:EPS` with EPS >= 0"))
+    }
+
+    /// The error bound to spawn from: `robust_error` itself, or the bound
+    /// that makes [`offset_ray_origin`] move exactly `eps` along `normal`.
+    #[inline]
+    pub fn spawn_error(self, robust_error: Vec3A, normal: Vec3A) -> Vec3A {
+        match self {
+            OffsetMode::Robust => robust_error,
+            OffsetMode::Fixed(eps) => {
+                let l1 = normal.abs().element_sum();
+                if l1 > 0.0 {
+                    Vec3A::splat(eps / l1)
+                } else {
+                    Vec3A::ZERO
+                }
+            }
+        }
+    }
+}
+
 /// Fraction of a segment's length left out at its far end, so that a shadow
 /// ray never reaches the surface of the point it aims at (pbrt's ShadowEpsilon).
 pub const SHADOW_EPSILON: f32 = 1e-4;

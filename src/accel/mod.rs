@@ -10,7 +10,7 @@ mod soup;
 mod sphere;
 mod triangle;
 
-use crate::math::{Ray, gamma};
+use crate::math::{OffsetMode, Ray, gamma};
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
@@ -58,6 +58,10 @@ pub struct SurfaceHit {
     pub light: u32,
     /// Time of the ray that found the hit, inherited by rays spawned here.
     pub time: f32,
+    /// Which primitive: a triangle's index, or the triangle count plus a
+    /// sphere's index (within one object, for diagnostics such as counting
+    /// self-intersections).
+    pub primitive: u32,
 }
 
 impl SurfaceHit {
@@ -139,6 +143,8 @@ pub struct Geometry {
     spheres: Vec<Sphere>,
     /// Objects in linear motion, each tested by moving the ray instead.
     moving: Vec<MovingGeometry>,
+    /// How rays spawned at hits leave the surface.
+    offset: OffsetMode,
 }
 
 /// Geometry translated by `velocity * time`: at time t it is hit where the
@@ -296,9 +302,28 @@ impl Geometry {
         b
     }
 
+    /// Sets how rays spawned at hits leave the surface.
+    pub fn set_offset(&mut self, offset: OffsetMode) {
+        self.offset = offset;
+    }
+
+    /// How rays spawned at hits leave the surface.
+    pub fn offset(&self) -> OffsetMode {
+        self.offset
+    }
+
     /// Closest hit along `ray` in (0, ray.t_max), at `ray.time`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+        let mut hit = self.intersect_all(ray);
+        if let (OffsetMode::Fixed(_), Some(h)) = (self.offset, &mut hit) {
+            h.error = self.offset.spawn_error(h.error, h.normal);
+        }
+        hit
+    }
+
+    #[inline]
+    fn intersect_all(&self, ray: &Ray) -> Option<SurfaceHit> {
         let mut best = self.intersect_static(ray);
         if self.moving.is_empty() {
             return best;
@@ -387,6 +412,7 @@ impl Geometry {
                 material: s.material,
                 light: s.light,
                 time: ray.time,
+                primitive: self.tri_vertices.len() as u32 + best_sphere,
             });
         }
         if best_tri == u32::MAX {
@@ -406,6 +432,7 @@ impl Geometry {
             material: shading.material,
             light: shading.light,
             time: ray.time,
+            primitive: best_tri,
         })
     }
 

@@ -2,6 +2,7 @@
 //! (`view`, `render`, `compare` here; `bench` in `bench.rs`).
 
 mod bench;
+mod stress;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -13,6 +14,7 @@ use tracelab::image::{Image, check_writable};
 use tracelab::integrator::{
     GlassShadows, IntegratorKind, IntegratorOptions, MisHeuristic, Strategy,
 };
+use tracelab::math::OffsetMode;
 use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
 use tracelab::sampling::{Domains, SamplerKind};
 use tracelab::scene::light::LightSampling;
@@ -37,6 +39,9 @@ enum Command {
     /// Measure error against a reference at 1, 2, 4, ... spp for several
     /// configurations; print a table, write CSV and log-log plots (SVG).
     Bench(bench::BenchArgs),
+    /// The numerical stress suite: scaled, far-away and awkward scenes against
+    /// their references; exits non-zero when a case fails.
+    Stress(stress::StressArgs),
     /// Compare two images: RMSE, relative MSE and mean relative error (as tev computes them).
     Compare {
         /// The image to measure.
@@ -174,6 +179,10 @@ struct RenderArgs {
     /// area and spheres by solid angle unless its [lights] table says otherwise).
     #[arg(long, value_enum)]
     light_sampling: Option<LightSamplingArg>,
+    /// How rays leave surfaces: `robust` (by the hit's rounding-error bound)
+    /// or `fixed:EPS` (the classic epsilon along the normal, to see its artifacts).
+    #[arg(long, value_parser = OffsetMode::parse, default_value = "robust")]
+    offset: OffsetMode,
     /// MC ray tracing: light samples (shadow rays) per hit.
     #[arg(long, default_value_t = 1)]
     shadow_rays: u32,
@@ -228,6 +237,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Render(args)) => render(&args),
         Some(Command::Compare { image, reference }) => compare(&image, &reference),
         Some(Command::Bench(args)) => bench::bench(&args),
+        Some(Command::Stress(args)) => stress::stress(&args),
         #[cfg(feature = "viewer")]
         Some(Command::View(args)) => view(args),
         #[cfg(feature = "viewer")]
@@ -354,6 +364,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             LightSamplingArg::SolidAngle => LightSampling::SolidAngle,
         });
     }
+    scene.set_offset(args.offset);
     for w in &scene.warnings {
         eprintln!("warning: {}: {w}", args.scene.display());
     }

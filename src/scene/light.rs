@@ -6,7 +6,7 @@
 //! solid angle they subtend. All densities are returned wrt. solid angle at
 //! the shading point, so the integrators can combine them with BSDF densities.
 
-use crate::math::{Frame, Rgb, gamma, luminance};
+use crate::math::{Frame, OffsetMode, Rgb, gamma, luminance};
 use crate::sampling::warp::{
     cosine_hemisphere_pdf, square_to_cosine_hemisphere, square_to_uniform_cone,
     square_to_uniform_sphere, square_to_uniform_triangle, uniform_cone_pdf,
@@ -485,6 +485,8 @@ impl Light {
 pub struct Lights {
     lights: Vec<Light>,
     selection: Option<AliasTable>,
+    /// How shadow rays stop short of sampled light points.
+    offset: OffsetMode,
 }
 
 impl Lights {
@@ -492,7 +494,11 @@ impl Lights {
     pub fn new(lights: Vec<Light>) -> Self {
         let powers: Vec<f32> = lights.iter().map(Light::power).collect();
         let selection = AliasTable::new(&powers);
-        Lights { lights, selection }
+        Lights {
+            lights,
+            selection,
+            offset: OffsetMode::Robust,
+        }
     }
 
     /// The same lights with every area light sampled by `mode`.
@@ -506,7 +512,13 @@ impl Lights {
         Lights {
             lights,
             selection: self.selection.clone(),
+            offset: self.offset,
         }
+    }
+
+    /// Sets how shadow rays stop short of sampled light points.
+    pub fn set_offset(&mut self, offset: OffsetMode) {
+        self.offset = offset;
     }
 
     /// The lights, indexed by the light ids stored on emissive primitives.
@@ -527,6 +539,7 @@ impl Lights {
         let (index, pmf) = table.sample(u_select);
         let mut s = self.lights[index].sample(reference, u)?;
         s.pdf *= pmf;
+        s.error = self.offset.spawn_error(s.error, s.normal);
         (s.pdf > 0.0 && s.pdf.is_finite() && s.distance > 0.0).then_some(s)
     }
 
@@ -542,6 +555,7 @@ impl Lights {
         let (index, pmf) = table.sample(u_select);
         let mut s = self.lights[index].sample_emission(u_position, u_direction)?;
         s.throughput /= pmf;
+        s.error = self.offset.spawn_error(s.error, s.normal);
         s.pdf_position *= pmf;
         (s.throughput.is_finite() && s.pdf_position > 0.0).then_some(s)
     }

@@ -10,6 +10,7 @@ pub mod obj;
 
 use crate::accel::{Geometry, Sphere, TriangleInput};
 use crate::error::{Error, Result};
+use crate::math::OffsetMode;
 use camera::Camera;
 use glam::Vec3A;
 use light::{Light, LightSampling, Lights};
@@ -300,6 +301,15 @@ impl Scene {
     /// Samples every area light by `mode` (the CLI's `--light-sampling`).
     pub fn set_light_sampling(&mut self, mode: LightSampling) {
         self.lights = self.lights.with_sampling(mode);
+    }
+
+    /// Sets how rays leave surfaces (`--offset`). Clones the geometry only
+    /// when it is shared and the mode changes.
+    pub fn set_offset(&mut self, offset: OffsetMode) {
+        if self.geometry.offset() != offset {
+            Arc::make_mut(&mut self.geometry).set_offset(offset);
+        }
+        self.lights.set_offset(offset);
     }
 
     /// Overrides the image size (keeping the field of view).
