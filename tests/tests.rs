@@ -23,6 +23,8 @@ mod motion;
 mod stress;
 // Every scene in scenes/ renders without non-finite samples.
 mod scenes;
+// Inputs that once crashed the fuzz targets.
+mod fuzz_regressions;
 // The command line: renders, comparisons and every kind of bad input.
 mod cli;
 // The viewer driven through egui_kittest (needs the default `viewer` feature).

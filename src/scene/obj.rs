@@ -32,11 +32,17 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh> {
         ignore_lines: true,
         ..Default::default()
     };
-    let (models, materials) =
+    // tobj has panicked on input our line scans did not foresee (found by
+    // fuzzing: `Kd` with fewer than three numbers); a panic in it is a bad
+    // file, not a crash.
+    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         tobj::load_obj_buf(&mut BufReader::new(text.as_bytes()), &options, |mtl| {
             tobj::load_mtl(dir.join(mtl))
         })
-        .map_err(|e| Error::at(path, None, format!("malformed OBJ: {e}")))?;
+    }))
+    .map_err(|_| Error::at(path, None, "malformed OBJ or MTL: the OBJ parser gave up"))?;
+    let (models, materials) =
+        parsed.map_err(|e| Error::at(path, None, format!("malformed OBJ: {e}")))?;
     let materials = materials
         .map_err(|e| Error::at(path, None, format!("cannot load its material library: {e}")))?;
     let mtl_path = mtl_library(&text)
@@ -163,8 +169,45 @@ pub fn check_obj_text(path: &Path, text: &str) -> Result<()> {
                         ),
                     ));
                 }
+                let mtl_text = std::fs::read_to_string(&mtl).map_err(|e| {
+                    Error::at(&mtl, None, format!("cannot read material library: {e}"))
+                })?;
+                check_mtl_text(&mtl, &mtl_text)?;
             }
             _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Line scan of an MTL file: the colour and number statements tracelab reads
+/// must hold finite numbers (tobj reports them without a line, or panics).
+pub fn check_mtl_text(path: &Path, text: &str) -> Result<()> {
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let Some(key) = words.next() else {
+            continue;
+        };
+        let wanted = match key {
+            "Ka" | "Kd" | "Ks" | "Ke" => 3,
+            "Ns" | "Ni" | "d" => 1,
+            _ => continue,
+        };
+        let values: Vec<&str> = words.take(wanted).collect();
+        let finite = values
+            .iter()
+            .all(|v| v.parse::<f32>().is_ok_and(f32::is_finite));
+        if values.len() < wanted || !finite {
+            let what = if wanted == 3 {
+                "three finite numbers"
+            } else {
+                "a finite number"
+            };
+            return Err(Error::at(
+                path,
+                Some(number + 1),
+                format!("`{key}` needs {what}, got `{}`", line.trim()),
+            ));
         }
     }
     Ok(())

@@ -1,0 +1,71 @@
+//! Inputs the fuzz targets (fuzz/, see the README) once crashed on, replayed
+//! the way each target feeds them: each must now load to a scene or fail
+//! with an error naming a file, never panic.
+
+use crate::common::{repo_path, temp_dir};
+use tracelab::scene::load::{load_scene_file, parse_scene};
+use tracelab::scene::{Limits, Scene};
+
+fn inputs(target: &str) -> Vec<(String, Vec<u8>)> {
+    let dir = repo_path(&format!("tests/data/fuzz/{target}"));
+    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .map(|e| {
+                    let path = e.unwrap().path();
+                    (path.display().to_string(), std::fs::read(&path).unwrap())
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+fn check(name: &str, result: tracelab::Result<tracelab::scene::SceneInput>) {
+    match result {
+        Ok(input) => {
+            let _ = Scene::build(input);
+        }
+        Err(e) => {
+            let message = e.to_string();
+            assert!(
+                message.contains(".obj") || message.contains(".mtl") || message.contains(".toml"),
+                "{name}: the error names no file: {message}"
+            );
+        }
+    }
+}
+
+#[test]
+fn obj_mtl_crashes_stay_fixed() {
+    let marker = b"\n#MTL\n";
+    let dir = temp_dir("fuzz-obj");
+    let scene = dir.join("scene.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\neye = [0, 1, 4]\nlook_at = [0, 0, 0]\nfov_y = 40\nwidth = 4\nheight = 4\n\n[[mesh]]\nfile = \"mesh.obj\"\n",
+    )
+    .unwrap();
+    let cases = inputs("obj_mtl");
+    assert!(!cases.is_empty());
+    for (name, data) in cases {
+        let (obj, mtl) = match data.windows(marker.len()).position(|w| w == marker) {
+            Some(i) => (&data[..i], &data[i + marker.len()..]),
+            None => (&data[..], &[][..]),
+        };
+        std::fs::write(dir.join("mesh.obj"), obj).unwrap();
+        std::fs::write(dir.join("mesh.mtl"), mtl).unwrap();
+        check(&name, load_scene_file(&scene, &Limits::default()));
+    }
+}
+
+#[test]
+fn scene_toml_crashes_stay_fixed() {
+    let path = repo_path("scenes/fuzz.toml");
+    for (name, data) in inputs("scene_toml") {
+        if let Ok(text) = std::str::from_utf8(&data) {
+            check(&name, parse_scene(&path, text, &Limits::default()));
+        }
+    }
+}
