@@ -52,6 +52,7 @@ fn paths_per_second_with(threads: usize, general: bool) -> f64 {
                 threads,
                 adaptive: None,
                 domains: Default::default(),
+                clamp: None,
             };
             let session = Session::new(scene.clone(), settings).unwrap();
             for _ in 0..4 {

@@ -149,6 +149,7 @@ pub fn measure(
             threads,
             adaptive: None,
             domains: config.domains,
+            clamp: None,
         };
         let session = Session::with_pool(scene.clone(), settings, pool.clone());
         let start = Instant::now();

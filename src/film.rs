@@ -15,16 +15,54 @@ pub const TILE_SIZE: u32 = 16;
 
 /// Running sums of one pixel. f64 keeps long renders (10^5 spp) exact enough
 /// for the variance estimate.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 pub struct PixelSums {
     pub sum: [f64; 3],
     pub sum_sq: [f64; 3],
     pub count: u32,
     /// Samples that were NaN or infinite and were left out.
     pub non_finite: u32,
+    /// Samples brighter than [`EXTREME_LUMINANCE`] (kept, or clamped).
+    pub extreme: u32,
+    /// Index of the first non-finite or extreme sample, for replaying it
+    /// (`tracelab render --debug-sample`); [`NOT_FLAGGED`] if none.
+    pub first_flagged: u32,
+}
+
+/// `first_flagged` of a pixel without non-finite or extreme samples.
+pub const NOT_FLAGGED: u32 = u32::MAX;
+
+/// Luminance above which a sample counts as extreme (a firefly candidate):
+/// a thousand times a white surface under unit irradiance / pi.
+pub const EXTREME_LUMINANCE: f32 = 1000.0;
+
+impl Default for PixelSums {
+    fn default() -> Self {
+        PixelSums {
+            sum: [0.0; 3],
+            sum_sq: [0.0; 3],
+            count: 0,
+            non_finite: 0,
+            extreme: 0,
+            first_flagged: NOT_FLAGGED,
+        }
+    }
 }
 
 impl PixelSums {
+    /// Notes sample `index` as non-finite or extreme when it is; returns
+    /// true when it is extreme (finite but brighter than [`EXTREME_LUMINANCE`]).
+    #[inline]
+    pub fn flag(&mut self, value: Rgb, index: u32) -> bool {
+        let non_finite = !value.is_finite();
+        let extreme = !non_finite && crate::math::luminance(value) > EXTREME_LUMINANCE;
+        if (non_finite || extreme) && self.first_flagged == NOT_FLAGGED {
+            self.first_flagged = index;
+        }
+        self.extreme += u32::from(extreme);
+        extreme
+    }
+
     /// Adds one sample, or counts it as non-finite and leaves it out.
     #[inline]
     pub fn add(&mut self, value: Rgb) {
@@ -134,6 +172,10 @@ pub struct FilmSnapshot {
     pub samples: Vec<u32>,
     /// Per-pixel counts of non-finite samples left out.
     pub non_finite_pixels: Vec<u32>,
+    /// Per-pixel counts of extreme samples.
+    pub extreme_pixels: Vec<u32>,
+    /// Per-pixel index of the first non-finite or extreme sample ([`NOT_FLAGGED`]).
+    pub first_flagged: Vec<u32>,
     /// Total non-finite samples left out.
     pub non_finite: u64,
 }
@@ -181,6 +223,8 @@ impl Film {
         let mut standard_error = Image::new(self.width, self.height);
         let mut samples = vec![0u32; n];
         let mut non_finite_pixels = vec![0u32; n];
+        let mut extreme_pixels = vec![0u32; n];
+        let mut first_flagged = vec![NOT_FLAGGED; n];
         let mut non_finite = 0u64;
         for tile in &self.tiles {
             // A poisoned lock only means a pass panicked; the sums are still valid.
@@ -193,6 +237,8 @@ impl Film {
                     standard_error.pixels[i] = p.standard_error();
                     samples[i] = p.count;
                     non_finite_pixels[i] = p.non_finite;
+                    extreme_pixels[i] = p.extreme;
+                    first_flagged[i] = p.first_flagged;
                     non_finite += p.non_finite as u64;
                 }
             }
@@ -202,6 +248,8 @@ impl Film {
             standard_error,
             samples,
             non_finite_pixels,
+            extreme_pixels,
+            first_flagged,
             non_finite,
         }
     }

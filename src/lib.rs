@@ -15,6 +15,7 @@ pub mod live;
 pub mod math;
 pub mod plot;
 pub mod render;
+pub mod replay;
 pub mod sampling;
 pub mod scene;
 pub mod stress;

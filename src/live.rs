@@ -439,6 +439,7 @@ mod tests {
                 threads: 0,
                 adaptive: None,
                 domains: Default::default(),
+                clamp: None,
             },
             target_spp: Some(spp),
         }

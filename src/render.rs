@@ -10,7 +10,7 @@
 use crate::error::{Error, Result};
 use crate::film::{Film, FilmSnapshot};
 use crate::integrator::{Integrator, LightTracer, RayCounts, sample_time};
-use crate::math::Rgb;
+use crate::math::{Ray, Rgb};
 use crate::sampling::{Domain, Domains, Sampler, SamplerKind};
 use crate::scene::Scene;
 use glam::Vec2;
@@ -34,6 +34,9 @@ pub struct RenderSettings {
     pub adaptive: Option<Adaptive>,
     /// Domains the sampler applies to; the others are independent.
     pub domains: Domains,
+    /// Scale down any sample whose largest component exceeds this (off by
+    /// default): removes fireflies at the price of bias, and is reported so.
+    pub clamp: Option<f32>,
 }
 
 /// Adaptive sampling: a pixel with at least `min_spp` samples whose relative
@@ -58,6 +61,10 @@ pub struct RenderStats {
     pub non_finite: u64,
     /// Samples adaptive sampling did not take (converged pixels).
     pub skipped: u64,
+    /// Finite samples brighter than [`crate::film::EXTREME_LUMINANCE`].
+    pub extreme: u64,
+    /// Samples scaled down by [`RenderSettings::clamp`].
+    pub clamped: u64,
     /// Wall time spent inside passes.
     pub render_time: Duration,
 }
@@ -74,6 +81,8 @@ pub struct Session {
     shadow_rays: AtomicU64,
     bounce_rays: AtomicU64,
     non_finite: AtomicU64,
+    extreme: AtomicU64,
+    clamped: AtomicU64,
     skipped: AtomicU64,
     render_nanos: AtomicU64,
     cancelled: AtomicBool,
@@ -105,6 +114,8 @@ impl Session {
             shadow_rays: AtomicU64::new(0),
             bounce_rays: AtomicU64::new(0),
             non_finite: AtomicU64::new(0),
+            extreme: AtomicU64::new(0),
+            clamped: AtomicU64::new(0),
             skipped: AtomicU64::new(0),
             render_nanos: AtomicU64::new(0),
             cancelled: AtomicBool::new(false),
@@ -191,6 +202,7 @@ impl Session {
                     let mut counts = RayCounts::default();
                     let mut non_finite = 0u64;
                     let mut skipped = 0u64;
+                    let (mut extreme, mut clamped) = (0u64, 0u64);
                     let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
                     for (i, pixel) in tile.pixels.iter_mut().enumerate() {
                         let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
@@ -204,30 +216,25 @@ impl Session {
                         }
                         for s in first..first + spp {
                             sampler.start(pixel_index, s);
-                            let mut film_point =
-                                Vec2::new(x as f32, y as f32) + sampler.next_2d_for(Domain::Pixel);
-                            let mut lens = sampler.next_2d_for(Domain::Lens);
-                            let mut time = sample_time(scene, &mut sampler, general);
-                            if deterministic {
-                                // One ray through the pixel centre, lens
-                                // centre, at mid-exposure.
-                                film_point = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                                lens = Vec2::splat(0.5);
-                                time = scene.camera.time(0.5);
-                            }
-                            let ray = scene.camera.generate_ray(film_point, lens).at_time(time);
+                            let ray = camera_ray(scene, &mut sampler, x, y, deterministic, general);
                             counts.camera += 1;
-                            let value =
+                            let mut value =
                                 settings
                                     .integrator
                                     .radiance(scene, ray, &mut sampler, &mut counts);
                             non_finite += u64::from(!value.is_finite());
+                            extreme += u64::from(pixel.flag(value, s));
+                            if let Some(limit) = settings.clamp {
+                                clamped += u64::from(clamp_sample(&mut value, limit));
+                            }
                             pixel.add(value);
                         }
                     }
                     drop(tile);
                     self.add_counts(counts.camera, &counts, non_finite);
                     self.skipped.fetch_add(skipped, Ordering::Relaxed);
+                    self.extreme.fetch_add(extreme, Ordering::Relaxed);
+                    self.clamped.fetch_add(clamped, Ordering::Relaxed);
                 });
         });
     }
@@ -320,8 +327,47 @@ impl Session {
             },
             non_finite: self.non_finite.load(Ordering::Relaxed),
             skipped: self.skipped.load(Ordering::Relaxed),
+            extreme: self.extreme.load(Ordering::Relaxed),
+            clamped: self.clamped.load(Ordering::Relaxed),
             render_time: Duration::from_nanos(self.render_nanos.load(Ordering::Relaxed)),
         }
+    }
+}
+
+/// The camera ray of the sample the sampler was started at, for pixel
+/// (`x`, `y`): film position, lens point and time in this order, so that a
+/// replay draws the same numbers. `deterministic` estimators shoot through
+/// the pixel and lens centres at mid-exposure.
+#[inline]
+pub fn camera_ray(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    x: u32,
+    y: u32,
+    deterministic: bool,
+    general: bool,
+) -> Ray {
+    let mut film_point = Vec2::new(x as f32, y as f32) + sampler.next_2d_for(Domain::Pixel);
+    let mut lens = sampler.next_2d_for(Domain::Lens);
+    let mut time = sample_time(scene, sampler, general);
+    if deterministic {
+        film_point = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+        lens = Vec2::splat(0.5);
+        time = scene.camera.time(0.5);
+    }
+    scene.camera.generate_ray(film_point, lens).at_time(time)
+}
+
+/// Scales `value` down so that its largest component is at most `limit`;
+/// returns true when it did.
+#[inline]
+pub fn clamp_sample(value: &mut Rgb, limit: f32) -> bool {
+    let max = value.max_element();
+    if max > limit && value.is_finite() {
+        *value *= limit / max;
+        true
+    } else {
+        false
     }
 }
 

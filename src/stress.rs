@@ -308,6 +308,7 @@ pub fn render(scene: &Scene, spp: u32, seed: u64) -> Result<(Image, u64)> {
         threads: 0,
         adaptive: None,
         domains: Default::default(),
+        clamp: None,
     };
     let session = Session::new(Arc::new(scene.clone()), settings)?;
     session.render_pass(spp);

@@ -42,6 +42,7 @@ pub fn render_with(
         threads,
         adaptive: None,
         domains: Default::default(),
+        clamp: None,
     };
     let session = Session::new(Arc::new(scene), settings).expect("session starts");
     let mut done = 0;

@@ -19,6 +19,8 @@ mod strategies;
 mod determinism;
 // Motion blur: a moving occluder against a case solved by hand.
 mod motion;
+// Replaying samples, flagging extreme ones, clamping.
+mod diagnostics;
 // Robust ray offsets at every scale; a fixed epsilon fails.
 mod stress;
 // Every scene in scenes/ renders without non-finite samples.

@@ -32,6 +32,7 @@ pub fn build_and_render(input: SceneInput) {
         threads: 1,
         adaptive: None,
         domains: Default::default(),
+        clamp: None,
     };
     if let Ok(session) = Session::new(Arc::new(scene), settings) {
         session.render_pass(1);

@@ -1,7 +1,7 @@
 //! `tracelab bench`: error against a reference at 1, 2, 4, ... spp for
 //! several configurations, as a table, CSV and log-log SVG plots.
 
-use super::{override_resolution, render_spp};
+use super::render::{override_resolution, render_spp};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -220,6 +220,7 @@ fn cached_reference(
             threads,
             adaptive: None,
             domains: config.domains,
+            clamp: None,
         },
     )?;
     render_spp(&session, spp);

@@ -19,6 +19,38 @@ use crate::scene::material::{Bsdf, BsdfSample};
 use glam::{Vec2, Vec3A};
 use std::f32::consts::FRAC_1_PI;
 
+/// Hears what one path does, for `--debug-sample`. Every method has an
+/// empty default and the render uses [`NoObserver`], a zero-sized type, so
+/// the observed loop compiles to the plain one.
+pub trait PathObserver {
+    /// The path reached vertex `bounce` (0 = first hit) with throughput `beta`.
+    fn vertex(&mut self, _bounce: u32, _hit: &SurfaceHit, _beta: Rgb) {}
+    /// Emission found at the vertex, its MIS weight and what it added.
+    fn emission(&mut self, _emitted: Rgb, _weight: f32, _added: Rgb) {}
+    /// A light sample: the point, its pdf (solid angle), the BSDF value, the
+    /// MIS weight, whether it is visible and what it added.
+    fn light_sample(
+        &mut self,
+        _ls: &LightSample,
+        _f: Rgb,
+        _weight: f32,
+        _visible: bool,
+        _added: Rgb,
+    ) {
+    }
+    /// The sampled continuation.
+    fn bsdf_sample(&mut self, _sample: &BsdfSample) {}
+    /// Russian roulette with survival probability `q`.
+    fn roulette(&mut self, _q: f32, _survived: bool) {}
+    /// The last ray left the scene.
+    fn escaped(&mut self) {}
+}
+
+/// The observer of ordinary rendering: hears nothing.
+pub struct NoObserver;
+
+impl PathObserver for NoObserver {}
+
 /// Settings of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathTracer {
@@ -77,24 +109,38 @@ impl PathTracer {
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
+        self.radiance_observed(scene, ray, sampler, counts, &mut NoObserver)
+    }
+
+    /// [`PathTracer::radiance`], telling `observer` about every vertex.
+    #[inline]
+    pub fn radiance_observed<O: PathObserver>(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> Rgb {
         let f = scene.features;
         if self.general || f.specular() {
-            self.trace::<true, false>(scene, ray, sampler, counts)
+            self.trace::<true, false, O>(scene, ray, sampler, counts, observer)
         } else if f.diffuse_only() {
-            self.trace::<false, true>(scene, ray, sampler, counts)
+            self.trace::<false, true, O>(scene, ray, sampler, counts, observer)
         } else {
-            self.trace::<false, false>(scene, ray, sampler, counts)
+            self.trace::<false, false, O>(scene, ray, sampler, counts, observer)
         }
     }
 
     /// The path loop. `SPECULAR`: the scene may have mirror or glass
     /// surfaces. `DIFFUSE_ONLY`: every BSDF is Lambertian.
-    fn trace<const SPECULAR: bool, const DIFFUSE_ONLY: bool>(
+    fn trace<const SPECULAR: bool, const DIFFUSE_ONLY: bool, O: PathObserver>(
         &self,
         scene: &Scene,
         mut ray: Ray,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
+        observer: &mut O,
     ) -> Rgb {
         let mut radiance = Rgb::ZERO;
         let mut beta = Rgb::ONE;
@@ -106,8 +152,10 @@ impl PathTracer {
         let mut bounces = 0;
         loop {
             let Some(hit) = scene.geometry.intersect(&ray) else {
+                observer.escaped();
                 break;
             };
+            observer.vertex(bounces, &hit, beta);
             let wo_world = -ray.direction;
             let material = &scene.materials[hit.material as usize];
 
@@ -126,6 +174,7 @@ impl PathTracer {
                         self.mis.weight(prev_bsdf_pdf, light_pdf)
                     };
                     radiance += beta * emitted * weight;
+                    observer.emission(emitted, weight, beta * emitted * weight);
                 }
             }
             if bounces >= self.max_depth || material.bsdf.is_black() {
@@ -154,9 +203,14 @@ impl PathTracer {
                             self.mis.weight(ls.pdf, pdf::<DIFFUSE_ONLY>(&bsdf, wo, wi))
                         };
                         counts.shadow += 1;
-                        if !scene.geometry.occluded(&shadow_ray(&hit, &ls)) {
-                            radiance += beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf);
-                        }
+                        let visible = !scene.geometry.occluded(&shadow_ray(&hit, &ls));
+                        let added = if visible {
+                            beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf)
+                        } else {
+                            Rgb::ZERO
+                        };
+                        radiance += added;
+                        observer.light_sample(&ls, f, weight, visible, added);
                     }
                 }
             }
@@ -164,17 +218,20 @@ impl PathTracer {
             let Some(sample) = sample::<DIFFUSE_ONLY>(&bsdf, wo, u_lobe, u_bsdf) else {
                 break;
             };
+            observer.bsdf_sample(&sample);
             beta *= sample.weight;
             specular_bounce = SPECULAR && sample.specular;
             prev_bsdf_pdf = sample.pdf;
             prev_point = hit.point;
             bounces += 1;
 
-            if self.russian_roulette
-                && bounces > self.rr_depth
-                && !survives_roulette(&mut beta, u_roulette)
-            {
-                break;
+            if self.russian_roulette && bounces > self.rr_depth {
+                let q = beta.max_element().min(0.95);
+                let survived = survives_roulette(&mut beta, u_roulette);
+                observer.roulette(q, survived);
+                if !survived {
+                    break;
+                }
             }
             if beta.max_element() <= 0.0 {
                 break;

@@ -369,6 +369,7 @@ impl ViewerApp {
                         threads: 0,
                         adaptive: None,
                         domains: c.domains,
+                        clamp: None,
                     },
                     target_spp: if integrator.is_deterministic() {
                         Some(1)

@@ -1,0 +1,544 @@
+//! `tracelab render`: one image from the command line, with a progress bar
+//! and a summary of what it cost; `--debug-sample` replays one path.
+
+use super::{IntegratorArg, integrator_kind};
+use clap::{Args, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+use tracelab::film::{EXTREME_LUMINANCE, FilmSnapshot, NOT_FLAGGED};
+use tracelab::image::check_writable;
+use tracelab::integrator::{GlassShadows, IntegratorOptions, MisHeuristic, Strategy};
+use tracelab::math::OffsetMode;
+use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
+use tracelab::replay::replay_sample;
+use tracelab::sampling::{Domains, SamplerKind};
+use tracelab::scene::light::LightSampling;
+use tracelab::scene::{Limits, Scene};
+use tracelab::{Error, Result};
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum StrategyArg {
+    /// BSDF sampling only.
+    Bsdf,
+    /// Light sampling only.
+    Light,
+    /// Both, combined by MIS.
+    Mis,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum LightSamplingArg {
+    /// Uniform by area: density d^2 / (cos A) in solid angle.
+    Area,
+    /// Uniform in solid angle: sphere cones, spherical triangles (Arvo).
+    SolidAngle,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum GlassShadowsArg {
+    Opaque,
+    Tinted,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum SamplerArg {
+    /// Independent uniform numbers.
+    Independent,
+    /// Jittered strata in every dimension and pair, shuffled between dimensions.
+    Stratified,
+    /// Correlated multi-jittered: jittered and Latin hypercube in every pair.
+    Multijitter,
+    /// Owen-scrambled Sobol, shuffled per dimension pair.
+    Sobol,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum MisArg {
+    None,
+    Balance,
+    Power,
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    #[arg(long, value_enum, default_value = "path")]
+    integrator: IntegratorArg,
+    /// Samples per pixel.
+    #[arg(long, conflicts_with_all = ["time", "rays_per_pixel"])]
+    spp: Option<u32>,
+    /// Render for this many seconds instead of a sample count.
+    #[arg(long, conflicts_with = "rays_per_pixel")]
+    time: Option<f64>,
+    /// Render until this many rays per pixel (all kinds) are cast: equal-cost comparisons.
+    #[arg(long)]
+    rays_per_pixel: Option<f64>,
+    #[arg(long, value_enum, default_value = "independent")]
+    sampler: SamplerArg,
+    /// Domains the sampler applies to, the rest independent: any of
+    /// pixel,lens,time,light,bsdf (default all).
+    #[arg(long, value_parser = parse_domains)]
+    domains: Option<Domains>,
+    /// Maximum bounces (1 = direct lighting); Mitsuba's max_depth is one more.
+    #[arg(long, default_value_t = 8)]
+    max_depth: u32,
+    /// Russian roulette starts after this many bounces.
+    #[arg(long, default_value_t = 5)]
+    rr_depth: u32,
+    /// Turn Russian roulette off.
+    #[arg(long)]
+    no_rr: bool,
+    /// Turn next-event estimation (light sampling) off: the same as --strategy bsdf.
+    #[arg(long, conflicts_with = "strategy")]
+    no_nee: bool,
+    /// Path tracing: sample the BSDF, the lights, or both with MIS.
+    #[arg(long, value_enum)]
+    strategy: Option<StrategyArg>,
+    /// How light and BSDF samples are combined (none = light sampling only).
+    #[arg(long, value_enum, default_value = "power")]
+    mis: MisArg,
+    /// How area lights are sampled (default: the scene's, i.e. triangles by
+    /// area and spheres by solid angle unless its [lights] table says otherwise).
+    #[arg(long, value_enum)]
+    light_sampling: Option<LightSamplingArg>,
+    /// How rays leave surfaces: `robust` (by the hit's rounding-error bound)
+    /// or `fixed:EPS` (the classic epsilon along the normal, to see its artifacts).
+    #[arg(long, value_parser = OffsetMode::parse, default_value = "robust")]
+    offset: OffsetMode,
+    /// MC ray tracing: light samples (shadow rays) per hit.
+    #[arg(long, default_value_t = 1)]
+    shadow_rays: u32,
+    /// MC ray tracing: BSDF samples (branching rays) per hit.
+    #[arg(long, default_value_t = 1)]
+    glossy_rays: u32,
+    /// Path tracing and Whitted: run the general code, not the code
+    /// specialised for the scene's features (to measure what that saves).
+    #[arg(long)]
+    general: bool,
+    /// Whitted: constant ambient radiance times the diffuse albedo.
+    #[arg(long, default_value_t = 0.0)]
+    ambient: f32,
+    /// Whitted: shadow rays through glass are blocked, or tinted by the glass.
+    #[arg(long, value_enum, default_value = "opaque")]
+    glass_shadows: GlassShadowsArg,
+    /// Image width (overrides the scene).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height (overrides the scene).
+    #[arg(long)]
+    height: Option<u32>,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Worker threads (default: one per core).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Adaptive sampling: stop sampling pixels whose relative standard error
+    /// falls below this (e.g. 0.02); biased, and reported as such.
+    #[arg(long)]
+    adaptive: Option<f32>,
+    /// Samples every pixel takes before adaptive sampling may stop it.
+    #[arg(long, default_value_t = 16)]
+    adaptive_min_spp: u32,
+    /// Exposure in stops for PNG output.
+    #[arg(long, default_value_t = 0.0)]
+    exposure: f32,
+    /// Largest accepted image side.
+    #[arg(long, default_value_t = Limits::default().max_resolution)]
+    max_resolution: u32,
+    /// Largest accepted triangle count.
+    #[arg(long, default_value_t = Limits::default().max_triangles)]
+    max_triangles: usize,
+    /// Scale down samples whose largest component exceeds this value
+    /// (removes fireflies; biased, and the summary says how often it acted).
+    #[arg(long)]
+    clamp: Option<f32>,
+    /// Replay one sample of the render instead, `X,Y,S` (pixel and sample
+    /// index), printing its path's vertices, pdfs and weights.
+    #[arg(long, value_parser = parse_debug_sample)]
+    debug_sample: Option<(u32, u32, u32)>,
+    /// Output file: .exr (linear float32) or .png (tone-mapped sRGB).
+    #[arg(long, short, required_unless_present = "debug_sample")]
+    out: Option<PathBuf>,
+}
+
+enum OutputFormat {
+    Exr,
+    Png,
+}
+
+fn output_format(path: &Path) -> Result<OutputFormat> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("exr") => Ok(OutputFormat::Exr),
+        Some("png") => Ok(OutputFormat::Png),
+        _ => Err(Error::at(
+            path,
+            None,
+            "output must end in .exr (linear float) or .png (tone-mapped sRGB)",
+        )),
+    }
+}
+
+fn parse_debug_sample(text: &str) -> std::result::Result<(u32, u32, u32), String> {
+    let parts: Vec<std::result::Result<u32, _>> =
+        text.split(',').map(|p| p.trim().parse::<u32>()).collect();
+    match parts.as_slice() {
+        [Ok(x), Ok(y), Ok(s)] => Ok((*x, *y, *s)),
+        _ => Err(format!(
+            "`{text}`: expected X,Y,S (pixel column, row, sample index)"
+        )),
+    }
+}
+
+pub fn render(args: &RenderArgs) -> Result<()> {
+    let output = match &args.out {
+        Some(out) if args.debug_sample.is_none() => {
+            check_writable(out)?;
+            Some((out.as_path(), output_format(out)?))
+        }
+        _ => None,
+    };
+    if let Some(t) = args.time {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(Error::new(format!(
+                "--time must be a positive number of seconds, got {t}"
+            )));
+        }
+    }
+    if args.spp == Some(0) {
+        return Err(Error::new("--spp must be at least 1"));
+    }
+    let limits = Limits {
+        max_resolution: args.max_resolution,
+        max_triangles: args.max_triangles,
+    };
+    let load_start = Instant::now();
+    let mut scene = Scene::load_with_limits(&args.scene, &limits)?;
+    override_resolution(&mut scene, args.width, args.height, &limits)?;
+    if let Some(mode) = args.light_sampling {
+        scene.set_light_sampling(match mode {
+            LightSamplingArg::Area => LightSampling::Area,
+            LightSamplingArg::SolidAngle => LightSampling::SolidAngle,
+        });
+    }
+    scene.set_offset(args.offset);
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {w}", args.scene.display());
+    }
+    let load_time = load_start.elapsed();
+
+    let integrator = integrator_options(args)?.build();
+    let sampler = match args.sampler {
+        SamplerArg::Independent => SamplerKind::Independent,
+        SamplerArg::Stratified => SamplerKind::Stratified,
+        SamplerArg::Multijitter => SamplerKind::MultiJittered,
+        SamplerArg::Sobol => SamplerKind::Sobol,
+    };
+    if let Some(a) = args.adaptive
+        && !(a.is_finite() && a > 0.0)
+    {
+        return Err(Error::new(format!(
+            "--adaptive must be a positive relative error, got {a}"
+        )));
+    }
+    if let Some(r) = args.rays_per_pixel
+        && !(r.is_finite() && r > 0.0)
+    {
+        return Err(Error::new(format!(
+            "--rays-per-pixel must be a positive number, got {r}"
+        )));
+    }
+    let target_spp = if integrator.is_deterministic() {
+        if args.spp.is_some_and(|s| s > 1) || args.time.is_some() || args.rays_per_pixel.is_some() {
+            eprintln!(
+                "note: {} is deterministic; rendering 1 sample per pixel",
+                integrator.name()
+            );
+        }
+        Some(1)
+    } else if args.time.is_some() || args.rays_per_pixel.is_some() {
+        None
+    } else {
+        Some(args.spp.unwrap_or(64))
+    };
+    let settings = RenderSettings {
+        integrator,
+        sampler,
+        seed: args.seed,
+        planned_spp: target_spp.unwrap_or(0),
+        threads: args.threads,
+        adaptive: args.adaptive.map(|threshold| Adaptive {
+            threshold,
+            min_spp: args.adaptive_min_spp.max(2),
+        }),
+        domains: args.domains.unwrap_or_default(),
+        clamp: args.clamp,
+    };
+    if let Some(c) = args.clamp
+        && !(c.is_finite() && c > 0.0)
+    {
+        return Err(Error::new(format!(
+            "--clamp must be a positive number, got {c}"
+        )));
+    }
+    if let Some((x, y, index)) = args.debug_sample {
+        let (value, lines) = replay_sample(&scene, &settings, x, y, index)?;
+        for line in lines {
+            println!("{line}");
+        }
+        return if value.is_finite() {
+            Ok(())
+        } else {
+            Err(Error::new("the replayed sample is not finite"))
+        };
+    }
+    let Some((out, format)) = output else {
+        return Err(Error::new("--out FILE is required"));
+    };
+    let session = Session::new(Arc::new(scene), settings)?;
+    let stats = match (target_spp, args.rays_per_pixel) {
+        (Some(spp), _) => render_spp(&session, spp),
+        (None, Some(rays)) => render_rays(&session, rays),
+        (None, None) => render_time(&session, Duration::from_secs_f64(args.time.unwrap_or(1.0))),
+    };
+    let snapshot = session.snapshot();
+    match format {
+        OutputFormat::Exr => snapshot.image.write_exr(out)?,
+        OutputFormat::Png => snapshot.image.write_png(out, args.exposure)?,
+    }
+    print_summary(&session, &stats, load_time);
+    print_flagged(
+        &snapshot,
+        session.scene().camera.width,
+        &settings_seed(&session),
+    );
+    eprintln!("wrote {}", out.display());
+    Ok(())
+}
+
+fn parse_domains(text: &str) -> std::result::Result<Domains, String> {
+    Domains::parse(text, ',')
+}
+
+/// Applies `--width`/`--height` (either alone keeps the other side).
+pub(crate) fn override_resolution(
+    scene: &mut Scene,
+    width: Option<u32>,
+    height: Option<u32>,
+    limits: &Limits,
+) -> Result<()> {
+    if width.is_none() && height.is_none() {
+        return Ok(());
+    }
+    let (w, h) = (
+        width.unwrap_or(scene.camera.width),
+        height.unwrap_or(scene.camera.height),
+    );
+    limits
+        .check_resolution(w, h)
+        .map_err(|e| Error::new(format!("--width/--height: {e}")))?;
+    scene.set_resolution(w, h);
+    Ok(())
+}
+
+fn progress_bar(len: u64, unit: &str) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len);
+    let template =
+        format!("{{elapsed_precise}} [{{bar:40}}] {{pos}}/{{len}} {unit} ({{eta}} left)");
+    bar.set_style(
+        ProgressStyle::with_template(&template).unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// Renders exactly `spp` samples per pixel in passes small enough for a live progress bar.
+pub(crate) fn render_spp(session: &Session, spp: u32) -> RenderStats {
+    let bar = progress_bar(spp as u64, "spp");
+    let mut done = 0;
+    let mut pass = 1;
+    while done < spp {
+        let k = pass.min(spp - done);
+        let start = Instant::now();
+        session.render_pass(k);
+        done += k;
+        bar.set_position(done as u64);
+        // Aim for passes of about a quarter second.
+        if start.elapsed() < Duration::from_millis(250) {
+            pass = (pass * 2).min(64);
+        }
+    }
+    bar.finish_and_clear();
+    session.stats()
+}
+
+/// Renders one sample per pixel at a time until the rays cast per pixel reach
+/// `budget` (the last pass may overshoot by one sample's rays).
+fn render_rays(session: &Session, budget: f64) -> RenderStats {
+    let pixels = f64::from(session.scene().camera.width) * f64::from(session.scene().camera.height);
+    let bar = progress_bar(budget.ceil() as u64, "rays/pixel");
+    loop {
+        let stats = session.stats();
+        let per_pixel = stats.rays.total() as f64 / pixels;
+        bar.set_position(per_pixel.min(budget) as u64);
+        if per_pixel >= budget {
+            break;
+        }
+        session.render_pass(1);
+    }
+    bar.finish_and_clear();
+    session.stats()
+}
+
+/// Estimator options from the command line.
+fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
+    let strategy = match (args.strategy, args.no_nee, args.mis) {
+        (Some(StrategyArg::Bsdf), ..) | (None, true, _) => Strategy::Bsdf,
+        (Some(StrategyArg::Light), ..) | (None, false, MisArg::None) => Strategy::Light,
+        (Some(StrategyArg::Mis), _, MisArg::None) => {
+            return Err(Error::new("--strategy mis needs --mis balance or power"));
+        }
+        _ => Strategy::Mis,
+    };
+    if matches!(args.integrator, IntegratorArg::Mcrt) && args.shadow_rays + args.glossy_rays == 0 {
+        return Err(Error::new(
+            "--shadow-rays and --glossy-rays cannot both be 0",
+        ));
+    }
+    Ok(IntegratorOptions {
+        kind: integrator_kind(args.integrator),
+        max_depth: args.max_depth,
+        russian_roulette: !args.no_rr,
+        rr_depth: args.rr_depth,
+        strategy,
+        mis: match args.mis {
+            MisArg::Balance => MisHeuristic::Balance,
+            MisArg::None | MisArg::Power => MisHeuristic::Power,
+        },
+        shadow_rays: args.shadow_rays,
+        glossy_rays: args.glossy_rays,
+        ambient: args.ambient,
+        glass_shadows: match args.glass_shadows {
+            GlassShadowsArg::Opaque => GlassShadows::Opaque,
+            GlassShadowsArg::Tinted => GlassShadows::Tinted,
+        },
+        general: args.general,
+    })
+}
+
+/// Renders passes until `budget` is spent, sizing passes so as not to overshoot.
+fn render_time(session: &Session, budget: Duration) -> RenderStats {
+    let bar = progress_bar(budget.as_millis() as u64, "ms");
+    let start = Instant::now();
+    let mut per_spp = Duration::ZERO;
+    loop {
+        let elapsed = start.elapsed();
+        if elapsed >= budget {
+            break;
+        }
+        let remaining = budget - elapsed;
+        let k = if per_spp.is_zero() {
+            1
+        } else {
+            ((remaining.as_secs_f64() / per_spp.as_secs_f64()) as u32).clamp(1, 64)
+        };
+        let pass_start = Instant::now();
+        session.render_pass(k);
+        per_spp = pass_start.elapsed() / k;
+        bar.set_position(start.elapsed().as_millis().min(budget.as_millis()) as u64);
+    }
+    bar.finish_and_clear();
+    session.stats()
+}
+
+fn settings_seed(session: &Session) -> String {
+    format!("--seed {}", session.settings().seed)
+}
+
+/// Where the first non-finite or extreme sample is, and how to replay it.
+fn print_flagged(snapshot: &FilmSnapshot, width: u32, seed: &str) {
+    let extreme: u64 = snapshot.extreme_pixels.iter().map(|&n| u64::from(n)).sum();
+    let Some(pixel) = snapshot
+        .first_flagged
+        .iter()
+        .position(|&s| s != NOT_FLAGGED)
+    else {
+        return;
+    };
+    let (x, y) = (pixel as u32 % width, pixel as u32 / width);
+    eprintln!(
+        "{} non-finite and {extreme} extreme samples (luminance > {EXTREME_LUMINANCE}); the first in pixel ({x}, {y}) is sample {}: replay it with the same options plus {seed} --debug-sample {x},{y},{}",
+        snapshot.non_finite, snapshot.first_flagged[pixel], snapshot.first_flagged[pixel]
+    );
+}
+
+fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
+    let seconds = stats.render_time.as_secs_f64();
+    let rays = stats.rays.total();
+    let settings = session.settings();
+    eprintln!(
+        "{} | {} sampler | {} threads | scene loaded in {:.2} s",
+        settings.integrator.describe(),
+        settings.sampler.name(),
+        session.threads(),
+        load_time.as_secs_f64()
+    );
+    let pixels = f64::from(session.scene().camera.width) * f64::from(session.scene().camera.height);
+    let per_pixel = |n: u64| n as f64 / pixels;
+    eprintln!(
+        "rays per pixel: {:.1} (camera {:.1}, shadow {:.1}, bounce {:.1})",
+        per_pixel(rays),
+        per_pixel(stats.rays.camera),
+        per_pixel(stats.rays.shadow),
+        per_pixel(stats.rays.bounce)
+    );
+    if matches!(
+        settings.integrator,
+        tracelab::integrator::Integrator::Path(_) | tracelab::integrator::Integrator::Whitted(_)
+    ) {
+        let skipped = session.scene().features.skipped();
+        if settings.integrator.is_general() {
+            eprintln!("general code (--general): nothing skipped");
+        } else {
+            eprintln!("specialised for this scene: skipped {}", skipped.join(", "));
+        }
+    }
+    if let Some(a) = settings.adaptive {
+        let planned = stats.samples + stats.skipped;
+        eprintln!(
+            "adaptive sampling (biased): {:.1}% of {} planned samples skipped (relative error < {}, after {} spp)",
+            100.0 * stats.skipped as f64 / planned.max(1) as f64,
+            planned,
+            a.threshold,
+            a.min_spp
+        );
+    }
+    if let Some(limit) = settings.clamp {
+        eprintln!(
+            "clamping (biased): {} of {} samples scaled down to a largest component of {limit}",
+            stats.clamped, stats.samples
+        );
+    }
+    println!(
+        "spp {} | {:.3} s | {:.2} M rays (camera {:.2} M, shadow {:.2} M, bounce {:.2} M) | {:.2} Mrays/s | {:.3} M paths/s | non-finite {}",
+        stats.spp,
+        seconds,
+        rays as f64 * 1e-6,
+        stats.rays.camera as f64 * 1e-6,
+        stats.rays.shadow as f64 * 1e-6,
+        stats.rays.bounce as f64 * 1e-6,
+        rays as f64 / seconds * 1e-6,
+        stats.samples as f64 / seconds * 1e-6,
+        stats.non_finite
+    );
+}
