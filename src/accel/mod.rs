@@ -145,6 +145,9 @@ pub struct Geometry {
     moving: Vec<MovingGeometry>,
     /// How rays spawned at hits leave the surface.
     offset: OffsetMode,
+    /// The triangle BVH came out deeper than its traversal stack and the
+    /// triangles are tested one by one instead.
+    bvh_too_deep: bool,
 }
 
 /// Geometry translated by `velocity * time`: at time t it is hit where the
@@ -169,6 +172,33 @@ fn bvh_ray(ray: &Ray, t_max: f32) -> obvhs::ray::Ray {
 
 fn build_params() -> BvhBuildParams {
     BvhBuildParams::medium_build()
+}
+
+/// obvhs traverses a CWBVH with a stack of this many entries; a deeper tree
+/// would silently lose nodes (its push saturates).
+const CWBVH_STACK_DEPTH: u32 = 32;
+
+/// Levels of the CWBVH below `node` (1 for a node with only leaves).
+fn cwbvh_depth(bvh: &CwBvh, node: usize) -> u32 {
+    let n = &bvh.nodes[node];
+    let deepest_child = (0..8)
+        .filter(|&c| !n.is_child_empty(c) && !n.is_leaf(c))
+        .map(|c| cwbvh_depth(bvh, n.child_node_index(c) as usize))
+        .max()
+        .unwrap_or(0);
+    1 + deepest_child
+}
+
+/// A CWBVH over `aabbs`, or None when it would be too deep to traverse:
+/// many nearly coincident primitives (found by fuzzing: a mesh of a hundred
+/// copies of a few triangles) make obvhs's PLOC builder produce chains. In
+/// builds with debug assertions obvhs's own validation panics on such a
+/// tree; that is caught and treated the same.
+fn build_shallow_cwbvh(aabbs: &[Aabb]) -> Option<CwBvh> {
+    let bvh =
+        std::panic::catch_unwind(|| build_cwbvh(aabbs, build_params(), &mut Duration::default()))
+            .ok()?;
+    (bvh.nodes.is_empty() || cwbvh_depth(&bvh, 0) < CWBVH_STACK_DEPTH).then_some(bvh)
 }
 
 impl Geometry {
@@ -200,13 +230,26 @@ impl Geometry {
                 .iter()
                 .map(|t| Aabb::from_points(&t.vertices))
                 .collect();
-            let bvh = build_cwbvh(&aabbs, build_params(), &mut Duration::default());
-            for &i in &bvh.primitive_indices {
-                let t = &triangles[i as usize];
-                geometry.tri_vertices.push(t.vertices);
-                geometry.tri_shading.push(TriangleShading::new(t));
+            match build_shallow_cwbvh(&aabbs) {
+                Some(bvh) => {
+                    for &i in &bvh.primitive_indices {
+                        let t = &triangles[i as usize];
+                        geometry.tri_vertices.push(t.vertices);
+                        geometry.tri_shading.push(TriangleShading::new(t));
+                    }
+                    geometry.tri_index = TriangleIndex::Bvh(bvh);
+                }
+                None => {
+                    // Correct at any depth, if slow: better than missed hits.
+                    for t in triangles {
+                        geometry.tri_vertices.push(t.vertices);
+                        geometry.tri_shading.push(TriangleShading::new(t));
+                    }
+                    geometry.tri_index =
+                        TriangleIndex::Soup(TriangleSoup::new(&geometry.tri_vertices));
+                    geometry.bvh_too_deep = true;
+                }
             }
-            geometry.tri_index = TriangleIndex::Bvh(bvh);
         }
         if spheres.len() <= SPHERE_LIST_MAX {
             geometry.spheres = spheres;
@@ -242,6 +285,12 @@ impl Geometry {
     /// True when there are spheres, at rest or moving.
     pub fn has_spheres(&self) -> bool {
         !self.spheres.is_empty() || self.moving.iter().any(|m| m.geometry.has_spheres())
+    }
+
+    /// True when the triangle BVH would have been too deep to traverse and
+    /// every triangle is tested instead (pathological overlapping geometry).
+    pub fn bvh_too_deep(&self) -> bool {
+        self.bvh_too_deep || self.moving.iter().any(|m| m.geometry.bvh_too_deep)
     }
 
     /// True when some object moves.
@@ -599,6 +648,25 @@ mod tests {
         assert!(g.occluded(&short(0.875)));
         // The bounds cover the whole sweep.
         assert!(g.bounds().max.x >= 1.25 && g.bounds().min.x <= -3.25);
+    }
+
+    #[test]
+    fn pathologically_deep_bvh_falls_back_to_testing_every_triangle() {
+        // Hundreds of copies of one quad (the shape of a fuzzer's find).
+        let mut triangles = Vec::new();
+        for _ in 0..300 {
+            triangles.extend(quad_mesh());
+        }
+        let g = Geometry::build(&triangles, vec![]);
+        // Either way every ray must still find the quad.
+        for i in 1..20 {
+            let s = i as f32 / 20.0;
+            let hit = g.intersect(&Ray::new(Vec3A::new(s, 0.3, 0.0), Vec3A::Z));
+            assert!(hit.is_some_and(|h| (h.t - 1.0).abs() < 1e-6));
+        }
+        let normal = Geometry::build(&quad_mesh().repeat(40), vec![]);
+        assert!(g.bvh_too_deep());
+        assert!(!normal.bvh_too_deep());
     }
 
     #[test]

@@ -5,9 +5,9 @@ mod bench;
 mod render;
 mod stress;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
-use tracelab::image::{Image, check_writable};
+use tracelab::image::Image;
 use tracelab::integrator::IntegratorKind;
 use tracelab::{Error, Result};
 
@@ -54,7 +54,7 @@ enum IntegratorArg {
 }
 
 #[cfg(feature = "viewer")]
-#[derive(Args, Debug)]
+#[derive(clap::Args, Debug)]
 struct ViewArgs {
     /// Scene file (TOML); default: the last one, or the Cornell box.
     scene: Option<PathBuf>,
@@ -134,7 +134,7 @@ fn view(args: ViewArgs) -> Result<()> {
         return Err(Error::at(scene, None, "no such scene file"));
     }
     if let Some(shot) = &args.screenshot {
-        check_writable(shot)?;
+        tracelab::image::check_writable(shot)?;
     }
     tracelab::viewer::run(tracelab::viewer::Launch {
         scene: args.scene,

@@ -248,6 +248,12 @@ impl Scene {
                 geometry.add_moving(Geometry::build(&triangles, spheres), velocity);
             }
         }
+        if geometry.bvh_too_deep() {
+            warnings.push(
+                "the BVH would be too deep to traverse (many overlapping triangles): testing every triangle instead, which is slow"
+                    .into(),
+            );
+        }
         let mut lights = Vec::new();
         for i in 0..geometry.triangle_count() {
             let material = &input.materials[geometry.triangle_material(i) as usize];
