@@ -314,3 +314,121 @@ fn degenerate_triangles_and_zero_area_emitters_are_dropped_with_a_count() {
     );
     assert!(stderr(&o).contains("no light source"), "{}", stderr(&o));
 }
+
+#[test]
+fn unreadable_reference_images_are_named() {
+    let dir = temp_dir("cli-bad-reference");
+    let garbage = dir.join("reference.exr");
+    std::fs::write(&garbage, "not an EXR").unwrap();
+    let scene = repo_path("scenes/cornell_box.toml");
+    assert_fails(
+        &tracelab(&[
+            "bench",
+            scene.to_str().unwrap(),
+            "--reference",
+            garbage.to_str().unwrap(),
+            "--config",
+            "path:independent",
+            "--max-spp",
+            "1",
+        ]),
+        1,
+        &["reference.exr"],
+    );
+}
+
+#[test]
+fn malformed_mtl_statements_name_file_and_line() {
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n";
+    let mtl = "newmtl a\nKs 0.1 0.1 0.1\nKd 0.5\n";
+    let dir = scene_dir(
+        "cli-bad-mtl",
+        &[
+            ("scene.toml", MESH_SCENE),
+            ("mesh.obj", obj),
+            ("m.mtl", mtl),
+        ],
+    );
+    assert_fails(
+        &render_scene(&dir, &[]),
+        1,
+        &["m.mtl:3:", "`Kd` needs three finite numbers"],
+    );
+}
+
+#[test]
+fn typo_guards_refuse_runaway_renders() {
+    let scene = repo_path("scenes/cornell_box.toml");
+    let s = scene.to_str().unwrap();
+    assert_fails(
+        &tracelab(&["render", s, "--spp", "100000000", "--out", "x.exr"]),
+        1,
+        &["--spp 100000000 is above the limit", "--max-spp"],
+    );
+    assert_fails(
+        &tracelab(&[
+            "render",
+            s,
+            "--integrator",
+            "mcrt",
+            "--glossy-rays",
+            "5",
+            "--max-depth",
+            "20",
+            "--out",
+            "x.exr",
+        ]),
+        1,
+        &["rays per sample", "--max-branch-rays"],
+    );
+    assert_fails(
+        &tracelab(&["render", s, "--offset", "fixed:-1", "--out", "x.exr"]),
+        2,
+        &["fixed:EPS"],
+    );
+    assert_fails(
+        &tracelab(&["render", s, "--debug-sample", "1,2", "--spp", "1"]),
+        2,
+        &["X,Y,S"],
+    );
+}
+
+#[test]
+fn debug_sample_prints_the_path() {
+    let scene = repo_path("scenes/cornell_box.toml");
+    let o = tracelab(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--spp",
+        "4",
+        "--debug-sample",
+        "128,200,3",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.contains("pixel (128, 200) sample 3"), "{out}");
+    assert!(out.contains("vertex 0:"), "{out}");
+    assert!(out.contains("sample value"), "{out}");
+    assert_fails(
+        &tracelab(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--debug-sample",
+            "999,0,0",
+        ]),
+        1,
+        &["outside the 256x256 image"],
+    );
+}
+
+#[test]
+fn stress_command_passes_robust_and_fails_fixed_epsilon() {
+    let o = tracelab(&["stress", "--quick"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}{out}", stderr(&o));
+    assert!(out.contains("cornell box scaled by 1e-4"), "{out}");
+    assert!(!out.contains("FAIL"), "{out}");
+    let o = tracelab(&["stress", "--quick", "--offset", "fixed:1e-3"]);
+    assert_fails(&o, 1, &["stress cases failed"]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("FAIL"));
+}

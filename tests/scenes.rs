@@ -47,3 +47,43 @@ fn every_shipped_scene_renders_cleanly() {
     }
     assert!(count >= 6);
 }
+
+/// Every estimator on every scene for 64 spp: not one non-finite sample.
+#[test]
+fn every_estimator_renders_every_scene_without_non_finite_samples() {
+    use tracelab::integrator::{IntegratorKind, IntegratorOptions};
+    for entry in std::fs::read_dir(repo_path("scenes")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let mut scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        scene.set_resolution(24, 18);
+        for kind in [
+            IntegratorKind::Whitted,
+            IntegratorKind::Mcrt,
+            IntegratorKind::Path,
+            IntegratorKind::Light,
+        ] {
+            let integrator = IntegratorOptions {
+                kind,
+                ..Default::default()
+            }
+            .build();
+            let spp = if integrator.is_deterministic() { 1 } else { 64 };
+            let (snapshot, stats) = render(scene.clone(), integrator, SamplerKind::Sobol, spp, 3);
+            assert_eq!(stats.non_finite, 0, "{} {kind:?}", path.display());
+            assert_eq!(snapshot.non_finite, 0, "{} {kind:?}", path.display());
+            assert!(
+                snapshot
+                    .image
+                    .pixels
+                    .iter()
+                    .flatten()
+                    .all(|c| c.is_finite() && *c >= 0.0),
+                "{} {kind:?}",
+                path.display()
+            );
+        }
+    }
+}

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tracelab::film::{EXTREME_LUMINANCE, FilmSnapshot, NOT_FLAGGED};
 use tracelab::image::check_writable;
-use tracelab::integrator::{GlassShadows, IntegratorOptions, MisHeuristic, Strategy};
+use tracelab::integrator::{GlassShadows, Integrator, IntegratorOptions, MisHeuristic, Strategy};
 use tracelab::math::OffsetMode;
 use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
 use tracelab::replay::replay_sample;
@@ -152,6 +152,13 @@ pub struct RenderArgs {
     /// Largest accepted triangle count.
     #[arg(long, default_value_t = Limits::default().max_triangles)]
     max_triangles: usize,
+    /// Largest accepted --spp (a typo guard; raise it to render more).
+    #[arg(long, default_value_t = 1 << 24)]
+    max_spp: u32,
+    /// Largest number of rays one MC ray tracing sample may branch into
+    /// (M glossy rays per hit to depth D cast about M^D rays).
+    #[arg(long, default_value_t = 1_000_000)]
+    max_branch_rays: u64,
     /// Scale down samples whose largest component exceeds this value
     /// (removes fireflies; biased, and the summary says how often it acted).
     #[arg(long)]
@@ -215,6 +222,14 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     }
     if args.spp == Some(0) {
         return Err(Error::new("--spp must be at least 1"));
+    }
+    if let Some(spp) = args.spp
+        && spp > args.max_spp
+    {
+        return Err(Error::new(format!(
+            "--spp {spp} is above the limit of {} samples per pixel (raise it with --max-spp)",
+            args.max_spp
+        )));
     }
     let limits = Limits {
         max_resolution: args.max_resolution,
@@ -282,6 +297,18 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         domains: args.domains.unwrap_or_default(),
         clamp: args.clamp,
     };
+    if let Integrator::Mcrt(m) = settings.integrator
+        && m.rays_per_sample_closed() > args.max_branch_rays
+    {
+        return Err(Error::new(format!(
+            "MC ray tracing with --glossy-rays {} --shadow-rays {} --max-depth {} would cast up to {} rays per sample, above the limit of {} (raise it with --max-branch-rays)",
+            m.glossy_rays,
+            m.shadow_rays,
+            m.max_depth,
+            m.rays_per_sample_closed(),
+            args.max_branch_rays
+        )));
+    }
     if let Some(c) = args.clamp
         && !(c.is_finite() && c > 0.0)
     {

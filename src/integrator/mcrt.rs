@@ -60,16 +60,20 @@ impl McRayTracer {
     }
 
     /// Expected rays per camera sample in a closed scene where every ray hits
-    /// a scattering surface: 1 + sum_{d=0..D} M^d N + sum_{d=1..D} M^d.
+    /// a scattering surface: 1 + sum_{d=0..D} M^d N + sum_{d=1..D} M^d
+    /// (saturating at `u64::MAX`).
     pub fn rays_per_sample_closed(&self) -> u64 {
         let (m, n) = (self.glossy_rays as u64, self.shadow_rays as u64);
         let mut total = 1;
         let mut width = 1u64;
         for depth in 0..=self.max_depth {
-            total += width * n;
+            total = width.saturating_mul(n).saturating_add(total);
             if depth < self.max_depth {
-                width *= m;
-                total += width;
+                width = width.saturating_mul(m);
+                total = total.saturating_add(width);
+            }
+            if total == u64::MAX || (m == 0 && depth > 0) {
+                break;
             }
         }
         total
