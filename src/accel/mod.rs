@@ -14,11 +14,12 @@ use crate::math::{OffsetMode, Ray, gamma};
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::builder::build_cwbvh;
+use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
+use obvhs::ploc::PlocBuilder;
 use soup::TriangleSoup;
 use sphere::intersect_sphere;
-use std::time::Duration;
 use triangle::ShearedRay;
 
 /// Marks a primitive that is not a light.
@@ -145,8 +146,8 @@ pub struct Geometry {
     moving: Vec<MovingGeometry>,
     /// How rays spawned at hits leave the surface.
     offset: OffsetMode,
-    /// The triangle BVH came out deeper than its traversal stack and the
-    /// triangles are tested one by one instead.
+    /// A BVH came out deeper than its traversal stack and its primitives
+    /// are tested one by one instead.
     bvh_too_deep: bool,
 }
 
@@ -191,13 +192,20 @@ fn cwbvh_depth(bvh: &CwBvh, node: usize) -> u32 {
 
 /// A CWBVH over `aabbs`, or None when it would be too deep to traverse:
 /// many nearly coincident primitives (found by fuzzing: a mesh of a hundred
-/// copies of a few triangles) make obvhs's PLOC builder produce chains. In
-/// builds with debug assertions obvhs's own validation panics on such a
-/// tree; that is caught and treated the same.
+/// copies of a few triangles) make obvhs's PLOC builder produce chains.
+/// The steps of obvhs's `build_cwbvh`, without its debug-build validation,
+/// which panics on such a tree where this returns None.
 fn build_shallow_cwbvh(aabbs: &[Aabb]) -> Option<CwBvh> {
-    let bvh =
-        std::panic::catch_unwind(|| build_cwbvh(aabbs, build_params(), &mut Duration::default()))
-            .ok()?;
+    let params = build_params();
+    let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
+        params.ploc_search_distance,
+        aabbs,
+        (0..aabbs.len() as u32).collect::<Vec<_>>(),
+        params.sort_precision,
+        params.search_depth_threshold,
+    );
+    ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+    let bvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
     (bvh.nodes.is_empty() || cwbvh_depth(&bvh, 0) < CWBVH_STACK_DEPTH).then_some(bvh)
 }
 
@@ -263,13 +271,20 @@ impl Geometry {
                     )
                 })
                 .collect();
-            let bvh = build_cwbvh(&aabbs, build_params(), &mut Duration::default());
-            geometry.spheres = bvh
-                .primitive_indices
-                .iter()
-                .map(|&i| spheres[i as usize])
-                .collect();
-            geometry.sphere_bvh = Some(bvh);
+            match build_shallow_cwbvh(&aabbs) {
+                Some(bvh) => {
+                    geometry.spheres = bvh
+                        .primitive_indices
+                        .iter()
+                        .map(|&i| spheres[i as usize])
+                        .collect();
+                    geometry.sphere_bvh = Some(bvh);
+                }
+                None => {
+                    geometry.spheres = spheres;
+                    geometry.bvh_too_deep = true;
+                }
+            }
         }
         geometry
     }
