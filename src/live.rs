@@ -57,6 +57,8 @@ pub struct ErrorPoint {
 pub struct LiveView {
     /// The settings this view renders with.
     pub settings: RenderSettings,
+    /// How its rays leave surfaces (a property of the scene it renders).
+    pub offset: crate::math::OffsetMode,
     pub snapshot: Arc<FilmSnapshot>,
     pub stats: RenderStats,
     pub history: Vec<ErrorPoint>,
@@ -259,6 +261,7 @@ fn render_loop(shared: &Shared, commands: &Receiver<Command>, pool: &Arc<rayon::
                     .iter()
                     .map(|s| LiveView {
                         settings: s.settings().clone(),
+                        offset: s.scene().geometry.offset(),
                         snapshot: Arc::new(s.snapshot()),
                         stats: s.stats(),
                         history: Vec::new(),

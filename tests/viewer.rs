@@ -96,6 +96,16 @@ fn controls_drive_the_renderer_and_export_writes_files() {
         finished(w) && w.app.frame().views[0].settings.sampler == SamplerKind::Stratified
     });
 
+    // The classic fixed epsilon instead of robust offsets.
+    click(&mut harness, "Fixed ε");
+    step_until(&mut harness, "fixed offsets", |w| {
+        finished(w) && w.app.frame().views[0].offset == tracelab::math::OffsetMode::Fixed(1e-3)
+    });
+    click(&mut harness, "Robust");
+    step_until(&mut harness, "robust offsets", |w| {
+        finished(w) && w.app.frame().views[0].offset == tracelab::math::OffsetMode::Robust
+    });
+
     // Start a side-by-side comparison: B is A with the other sampler.
     harness.get_by_label("Side-by-side comparison").click();
     step_until(&mut harness, "two views", |w| {

@@ -68,6 +68,7 @@ type RenderKey = (
         crate::live::Lock,
         Option<u32>,
         Option<(u32, u32)>,
+        crate::math::OffsetMode,
     ),
     Option<CameraKey>,
     usize,
@@ -352,6 +353,7 @@ impl ViewerApp {
         if let Some((w, h)) = self.settings.resolution {
             scene.set_resolution(w, h);
         }
+        scene.set_offset(self.settings.offset);
         let scene = Arc::new(scene);
         let configs = self.configs();
         let target = (!self.settings.unlimited).then_some(self.settings.target_spp.max(1));
@@ -648,16 +650,19 @@ impl ViewerApp {
         }
         let distance = new_offset.length();
         let fov = 2.0 * camera.tan_half_fov_y.atan().to_degrees();
-        self.camera = Some(Camera::look_at(
-            pivot + new_offset,
-            pivot,
-            up,
-            fov,
-            camera.width,
-            camera.height,
-            camera.aperture_radius,
-            distance,
-        ));
+        self.camera = Some(
+            Camera::look_at(
+                pivot + new_offset,
+                pivot,
+                up,
+                fov,
+                camera.width,
+                camera.height,
+                camera.aperture_radius,
+                distance,
+            )
+            .with_shutter(camera.shutter_open, camera.shutter_close),
+        );
     }
 
     /// Back to the scene's own camera.

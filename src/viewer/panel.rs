@@ -6,6 +6,7 @@ use super::app::ViewerApp;
 use super::settings::{CompareLayout, Config, ToneMap, ViewMode};
 use crate::integrator::{GlassShadows, IntegratorKind, MisHeuristic, Strategy};
 use crate::live::Lock;
+use crate::math::OffsetMode;
 use crate::sampling::SamplerKind;
 use eframe::egui::{self, RichText};
 
@@ -255,6 +256,32 @@ fn samples_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
         });
         app.settings.resolution = Some((w, h));
     }
+    ray_offsets(ui, &mut app.settings.offset);
+}
+
+/// Robust offsets, or the classic fixed epsilon to see what it gets wrong.
+fn ray_offsets(ui: &mut egui::Ui, offset: &mut OffsetMode) {
+    ui.horizontal(|ui| {
+        ui.label("Ray offsets");
+        let mut fixed = matches!(offset, OffsetMode::Fixed(_));
+        ui.radio_value(&mut fixed, false, "Robust");
+        ui.radio_value(&mut fixed, true, "Fixed ε");
+        let mut eps = match *offset {
+            OffsetMode::Fixed(e) => e,
+            OffsetMode::Robust => 1e-3,
+        };
+        if fixed {
+            ui.add(
+                egui::DragValue::new(&mut eps)
+                    .range(0.0..=1e3)
+                    .speed(1e-4)
+                    .max_decimals(6),
+            );
+            *offset = OffsetMode::Fixed(eps);
+        } else {
+            *offset = OffsetMode::Robust;
+        }
+    });
 }
 
 fn display_section(ui: &mut egui::Ui, app: &mut ViewerApp) {

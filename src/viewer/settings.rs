@@ -4,6 +4,7 @@
 
 use crate::integrator::IntegratorOptions;
 use crate::live::Lock;
+use crate::math::OffsetMode;
 use crate::sampling::{Domains, SamplerKind};
 use serde::{Deserialize, Serialize};
 
@@ -167,6 +168,8 @@ pub struct Settings {
     pub unlimited: bool,
     /// Image size; `None` keeps the scene's.
     pub resolution: Option<(u32, u32)>,
+    /// How rays leave surfaces (a fixed epsilon shows its artifacts).
+    pub offset: OffsetMode,
     pub reference_path: String,
     pub export_dir: String,
     pub display: Display,
@@ -187,6 +190,7 @@ impl Default for Settings {
             target_spp: 1024,
             unlimited: false,
             resolution: None,
+            offset: OffsetMode::Robust,
             reference_path: String::new(),
             export_dir: "exports".into(),
             display: Display::default(),
@@ -205,6 +209,7 @@ impl Settings {
         Lock,
         Option<u32>,
         Option<(u32, u32)>,
+        OffsetMode,
     ) {
         (
             self.a,
@@ -212,6 +217,7 @@ impl Settings {
             self.lock,
             (!self.unlimited).then_some(self.target_spp),
             self.resolution,
+            self.offset,
         )
     }
 }
