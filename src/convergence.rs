@@ -115,9 +115,50 @@ pub struct Checkpoint {
     pub rmse: f64,
 }
 
+/// When a measurement stops doubling the sample count (besides `max_spp`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StopAt {
+    /// Once a checkpoint's RMSE is at most this.
+    pub rmse: Option<f64>,
+    /// Once a checkpoint took at least this many seconds.
+    pub seconds: Option<f64>,
+}
+
+impl Checkpoint {
+    /// Efficiency 1 / (MSE x time): constant for an unbiased estimator whose
+    /// MSE falls as 1/time; higher is better.
+    pub fn efficiency(&self) -> f64 {
+        1.0 / (self.rmse * self.rmse * self.seconds)
+    }
+}
+
+/// Render time needed to reach `target` RMSE: interpolated log-log between
+/// the two checkpoints that bracket it (RMSE ~ time^slope locally), or the
+/// first checkpoint's time if it is already below. None if never reached.
+pub fn time_to_rmse(points: &[Checkpoint], target: f64) -> Option<f64> {
+    let first = points.first()?;
+    if first.rmse <= target {
+        return Some(first.seconds);
+    }
+    points.windows(2).find_map(|w| {
+        let (a, b) = (&w[0], &w[1]);
+        if b.rmse > target || a.rmse <= 0.0 || b.rmse <= 0.0 {
+            return None;
+        }
+        let (ta, tb) = (a.seconds.max(1e-9).ln(), b.seconds.max(1e-9).ln());
+        let (ea, eb) = (a.rmse.ln(), b.rmse.ln());
+        if ea == eb {
+            return Some(b.seconds);
+        }
+        let f = (target.ln() - ea) / (eb - ea);
+        Some((ta + f * (tb - ta)).exp())
+    })
+}
+
 /// Renders `config` separately at 1, 2, 4, ... `max_spp` samples per pixel
 /// (each render plans its own count, so stratified samplers are measured at
-/// their best) and compares each image with `reference`.
+/// their best) and compares each image with `reference`, stopping early as
+/// `stop` says.
 #[allow(clippy::too_many_arguments)]
 pub fn measure(
     scene: &Arc<Scene>,
@@ -125,6 +166,7 @@ pub fn measure(
     reference: &Image,
     reference_mse: f64,
     max_spp: u32,
+    stop: StopAt,
     seed: u64,
     threads: usize,
 ) -> Result<Vec<Checkpoint>> {
@@ -169,7 +211,10 @@ pub fn measure(
             error,
             rmse: (error.rmse * error.rmse - reference_mse).max(0.0).sqrt(),
         });
-        if config.integrator.build().is_deterministic() {
+        let last = out[out.len() - 1];
+        let reached = stop.rmse.is_some_and(|e| last.rmse <= e)
+            || stop.seconds.is_some_and(|s| last.seconds >= s);
+        if config.integrator.build().is_deterministic() || reached {
             break;
         }
         spp *= 2;
@@ -209,6 +254,31 @@ pub fn log_log_slope(points: &[Checkpoint], from_spp: u32) -> Option<f64> {
     let sxy: f64 = xy.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
     let sxx: f64 = xy.iter().map(|p| (p.0 - mx).powi(2)).sum();
     (sxx > 0.0).then(|| sxy / sxx)
+}
+
+#[cfg(test)]
+mod time_to_rmse_tests {
+    use super::*;
+
+    fn point(seconds: f64, rmse: f64) -> Checkpoint {
+        Checkpoint {
+            spp: 1,
+            seconds,
+            rays_per_pixel: 0.0,
+            error: ErrorMetrics::default(),
+            rmse,
+        }
+    }
+
+    #[test]
+    fn interpolates_on_the_log_log_line() {
+        // RMSE = 0.1 / sqrt(t): 0.1 at t = 1, 0.05 at t = 4, 0.025 at t = 16.
+        let points = [point(1.0, 0.1), point(4.0, 0.05), point(16.0, 0.025)];
+        let t = time_to_rmse(&points, 0.04).unwrap();
+        assert!((t - (0.1f64 / 0.04).powi(2)).abs() < 1e-9, "{t}");
+        assert_eq!(time_to_rmse(&points, 0.2), Some(1.0));
+        assert_eq!(time_to_rmse(&points, 0.01), None);
+    }
 }
 
 #[cfg(test)]

@@ -16,7 +16,7 @@ pub struct Image {
 
 /// Error metrics between an image and a reference, averaged over all pixels
 /// and channels, as tev defines them.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ErrorMetrics {
     /// sqrt(mean((a - b)^2)).
     pub rmse: f64,

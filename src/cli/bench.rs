@@ -5,7 +5,9 @@ use super::render::{override_resolution, render_spp};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use tracelab::convergence::{BenchConfig, Checkpoint, log_log_slope, mean_variance, measure};
+use tracelab::convergence::{
+    BenchConfig, Checkpoint, StopAt, log_log_slope, mean_variance, measure, time_to_rmse,
+};
 use tracelab::image::{Image, check_writable};
 use tracelab::plot::{Series, log_log_svg};
 use tracelab::render::{RenderSettings, Session};
@@ -40,6 +42,15 @@ pub struct BenchArgs {
     /// Largest sample count measured (powers of two from 1).
     #[arg(long, default_value_t = 256)]
     max_spp: u32,
+    /// Stop doubling once a checkpoint's RMSE is at most this.
+    #[arg(long)]
+    until_rmse: Option<f64>,
+    /// Stop doubling once a checkpoint took this many seconds.
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// RMSE levels for the time-to-error table (comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "0.01,0.005")]
+    targets: Vec<f64>,
     /// Fit the log-log slope from this many samples per pixel on.
     #[arg(long, default_value_t = 4)]
     slope_from: u32,
@@ -104,7 +115,7 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
         None => 0.0,
     };
     let mut csv = String::from(
-        "config,spp,seconds,rays_per_pixel,rmse,rmse_without_reference_noise,relative_mse,mean_relative_error\n",
+        "config,spp,seconds,rays_per_pixel,rmse,rmse_without_reference_noise,relative_mse,mean_relative_error,efficiency\n",
     );
     let mut results = Vec::new();
     for config in &configs {
@@ -115,21 +126,39 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
             &reference,
             reference_mse,
             args.max_spp,
+            StopAt {
+                rmse: args.until_rmse,
+                seconds: args.seconds,
+            },
             args.seed,
             args.threads,
         )?;
         println!("{}", config.label);
         println!(
-            "  {:>7} {:>9} {:>10} {:>10} {:>14} {:>12}",
-            "spp", "seconds", "rays/px", "RMSE", "RMSE-ref.noise", "rel. MSE"
+            "  {:>7} {:>9} {:>10} {:>10} {:>14} {:>12} {:>12} {:>12}",
+            "spp",
+            "seconds",
+            "rays/px",
+            "RMSE",
+            "RMSE-ref.noise",
+            "rel. MSE",
+            "mean rel.",
+            "1/(MSE t)"
         );
         for p in &points {
             println!(
-                "  {:>7} {:>9.3} {:>10.1} {:>10.6} {:>14.6} {:>12.6}",
-                p.spp, p.seconds, p.rays_per_pixel, p.error.rmse, p.rmse, p.error.relative_mse
+                "  {:>7} {:>9.3} {:>10.1} {:>10.6} {:>14.6} {:>12.6} {:>12.6} {:>12.4e}",
+                p.spp,
+                p.seconds,
+                p.rays_per_pixel,
+                p.error.rmse,
+                p.rmse,
+                p.error.relative_mse,
+                p.error.mean_relative_error,
+                p.efficiency()
             );
             csv += &format!(
-                "{},{},{:.6},{:.3},{:.8},{:.8},{:.8},{:.8}\n",
+                "{},{},{:.6},{:.3},{:.8},{:.8},{:.8},{:.8},{:.6e}\n",
                 config.label,
                 p.spp,
                 p.seconds,
@@ -137,7 +166,8 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
                 p.error.rmse,
                 p.rmse,
                 p.error.relative_mse,
-                p.error.mean_relative_error
+                p.error.mean_relative_error,
+                p.efficiency()
             );
         }
         match log_log_slope(&points, args.slope_from) {
@@ -148,6 +178,24 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
             None => println!("  (too few points for a slope)"),
         }
         results.push((config.label.clone(), points));
+    }
+    if !args.targets.is_empty() {
+        println!(
+            "time to reach RMSE (reference noise removed; log-log interpolation between checkpoints)"
+        );
+        let header: Vec<String> = args.targets.iter().map(|t| format!("{t}")).collect();
+        println!("  {:<48} {}", "config", header.join("        "));
+        for (name, points) in &results {
+            let cells: Vec<String> = args
+                .targets
+                .iter()
+                .map(|&t| match time_to_rmse(points, t) {
+                    Some(s) => format!("{s:>8.3} s"),
+                    None => format!("{:>10}", "not reached"),
+                })
+                .collect();
+            println!("  {name:<48} {}", cells.join("  "));
+        }
     }
     if let Some(path) = &args.csv {
         tracelab::image::write_atomically(path, |tmp| {
