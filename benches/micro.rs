@@ -1,0 +1,184 @@
+//! Micro benchmarks (divan): `cargo bench --bench micro`. A benchmark, never
+//! a test. BVH build over 10k, 100k and 1M triangles; closest-hit and
+//! any-hit rays, coherent and incoherent, on the 100k mesh; BSDF sampling;
+//! sample generation by each sampler.
+
+use divan::{Bencher, black_box};
+use glam::{Vec2, Vec3A};
+use tracelab::accel::{AccelChoice, Geometry, TriangleInput};
+use tracelab::math::{Ray, Rgb};
+use tracelab::sampling::hash::{hash_combine, to_unit_float};
+use tracelab::sampling::warp::square_to_uniform_sphere;
+use tracelab::sampling::{Sampler, SamplerKind};
+use tracelab::scene::material::Bsdf;
+
+fn main() {
+    divan::main();
+}
+
+/// UV sphere of radius 1 with about `2 n^2` triangles.
+fn uv_sphere(n: usize) -> Vec<TriangleInput> {
+    let point = |i: usize, j: usize| {
+        let theta = std::f32::consts::PI * i as f32 / n as f32;
+        let phi = 2.0 * std::f32::consts::PI * j as f32 / n as f32;
+        Vec3A::new(
+            theta.sin() * phi.cos(),
+            theta.cos(),
+            theta.sin() * phi.sin(),
+        )
+    };
+    let mut triangles = Vec::with_capacity(2 * n * n);
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            );
+            triangles.push(TriangleInput {
+                vertices: [a, b, c],
+                material: 0,
+            });
+            triangles.push(TriangleInput {
+                vertices: [a, c, d],
+                material: 0,
+            });
+        }
+    }
+    triangles
+}
+
+fn unit(i: u64, salt: u64) -> Vec2 {
+    let h = hash_combine(i, salt);
+    Vec2::new(to_unit_float(h), to_unit_float(h << 24))
+}
+
+/// Rays from a sphere of radius 2 towards random points in the unit ball.
+fn incoherent_rays(count: usize) -> Vec<Ray> {
+    (0..count as u64)
+        .map(|i| {
+            let origin = 2.0 * square_to_uniform_sphere(unit(i, 1));
+            let target =
+                0.9 * square_to_uniform_sphere(unit(i, 2)) * to_unit_float(hash_combine(i, 3));
+            Ray::new(origin, (target - origin).normalize())
+        })
+        .collect()
+}
+
+/// A scanline grid of directions from one origin.
+fn coherent_rays(side: usize) -> Vec<Ray> {
+    let origin = Vec3A::new(0.0, 0.0, 3.0);
+    (0..side * side)
+        .map(|k| {
+            let (x, y) = (
+                (k % side) as f32 / side as f32,
+                (k / side) as f32 / side as f32,
+            );
+            let target = Vec3A::new(2.0 * x - 1.0, 2.0 * y - 1.0, 0.0);
+            Ray::new(origin, (target - origin).normalize())
+        })
+        .collect()
+}
+
+#[divan::bench(args = [71, 224, 708], sample_count = 5)]
+fn bvh_build(bencher: Bencher, n: usize) {
+    let triangles = uv_sphere(n);
+    bencher
+        .counter(divan::counter::ItemsCount::new(triangles.len()))
+        .bench(|| Geometry::build_with(black_box(&triangles), vec![], AccelChoice::Bvh));
+}
+
+mod rays_100k {
+    use super::*;
+    use std::sync::LazyLock;
+
+    static MESH: LazyLock<Geometry> =
+        LazyLock::new(|| Geometry::build_with(&uv_sphere(224), vec![], AccelChoice::Bvh));
+    static INCOHERENT: LazyLock<Vec<Ray>> = LazyLock::new(|| incoherent_rays(100_000));
+    static COHERENT: LazyLock<Vec<Ray>> = LazyLock::new(|| coherent_rays(316));
+
+    fn run(bencher: Bencher, rays: &[Ray], any: bool) {
+        let mesh = &*MESH;
+        bencher
+            .counter(divan::counter::ItemsCount::new(rays.len()))
+            .bench(|| {
+                let mut hits = 0usize;
+                for r in rays {
+                    hits += usize::from(if any {
+                        mesh.occluded(r)
+                    } else {
+                        mesh.intersect(r).is_some()
+                    });
+                }
+                hits
+            });
+    }
+
+    #[divan::bench(sample_count = 10)]
+    fn closest_incoherent(bencher: Bencher) {
+        run(bencher, &INCOHERENT, false);
+    }
+
+    #[divan::bench(sample_count = 10)]
+    fn any_incoherent(bencher: Bencher) {
+        run(bencher, &INCOHERENT, true);
+    }
+
+    #[divan::bench(sample_count = 10)]
+    fn closest_coherent(bencher: Bencher) {
+        run(bencher, &COHERENT, false);
+    }
+
+    #[divan::bench(sample_count = 10)]
+    fn any_coherent(bencher: Bencher) {
+        run(bencher, &COHERENT, true);
+    }
+}
+
+#[divan::bench(args = ["diffuse", "glossy", "mirror", "dielectric"])]
+fn bsdf_sample(bencher: Bencher, kind: &str) {
+    let bsdf = match kind {
+        "diffuse" => Bsdf::Diffuse {
+            albedo: Rgb::splat(0.5),
+        },
+        "glossy" => Bsdf::glossy(Rgb::splat(0.3), Rgb::splat(0.5), 50.0),
+        "mirror" => Bsdf::Mirror {
+            reflectance: Rgb::ONE,
+        },
+        _ => Bsdf::Dielectric {
+            eta: 1.5,
+            tint: Rgb::ONE,
+        },
+    };
+    let wo = Vec3A::new(0.3, 0.2, 0.9).normalize();
+    let inputs: Vec<(f32, Vec2)> = (0..1024u64).map(|i| (unit(i, 7).x, unit(i, 8))).collect();
+    bencher
+        .counter(divan::counter::ItemsCount::new(inputs.len()))
+        .bench(|| {
+            let mut pdf = 0.0;
+            for &(u_lobe, u) in &inputs {
+                if let Some(s) = bsdf.sample(black_box(wo), u_lobe, u) {
+                    pdf += s.pdf;
+                }
+            }
+            pdf
+        });
+}
+
+#[divan::bench(args = [SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::MultiJittered, SamplerKind::Sobol])]
+fn sampler_2d(bencher: Bencher, kind: SamplerKind) {
+    let mut sampler = Sampler::new(kind, 7, 64);
+    bencher
+        .counter(divan::counter::ItemsCount::new(64usize * 16))
+        .bench_local(|| {
+            let mut sum = Vec2::ZERO;
+            for s in 0..64 {
+                sampler.start(12_345, s);
+                for _ in 0..16 {
+                    sum += sampler.next_2d();
+                }
+            }
+            sum
+        });
+}
