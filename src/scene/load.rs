@@ -4,7 +4,7 @@
 use super::description::*;
 use super::material::{Bsdf, Material};
 use super::obj::load_obj;
-use super::{Limits, MovingInput, SceneInput};
+use super::{Limits, MAX_COORDINATE, MovingInput, SceneInput, in_range};
 use crate::accel::{NO_LIGHT, Sphere, TriangleInput};
 use crate::error::{Error, Result, line_of};
 use crate::math::Rgb;
@@ -131,6 +131,18 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
                 ));
             }
         }
+        if !mesh_triangles
+            .iter()
+            .all(|t| t.vertices.iter().all(|&v| in_range(v)))
+        {
+            return Err(at(
+                mesh.span(),
+                format!(
+                    "mesh `{}`: after its transform, coordinates reach beyond ±{MAX_COORDINATE:e}",
+                    desc.file
+                ),
+            ));
+        }
         let emissive = mesh_triangles
             .iter()
             .any(|t| materials[t.material as usize].is_emissive());
@@ -148,10 +160,12 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         let q = quad.get_ref();
         let material = lookup(&q.material, quad.span(), &by_name)?;
         let (c, u, v) = (Vec3A::from(q.corner), Vec3A::from(q.u), Vec3A::from(q.v));
-        if !(c.is_finite() && u.is_finite() && v.is_finite()) {
+        if !(in_range(c) && in_range(u) && in_range(v) && in_range(c + u + v)) {
             return Err(at(
                 quad.span(),
-                "quad: `corner`, `u` and `v` must be finite".into(),
+                format!(
+                    "quad: `corner`, `u` and `v` must be finite and within ±{MAX_COORDINATE:e}"
+                ),
             ));
         }
         let halves = [
@@ -179,11 +193,11 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         let s = sphere.get_ref();
         let material = lookup(&s.material, sphere.span(), &by_name)?;
         let center = Vec3A::from(s.center);
-        if !center.is_finite() || !s.radius.is_finite() || s.radius < 0.0 {
+        if !in_range(center) || !(s.radius >= 0.0 && s.radius <= MAX_COORDINATE) {
             return Err(at(
                 sphere.span(),
                 format!(
-                    "sphere: `center` must be finite and `radius` >= 0, got {}",
+                    "sphere: `center` must be finite and `radius` in [0, {MAX_COORDINATE:e}], got {}",
                     s.radius
                 ),
             ));

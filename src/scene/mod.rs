@@ -18,6 +18,16 @@ use material::{Bsdf, Material};
 use std::path::Path;
 use std::sync::Arc;
 
+/// Largest coordinate magnitude accepted anywhere in a scene. Beyond it,
+/// squared distances and areas overflow f32 and the BVH builder's costs
+/// become infinite (found by fuzzing: obvhs then builds a broken tree).
+pub const MAX_COORDINATE: f32 = 1e15;
+
+/// True when every component of `v` is finite and within [`MAX_COORDINATE`].
+pub fn in_range(v: Vec3A) -> bool {
+    v.is_finite() && v.abs().max_element() <= MAX_COORDINATE
+}
+
 /// Sizes beyond which input is taken for a typo rather than a wish.
 #[derive(Clone, Copy, Debug)]
 pub struct Limits {
@@ -231,6 +241,21 @@ impl Scene {
         }
         if dropped.spheres > 0 {
             warnings.push(format!("dropped {} sphere(s) of radius 0", dropped.spheres));
+        }
+        let triangle_out_of_range = |t: &TriangleInput| !t.vertices.iter().all(|&v| in_range(v));
+        let sphere_out_of_range = |s: &Sphere| !in_range(s.center) || !(s.radius <= MAX_COORDINATE);
+        let out_of_range = triangles.iter().any(triangle_out_of_range)
+            || spheres.iter().any(sphere_out_of_range)
+            || moving.iter().any(|(t, s, v)| {
+                t.iter().any(triangle_out_of_range)
+                    || s.iter().any(sphere_out_of_range)
+                    || !in_range(*v)
+            })
+            || !in_range(input.camera.eye);
+        if out_of_range {
+            return Err(Error::new(format!(
+                "the scene has coordinates beyond ±{MAX_COORDINATE:e} (or not finite): areas and distances would overflow"
+            )));
         }
         if let Some(bad) = triangles
             .iter()

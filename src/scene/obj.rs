@@ -102,6 +102,16 @@ pub fn check_obj_text(path: &Path, text: &str) -> Result<()> {
                 }
                 for c in coords {
                     match c.parse::<f32>() {
+                        Ok(x) if x.is_finite() && x.abs() > super::MAX_COORDINATE => {
+                            return Err(Error::at(
+                                path,
+                                Some(number),
+                                format!(
+                                    "vertex coordinate `{c}` is beyond ±{:e} (areas and distances would overflow)",
+                                    super::MAX_COORDINATE
+                                ),
+                            ));
+                        }
                         Ok(x) if x.is_finite() => {}
                         Ok(_) => {
                             return Err(Error::at(
