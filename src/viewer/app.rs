@@ -7,7 +7,7 @@
 use super::display::render_view;
 use super::export::{export_path, write_color_image, write_exr};
 use super::launch::{Launch, list_scene_files, resolve_scene_path};
-use super::settings::{Config, Display, Settings};
+use super::settings::{Config, Display, Settings, load_settings, settings_file};
 use crate::image::Image;
 use crate::live::{ErrorPoint, LiveConfig, LiveFrame, LiveRender};
 use crate::render::RenderSettings;
@@ -129,12 +129,10 @@ impl ViewerApp {
     /// Builds the app: restores saved settings (unless `launch.fresh`), applies
     /// the launch options, loads the scene and starts rendering.
     pub fn new(cc: &eframe::CreationContext<'_>, launch: Launch) -> Self {
-        let mut settings: Settings = if launch.fresh {
-            Settings::default()
-        } else {
-            cc.storage
-                .and_then(|s| eframe::get_value(s, eframe::APP_KEY))
-                .unwrap_or_default()
+        let _ = cc;
+        let mut settings: Settings = match settings_file() {
+            Some(path) if !launch.fresh => load_settings(&path),
+            _ => Settings::default(),
         };
         if let Some(scene) = &launch.scene {
             settings.scene_path = scene.to_string_lossy().into_owned();

@@ -94,9 +94,14 @@ impl eframe::App for Window {
         }
     }
 
-    fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        if self.persist {
-            eframe::set_value(storage, eframe::APP_KEY, &self.app.settings);
+    fn save(&mut self, _storage: &mut dyn eframe::Storage) {
+        // Our own file, written atomically; eframe's storage keeps only the
+        // window geometry.
+        if self.persist
+            && let Some(path) = settings::settings_file()
+            && let Err(e) = settings::save_settings(&path, &self.app.settings)
+        {
+            self.app.errors.push(e.to_string());
         }
     }
 

@@ -221,3 +221,62 @@ impl Settings {
         )
     }
 }
+
+/// Where the viewer keeps its settings: `settings.toml` in eframe's storage
+/// folder for tracelab (e.g. `~/.local/share/tracelab/`).
+pub fn settings_file() -> Option<std::path::PathBuf> {
+    eframe::storage_dir("tracelab").map(|d| d.join("settings.toml"))
+}
+
+/// Reads saved settings; a missing or unreadable file gives the defaults
+/// (a settings file from another version must not stop the viewer).
+pub fn load_settings(path: &std::path::Path) -> Settings {
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|text| toml::from_str(&text).ok())
+        .unwrap_or_default()
+}
+
+/// Writes the settings through a temporary file and a rename, so that an
+/// interrupted save never leaves a half-written file in place of a good one
+/// (eframe's own storage writes in place).
+pub fn save_settings(path: &std::path::Path, settings: &Settings) -> crate::Result<()> {
+    let text = toml::to_string(settings)
+        .map_err(|e| crate::Error::at(path, None, format!("cannot encode settings: {e}")))?;
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| crate::Error::at(dir, None, format!("cannot create folder: {e}")))?;
+    }
+    crate::image::write_atomically(path, |tmp| {
+        std::fs::write(tmp, &text).map_err(|e| e.to_string())
+    })
+}
+
+#[cfg(test)]
+mod persistence_tests {
+    use super::*;
+
+    #[test]
+    fn settings_survive_a_save_and_load() {
+        let dir = std::env::temp_dir().join(format!("tracelab-settings-{}", std::process::id()));
+        let path = dir.join("settings.toml");
+        let mut settings = Settings::default();
+        settings.target_spp = 77;
+        settings.compare = true;
+        settings.resolution = Some((320, 200));
+        settings.offset = OffsetMode::Fixed(1e-3);
+        settings.a.sampler = SamplerKind::Sobol;
+        save_settings(&path, &settings).unwrap();
+        assert_eq!(load_settings(&path), settings);
+        // No temporary file is left behind.
+        let names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("settings.toml")]);
+        // A damaged file gives the defaults, not an error.
+        std::fs::write(&path, "target_spp = [").unwrap();
+        assert_eq!(load_settings(&path), Settings::default());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
