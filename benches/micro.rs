@@ -3,9 +3,12 @@
 //! any-hit rays, coherent and incoherent, on the 100k mesh; BSDF sampling;
 //! sample generation by each sampler.
 
+mod shared;
+
 use divan::{Bencher, black_box};
 use glam::{Vec2, Vec3A};
-use tracelab::accel::{AccelChoice, Geometry, TriangleInput};
+use shared::uv_sphere;
+use tracelab::accel::{AccelChoice, Geometry};
 use tracelab::math::{Ray, Rgb};
 use tracelab::sampling::hash::{hash_combine, to_unit_float};
 use tracelab::sampling::warp::square_to_uniform_sphere;
@@ -14,39 +17,6 @@ use tracelab::scene::material::Bsdf;
 
 fn main() {
     divan::main();
-}
-
-/// UV sphere of radius 1 with about `2 n^2` triangles.
-fn uv_sphere(n: usize) -> Vec<TriangleInput> {
-    let point = |i: usize, j: usize| {
-        let theta = std::f32::consts::PI * i as f32 / n as f32;
-        let phi = 2.0 * std::f32::consts::PI * j as f32 / n as f32;
-        Vec3A::new(
-            theta.sin() * phi.cos(),
-            theta.cos(),
-            theta.sin() * phi.sin(),
-        )
-    };
-    let mut triangles = Vec::with_capacity(2 * n * n);
-    for i in 0..n {
-        for j in 0..n {
-            let (a, b, c, d) = (
-                point(i, j),
-                point(i + 1, j),
-                point(i + 1, j + 1),
-                point(i, j + 1),
-            );
-            triangles.push(TriangleInput {
-                vertices: [a, b, c],
-                material: 0,
-            });
-            triangles.push(TriangleInput {
-                vertices: [a, c, d],
-                material: 0,
-            });
-        }
-    }
-    triangles
 }
 
 fn unit(i: u64, salt: u64) -> Vec2 {

@@ -9,8 +9,11 @@
 //! 3. The same on the Cornell box, with its 8-wide triangle soup and with a BVH.
 //! 4. Coherent rays (one origin, a scanline grid of directions) on the spheres.
 
+mod shared;
+
 use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
+use shared::uv_sphere;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -63,39 +66,6 @@ fn paths_per_second_with(threads: usize, general: bool) -> f64 {
         })
         .collect();
     median(runs)
-}
-
-/// UV sphere of radius 1 with about `2 * n * n` triangles.
-fn uv_sphere(n: usize) -> Vec<TriangleInput> {
-    let point = |i: usize, j: usize| {
-        let theta = std::f32::consts::PI * i as f32 / n as f32;
-        let phi = 2.0 * std::f32::consts::PI * j as f32 / n as f32;
-        Vec3A::new(
-            theta.sin() * phi.cos(),
-            theta.cos(),
-            theta.sin() * phi.sin(),
-        )
-    };
-    let mut triangles = Vec::with_capacity(2 * n * n);
-    for i in 0..n {
-        for j in 0..n {
-            let (a, b, c, d) = (
-                point(i, j),
-                point(i + 1, j),
-                point(i + 1, j + 1),
-                point(i, j + 1),
-            );
-            triangles.push(TriangleInput {
-                vertices: [a, b, c],
-                material: 0,
-            });
-            triangles.push(TriangleInput {
-                vertices: [a, c, d],
-                material: 0,
-            });
-        }
-    }
-    triangles
 }
 
 fn incoherent_rays(count: u64, radius: f32, center: Vec3A, spread: f32) -> Vec<Ray> {
