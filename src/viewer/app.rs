@@ -128,8 +128,7 @@ pub struct ViewerApp {
 impl ViewerApp {
     /// Builds the app: restores saved settings (unless `launch.fresh`), applies
     /// the launch options, loads the scene and starts rendering.
-    pub fn new(cc: &eframe::CreationContext<'_>, launch: Launch) -> Self {
-        let _ = cc;
+    pub fn new(launch: Launch) -> Self {
         let mut settings: Settings = match settings_file() {
             Some(path) if !launch.fresh => load_settings(&path),
             _ => Settings::default(),

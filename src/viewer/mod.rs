@@ -59,10 +59,11 @@ pub struct Window {
 }
 
 impl Window {
-    pub fn new(cc: &eframe::CreationContext<'_>, launch: Launch) -> Self {
+    /// eframe's app creator; settings come from our own file, not `_cc.storage`.
+    pub fn new(_cc: &eframe::CreationContext<'_>, launch: Launch) -> Self {
         let persist = launch.screenshot.is_none();
         Window {
-            app: ViewerApp::new(cc, launch),
+            app: ViewerApp::new(launch),
             editing: Editing::A,
             persist,
         }
