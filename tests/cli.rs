@@ -203,7 +203,21 @@ fn out_of_range_face_index_names_the_line() {
     assert_fails(
         &render_scene(&dir, &[]),
         1,
-        &["mesh.obj:5: face index 9 is out of range"],
+        &["mesh.obj:5: face vertex index 9 is out of range"],
+    );
+}
+
+#[test]
+fn texture_and_normal_indices_are_checked_too() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/-3 3/1\n";
+    let dir = scene_dir(
+        "cli-bad-vt",
+        &[("scene.toml", MESH_SCENE), ("mesh.obj", obj)],
+    );
+    assert_fails(
+        &render_scene(&dir, &[]),
+        1,
+        &["mesh.obj:5: face texture coordinate index -3 is out of range: 1 defined so far"],
     );
 }
 

@@ -86,7 +86,7 @@ fn mtl_library(text: &str) -> Option<&str> {
 /// Line scan for what tobj accepts silently or reports without a line.
 pub fn check_obj_text(path: &Path, text: &str) -> Result<()> {
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let mut vertex_count: i64 = 0;
+    let (mut vertex_count, mut texcoord_count, mut normal_count) = (0i64, 0i64, 0i64);
     for (number, line) in text.lines().enumerate() {
         let number = number + 1;
         let mut words = line.split_whitespace();
@@ -131,31 +131,46 @@ pub fn check_obj_text(path: &Path, text: &str) -> Result<()> {
                 }
                 vertex_count += 1;
             }
+            Some("vt") => texcoord_count += 1,
+            Some("vn") => normal_count += 1,
             Some("f") => {
                 let mut corners = 0;
                 for corner in words {
                     corners += 1;
-                    let index = corner.split('/').next().unwrap_or("");
-                    let resolved = match index.parse::<i64>() {
-                        // OBJ indices are 1-based; negative ones count back from the last vertex.
-                        Ok(i) if i > 0 => i,
-                        Ok(i) if i < 0 => vertex_count + 1 + i,
-                        _ => {
+                    // `v`, `v/vt`, `v//vn` or `v/vt/vn`; each index checked
+                    // against what is defined so far (tobj overflows on some).
+                    let mut parts = corner.split('/');
+                    let kinds = [
+                        ("vertex", vertex_count, false),
+                        ("texture coordinate", texcoord_count, true),
+                        ("normal", normal_count, true),
+                    ];
+                    for (what, count, optional) in kinds {
+                        let index = parts.next().unwrap_or("");
+                        if optional && index.is_empty() {
+                            continue;
+                        }
+                        let resolved = match index.parse::<i64>() {
+                            // OBJ indices are 1-based; negative ones count back from the last one.
+                            Ok(i) if i > 0 => i,
+                            Ok(i) if i < 0 => count + 1 + i,
+                            _ => {
+                                return Err(Error::at(
+                                    path,
+                                    Some(number),
+                                    format!("face index `{corner}` is not a valid index"),
+                                ));
+                            }
+                        };
+                        if resolved < 1 || resolved > count {
                             return Err(Error::at(
                                 path,
                                 Some(number),
-                                format!("face index `{corner}` is not a valid index"),
+                                format!(
+                                    "face {what} index {index} is out of range: {count} defined so far"
+                                ),
                             ));
                         }
-                    };
-                    if resolved < 1 || resolved > vertex_count {
-                        return Err(Error::at(
-                            path,
-                            Some(number),
-                            format!(
-                                "face index {index} is out of range: {vertex_count} vertices defined so far"
-                            ),
-                        ));
                     }
                 }
                 if corners < 3 {
