@@ -62,7 +62,7 @@ def mitsuba_points(mi, variant, sampler, reference, targets, max_spp, threads):
     return points
 
 
-def tracelab_times(binary, configs, targets, max_spp, reference):
+def tracelab_times(binary, configs, targets, max_spp, reference, threads):
     args = [
         binary,
         "bench",
@@ -75,6 +75,8 @@ def tracelab_times(binary, configs, targets, max_spp, reference):
         str(min(targets)),
         "--targets",
         ",".join(str(t) for t in targets),
+        "--threads",
+        str(threads),
     ]
     for c in configs:
         args += ["--config", c]
@@ -98,6 +100,7 @@ def main():
     p.add_argument("--variants", default="scalar_rgb,llvm_ad_rgb")
     p.add_argument("--samplers", default="independent,stratified,multijitter")
     p.add_argument("--max-spp", type=int, default=4096)
+    p.add_argument("--threads", type=int, default=0, help="tracelab's render threads (0 = all cores); pin both with taskset")
     p.add_argument("--reference", default=os.path.join(REPO, "tests/data/cornell_box_path_ref.exr"))
     p.add_argument("--tracelab", default=os.path.join(REPO, "target/release/tracelab"))
     p.add_argument(
@@ -136,7 +139,7 @@ def main():
                 f"{t:8.3f} s" if t else " not reached" for t in times)
                 + "   (spp, s, RMSE: " + ", ".join(f"{s} {t:.3f} {e:.4f}" for t, e, s in pts) + ")")
 
-    tl, _ = tracelab_times(args.tracelab, args.configs.split(","), targets, args.max_spp, args.reference)
+    tl, _ = tracelab_times(args.tracelab, args.configs.split(","), targets, args.max_spp, args.reference, args.threads)
     for name, times in tl.items():
         rows.append((f"tracelab {name}", times))
         print(f"tracelab {name:<40} " + "  ".join(f"{t:8.3f} s" if t else " not reached" for t in times))
