@@ -322,7 +322,14 @@ mod tests {
 
     #[test]
     fn accepts_valid_faces_including_negative_indices() {
-        check("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -3 -2 -1\nf 1/1/1 2//2 3\n").unwrap();
+        check("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nvn 0 1 0\nf 1 2 3\nf -3 -2 -1\nf 1/1/1 2//2 3/-1/-2\n")
+            .unwrap();
+        // Texture and normal indices are checked against their own counts.
+        let e = check("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/1\n").unwrap_err();
+        assert_eq!(
+            e.message(),
+            "m.obj:4: face texture coordinate index 1 is out of range: 0 defined so far"
+        );
     }
 
     #[test]
@@ -337,12 +344,12 @@ mod tests {
         let e = check("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").unwrap_err();
         assert_eq!(
             e.message(),
-            "m.obj:4: face index 4 is out of range: 3 vertices defined so far"
+            "m.obj:4: face vertex index 4 is out of range: 3 defined so far"
         );
         let e = check("v 0 0 0\nf 1 -5 1\n").unwrap_err();
         assert!(
             e.message()
-                .starts_with("m.obj:2: face index -5 is out of range")
+                .starts_with("m.obj:2: face vertex index -5 is out of range")
         );
         let e = check("v 0 0 0\nmtllib nowhere.mtl\n").unwrap_err();
         assert!(
