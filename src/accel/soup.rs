@@ -180,19 +180,22 @@ fn block_hits(block: &Block, axes: &Axes, t_max: f32) -> Option<BlockHits> {
     let e1 = ax * cy - ay * cx;
     let e2 = bx * ay - by * ax;
     let zero = f32x8::splat(0.0);
-    let any_negative = e0.simd_lt(zero) | e1.simd_lt(zero) | e2.simd_lt(zero);
-    let any_positive = e0.simd_gt(zero) | e1.simd_gt(zero) | e2.simd_gt(zero);
+    let sign = f32x8::splat(-0.0);
     let ambiguous =
         (e0.simd_eq(zero) | e1.simd_eq(zero) | e2.simd_eq(zero)).to_bitmask() & block.lanes;
+    // With no edge function zero (ambiguous lanes are decided apart), the ray
+    // is inside when all three have the same sign bit: two XORs instead of
+    // six comparisons.
+    let mixed_signs = ((e0 ^ e1) | (e1 ^ e2)).to_bitmask();
     let det = e0 + e1 + e2;
     let t_scaled = e0 * az + e1 * bz + e2 * cz;
-    // t * det within (0, t_max * det), compared without dividing.
-    let t_abs = det.simd_lt(zero).select(-t_scaled, t_scaled);
+    // t * det within (0, t_max * det), compared without dividing; the sign of
+    // det is moved onto t_scaled by XOR.
+    let t_abs = t_scaled ^ (det & sign);
     let det_abs = det.abs();
     let in_range =
         t_abs.simd_gt(zero) & t_abs.simd_lt(f32x8::splat(t_max) * det_abs) & det_abs.simd_gt(zero);
-    let mut mask =
-        (in_range & !(any_negative & any_positive)).to_bitmask() & block.lanes & !ambiguous;
+    let mut mask = in_range.to_bitmask() & !mixed_signs & block.lanes & !ambiguous;
     if mask == 0 && ambiguous == 0 {
         return None;
     }
