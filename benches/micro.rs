@@ -7,48 +7,14 @@ mod shared;
 
 use divan::{Bencher, black_box};
 use glam::{Vec2, Vec3A};
-use shared::uv_sphere;
+use shared::{coherent_rays, incoherent_rays, unit, uv_sphere};
 use tracelab::accel::{AccelChoice, Geometry};
 use tracelab::math::{Ray, Rgb};
-use tracelab::sampling::hash::{hash_combine, to_unit_float};
-use tracelab::sampling::warp::square_to_uniform_sphere;
 use tracelab::sampling::{Sampler, SamplerKind};
 use tracelab::scene::material::Bsdf;
 
 fn main() {
     divan::main();
-}
-
-fn unit(i: u64, salt: u64) -> Vec2 {
-    let h = hash_combine(i, salt);
-    Vec2::new(to_unit_float(h), to_unit_float(h << 24))
-}
-
-/// Rays from a sphere of radius 2 towards random points in the unit ball.
-fn incoherent_rays(count: usize) -> Vec<Ray> {
-    (0..count as u64)
-        .map(|i| {
-            let origin = 2.0 * square_to_uniform_sphere(unit(i, 1));
-            let target =
-                0.9 * square_to_uniform_sphere(unit(i, 2)) * to_unit_float(hash_combine(i, 3));
-            Ray::new(origin, (target - origin).normalize())
-        })
-        .collect()
-}
-
-/// A scanline grid of directions from one origin.
-fn coherent_rays(side: usize) -> Vec<Ray> {
-    let origin = Vec3A::new(0.0, 0.0, 3.0);
-    (0..side * side)
-        .map(|k| {
-            let (x, y) = (
-                (k % side) as f32 / side as f32,
-                (k / side) as f32 / side as f32,
-            );
-            let target = Vec3A::new(2.0 * x - 1.0, 2.0 * y - 1.0, 0.0);
-            Ray::new(origin, (target - origin).normalize())
-        })
-        .collect()
 }
 
 #[divan::bench(args = [71, 224, 708], sample_count = 5)]

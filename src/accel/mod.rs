@@ -318,6 +318,35 @@ impl Geometry {
         self.tri_vertices.len()
     }
 
+    /// Bytes held by the geometry and its acceleration structures (heap
+    /// arrays at their length, not capacity), for the memory-per-triangle
+    /// figure of `cargo bench --bench scaling`.
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        let bvh = |b: &CwBvh| {
+            size_of_val(&b.nodes[..])
+                + size_of_val(&b.primitive_indices[..])
+                + b.exact_node_aabbs
+                    .as_ref()
+                    .map_or(0, |a| size_of_val(&a[..]))
+        };
+        let index = match &self.tri_index {
+            TriangleIndex::Empty => 0,
+            TriangleIndex::Soup(soup) => soup.memory_bytes(),
+            TriangleIndex::Bvh(b) => bvh(b),
+        };
+        size_of_val(&self.tri_vertices[..])
+            + size_of_val(&self.tri_shading[..])
+            + index
+            + self.sphere_bvh.as_ref().map_or(0, bvh)
+            + size_of_val(&self.spheres[..])
+            + self
+                .moving
+                .iter()
+                .map(|m| m.geometry.memory_bytes())
+                .sum::<usize>()
+    }
+
     /// Triangle vertices in BVH order.
     pub fn triangles(&self) -> &[[Vec3A; 3]] {
         &self.tri_vertices

@@ -53,6 +53,11 @@ impl TriangleSoup {
         TriangleSoup { blocks }
     }
 
+    /// Bytes of the blocks.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(&self.blocks[..])
+    }
+
     /// Closest hit in (0, t_max).
     #[inline]
     pub fn closest(&self, ray: &Ray, t_max: f32, triangles: &[[Vec3A; 3]]) -> Option<SoupHit> {

@@ -32,8 +32,8 @@ pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
 pub fn sin_cos_quarter_pi(x: f32) -> (f32, f32) {
     let x2 = x * x;
     let sin = x + x * x2 * (-1.666_665_5e-1 + x2 * (8.332_161e-3 + x2 * -1.951_529_6e-4));
-    let cos = 1.0 - 0.5 * x2
-        + x2 * x2 * (4.166_664_6e-2 + x2 * (-1.388_731_6e-3 + x2 * 2.443_315_7e-5));
+    let cos =
+        1.0 - 0.5 * x2 + x2 * x2 * (4.166_664_6e-2 + x2 * (-1.388_731_6e-3 + x2 * 2.443_315_7e-5));
     (sin, cos)
 }
 
@@ -113,7 +113,10 @@ mod tests {
         for i in 0..=10_000 {
             let x = std::f32::consts::FRAC_PI_4 * (i as f32 / 5_000.0 - 1.0);
             let (sin, cos) = super::sin_cos_quarter_pi(x);
-            assert!((sin - x.sin()).abs() <= 2.0 * f32::EPSILON * x.sin().abs().max(1e-30), "{x}");
+            assert!(
+                (sin - x.sin()).abs() <= 2.0 * f32::EPSILON * x.sin().abs().max(1e-30),
+                "{x}"
+            );
             assert!((cos - x.cos()).abs() <= 2.0 * f32::EPSILON, "{x}");
         }
     }
