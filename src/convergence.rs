@@ -107,7 +107,12 @@ impl BenchConfig {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Checkpoint {
     pub spp: u32,
+    /// Wall-clock render time.
     pub seconds: f64,
+    /// CPU time of the whole process over the render (all threads), when
+    /// the platform reports it: about `seconds` x threads when the threads
+    /// are not waiting.
+    pub cpu_seconds: Option<f64>,
     pub rays_per_pixel: f64,
     pub error: ErrorMetrics,
     /// RMSE with the reference's own noise taken out: sqrt(MSE - mean
@@ -195,6 +200,7 @@ pub fn measure(
         };
         let session = Session::with_pool(scene.clone(), settings, pool.clone());
         let start = Instant::now();
+        let cpu_start = cpu_time::ProcessTime::try_now().ok();
         let mut done = 0;
         while done < spp {
             let k = (spp - done).min(64);
@@ -202,11 +208,15 @@ pub fn measure(
             done += k;
         }
         let seconds = start.elapsed().as_secs_f64();
+        let cpu_seconds = cpu_start
+            .and_then(|t| t.try_elapsed().ok())
+            .map(|d| d.as_secs_f64());
         let stats = session.stats();
         let error = session.snapshot().image.compare(reference)?;
         out.push(Checkpoint {
             spp,
             seconds,
+            cpu_seconds,
             rays_per_pixel: stats.rays.total() as f64 / pixels,
             error,
             rmse: (error.rmse * error.rmse - reference_mse).max(0.0).sqrt(),
@@ -264,6 +274,7 @@ mod time_to_rmse_tests {
         Checkpoint {
             spp: 1,
             seconds,
+            cpu_seconds: None,
             rays_per_pixel: 0.0,
             error: ErrorMetrics::default(),
             rmse,
@@ -312,6 +323,7 @@ mod tests {
                     rmse,
                     spp,
                     seconds: 0.0,
+                    cpu_seconds: None,
                     rays_per_pixel: 0.0,
                     error: ErrorMetrics {
                         rmse,

@@ -115,7 +115,7 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
         None => 0.0,
     };
     let mut csv = String::from(
-        "config,spp,seconds,rays_per_pixel,rmse,rmse_without_reference_noise,relative_mse,mean_relative_error,efficiency\n",
+        "config,spp,seconds,cpu_seconds,rays_per_pixel,rmse,rmse_without_reference_noise,relative_mse,mean_relative_error,efficiency\n",
     );
     let mut results = Vec::new();
     for config in &configs {
@@ -135,9 +135,10 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
         )?;
         println!("{}", config.label);
         println!(
-            "  {:>7} {:>9} {:>10} {:>10} {:>14} {:>12} {:>12} {:>12}",
+            "  {:>7} {:>9} {:>9} {:>10} {:>10} {:>14} {:>12} {:>12} {:>12}",
             "spp",
             "seconds",
+            "CPU s",
             "rays/px",
             "RMSE",
             "RMSE-ref.noise",
@@ -147,9 +148,10 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
         );
         for p in &points {
             println!(
-                "  {:>7} {:>9.3} {:>10.1} {:>10.6} {:>14.6} {:>12.6} {:>12.6} {:>12.4e}",
+                "  {:>7} {:>9.3} {:>9} {:>10.1} {:>10.6} {:>14.6} {:>12.6} {:>12.6} {:>12.4e}",
                 p.spp,
                 p.seconds,
+                p.cpu_seconds.map_or("-".into(), |c| format!("{c:.3}")),
                 p.rays_per_pixel,
                 p.error.rmse,
                 p.rmse,
@@ -158,10 +160,11 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
                 p.efficiency()
             );
             csv += &format!(
-                "{},{},{:.6},{:.3},{:.8},{:.8},{:.8},{:.8},{:.6e}\n",
+                "{},{},{:.6},{},{:.3},{:.8},{:.8},{:.8},{:.8},{:.6e}\n",
                 config.label,
                 p.spp,
                 p.seconds,
+                p.cpu_seconds.map_or(String::new(), |c| format!("{c:.6}")),
                 p.rays_per_pixel,
                 p.error.rmse,
                 p.rmse,
