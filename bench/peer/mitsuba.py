@@ -49,7 +49,9 @@ def mitsuba_points(mi, variant, sampler, reference, targets, max_spp, threads):
     spp = 1
     while spp <= max_spp:
         scene = mi.load_file(scene_path, spp=spp, sampler=sampler)
-        mi.render(scene, spp=spp, seed=1)  # warm-up: JIT compilation, caches
+        # Warm-up, evaluated: the LLVM variant records lazily, so an image
+        # that is never read would leave kernel compilation to the timed call.
+        np.array(mi.render(scene, spp=spp, seed=1))
         start = time.perf_counter()
         image = mi.render(scene, spp=spp, seed=2)
         image = np.array(image)  # forces evaluation

@@ -1,26 +1,30 @@
-//! Ray queries against the scene's geometry: obvhs compressed wide BVHs (CWBVH)
-//! over triangles and over spheres, watertight ray/triangle intersection and a
-//! numerically careful ray/sphere test.
+//! Ray queries against the scene's geometry: an 8-wide BVH over triangles
+//! (obvhs builds the binary tree, `wide_bvh.rs` collapses and traverses it),
+//! a flat soup for small meshes, an obvhs CWBVH over many spheres,
+//! watertight ray/triangle intersection and a numerically careful ray/sphere
+//! test.
 //!
-//! Triangles are stored in flat arrays in BVH leaf order, so a leaf's
-//! primitives are contiguous in memory and the traversal's primitive index
-//! addresses them directly (obvhs `primitive_indices` applied once at build).
+//! Triangles are stored in flat arrays in leaf order, so a leaf's triangles
+//! are contiguous in memory and a hit's index addresses them directly.
 
+mod block;
 mod soup;
 mod sphere;
 mod triangle;
+mod wide_bvh;
 
 use crate::math::{OffsetMode, Ray, gamma};
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
+use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
 use obvhs::ploc::PlocBuilder;
 use soup::TriangleSoup;
 use sphere::intersect_sphere;
-use triangle::ShearedRay;
+use wide_bvh::WideBvh;
 
 /// Marks a primitive that is not a light.
 pub const NO_LIGHT: u32 = u32::MAX;
@@ -107,8 +111,8 @@ enum TriangleIndex {
     /// Every triangle tested, eight per instruction: faster below
     /// [`SOUP_MAX_TRIANGLES`] triangles.
     Soup(TriangleSoup),
-    /// obvhs CWBVH.
-    Bvh(CwBvh),
+    /// An 8-wide BVH with SIMD node tests and 8-triangle leaves.
+    Bvh(WideBvh),
 }
 
 /// Which triangle index to build.
@@ -190,12 +194,8 @@ fn cwbvh_depth(bvh: &CwBvh, node: usize) -> u32 {
     1 + deepest_child
 }
 
-/// A CWBVH over `aabbs`, or None when it would be too deep to traverse:
-/// many nearly coincident primitives (found by fuzzing: a mesh of a hundred
-/// copies of a few triangles) make obvhs's PLOC builder produce chains.
-/// The steps of obvhs's `build_cwbvh`, without its debug-build validation,
-/// which panics on such a tree where this returns None.
-fn build_shallow_cwbvh(aabbs: &[Aabb]) -> Option<CwBvh> {
+/// obvhs's binary BVH over `aabbs`: PLOC, then reinsertion.
+fn build_bvh2(aabbs: &[Aabb]) -> Bvh2 {
     let params = build_params();
     let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
         params.ploc_search_distance,
@@ -205,10 +205,26 @@ fn build_shallow_cwbvh(aabbs: &[Aabb]) -> Option<CwBvh> {
         params.search_depth_threshold,
     );
     ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+    bvh2
+}
+
+/// The triangles' 8-wide BVH and the order to store them in, or None when
+/// the tree would be deeper than its traversal stack (many nearly coincident
+/// triangles, found by fuzzing, make PLOC produce chains).
+fn build_wide_bvh(triangles: &[[Vec3A; 3]]) -> Option<(WideBvh, Vec<usize>)> {
+    let aabbs: Vec<Aabb> = triangles.iter().map(|t| Aabb::from_points(t)).collect();
+    WideBvh::from_bvh2(&build_bvh2(&aabbs), triangles)
+}
+
+/// A CWBVH over `aabbs` (spheres), or None when it would be too deep to
+/// traverse. The steps of obvhs's `build_cwbvh`, without its debug-build
+/// validation, which panics on such a tree where this returns None.
+fn build_shallow_cwbvh(aabbs: &[Aabb]) -> Option<CwBvh> {
+    let params = build_params();
+    let bvh2 = build_bvh2(aabbs);
     let bvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
     (bvh.nodes.is_empty() || cwbvh_depth(&bvh, 0) < CWBVH_STACK_DEPTH).then_some(bvh)
 }
-
 impl Geometry {
     /// Builds the BVHs and stores the triangles in leaf order.
     pub fn build(triangles: &[TriangleInput], spheres: Vec<Sphere>) -> Self {
@@ -228,33 +244,20 @@ impl Geometry {
             AccelChoice::Soup => true,
         };
         if !triangles.is_empty() && use_soup {
-            for t in triangles {
-                geometry.tri_vertices.push(t.vertices);
-                geometry.tri_shading.push(TriangleShading::new(t));
-            }
-            geometry.tri_index = TriangleIndex::Soup(TriangleSoup::new(&geometry.tri_vertices));
+            geometry.store_soup(triangles);
         } else if !triangles.is_empty() {
-            let aabbs: Vec<Aabb> = triangles
-                .iter()
-                .map(|t| Aabb::from_points(&t.vertices))
-                .collect();
-            match build_shallow_cwbvh(&aabbs) {
-                Some(bvh) => {
-                    for &i in &bvh.primitive_indices {
-                        let t = &triangles[i as usize];
-                        geometry.tri_vertices.push(t.vertices);
-                        geometry.tri_shading.push(TriangleShading::new(t));
+            let vertices: Vec<[Vec3A; 3]> = triangles.iter().map(|t| t.vertices).collect();
+            match build_wide_bvh(&vertices) {
+                Some((bvh, order)) => {
+                    for i in order {
+                        geometry.tri_vertices.push(triangles[i].vertices);
+                        geometry.tri_shading.push(TriangleShading::new(&triangles[i]));
                     }
                     geometry.tri_index = TriangleIndex::Bvh(bvh);
                 }
                 None => {
                     // Correct at any depth, if slow: better than missed hits.
-                    for t in triangles {
-                        geometry.tri_vertices.push(t.vertices);
-                        geometry.tri_shading.push(TriangleShading::new(t));
-                    }
-                    geometry.tri_index =
-                        TriangleIndex::Soup(TriangleSoup::new(&geometry.tri_vertices));
+                    geometry.store_soup(triangles);
                     geometry.bvh_too_deep = true;
                 }
             }
@@ -287,6 +290,15 @@ impl Geometry {
             }
         }
         geometry
+    }
+
+    /// Stores the triangles in input order and tests them all, as a soup.
+    fn store_soup(&mut self, triangles: &[TriangleInput]) {
+        for t in triangles {
+            self.tri_vertices.push(t.vertices);
+            self.tri_shading.push(TriangleShading::new(t));
+        }
+        self.tri_index = TriangleIndex::Soup(TriangleSoup::new(&self.tri_vertices));
     }
 
     /// Adds an object that moves by `velocity` per unit of time; `geometry`
@@ -333,7 +345,7 @@ impl Geometry {
         let index = match &self.tri_index {
             TriangleIndex::Empty => 0,
             TriangleIndex::Soup(soup) => soup.memory_bytes(),
-            TriangleIndex::Bvh(b) => bvh(b),
+            TriangleIndex::Bvh(b) => b.memory_bytes(),
         };
         size_of_val(&self.tri_vertices[..])
             + size_of_val(&self.tri_shading[..])
@@ -452,20 +464,9 @@ impl Geometry {
                 }
             }
             TriangleIndex::Bvh(bvh) => {
-                let sheared = ShearedRay::new(ray);
-                let mut hit = obvhs::ray::RayHit::none();
-                bvh.ray_traverse(bvh_ray(ray, best_t), &mut hit, |r, id| {
-                    match sheared.intersect(&self.tri_vertices[id], r.tmax) {
-                        Some((t, b1, b2)) => {
-                            best_b1 = b1;
-                            best_b2 = b2;
-                            best_tri = id as u32;
-                            t
-                        }
-                        None => f32::INFINITY,
-                    }
-                });
-                best_t = best_t.min(hit.t);
+                if let Some((i, t, b1, b2)) = bvh.closest(ray, best_t, &self.tri_vertices) {
+                    (best_tri, best_t, best_b1, best_b2) = (i as u32, t, b1, b2);
+                }
             }
         }
         let mut best_sphere = u32::MAX;
@@ -547,14 +548,7 @@ impl Geometry {
         let triangle_blocks = match &self.tri_index {
             TriangleIndex::Empty => false,
             TriangleIndex::Soup(soup) => soup.any(ray, ray.t_max, &self.tri_vertices),
-            TriangleIndex::Bvh(bvh) => {
-                let sheared = ShearedRay::new(ray);
-                !bvh.ray_traverse_miss(bvh_ray(ray, ray.t_max), |r, id| {
-                    sheared
-                        .intersect(&self.tri_vertices[id], r.tmax)
-                        .map_or(f32::INFINITY, |h| h.0)
-                })
-            }
+            TriangleIndex::Bvh(bvh) => bvh.any(ray, ray.t_max, &self.tri_vertices),
         };
         if triangle_blocks {
             return true;

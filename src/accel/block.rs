@@ -1,0 +1,274 @@
+//! Eight triangles per instruction: the blocks that the triangle soup and
+//! the wide BVH's leaves are made of, the watertight test on a block, and
+//! the slab test of a ray against eight boxes.
+
+use super::triangle::{ShearedRay, permuted_axes};
+use crate::math::{Ray, gamma};
+use glam::Vec3A;
+use wide::f32x8;
+
+/// Triangles per block and boxes per slab test (SIMD lanes).
+pub const LANES: usize = 8;
+
+/// A hit: triangle index, t and barycentrics (b1, b2).
+pub type TriangleHit = (usize, f32, f32, f32);
+
+/// Up to eight triangles: `v[vertex][axis]`, one lane per triangle.
+#[derive(Clone, Debug)]
+pub struct Block {
+    v: [[f32x8; 3]; 3],
+    /// Index of the block's first triangle; its triangles are contiguous.
+    pub first: u32,
+    /// Bit i set when lane i holds a triangle.
+    lanes: u32,
+}
+
+impl Block {
+    /// The block of `triangles` (at most [`LANES`]), the first of which has
+    /// index `first`.
+    pub fn new(triangles: &[[Vec3A; 3]], first: usize) -> Self {
+        debug_assert!(!triangles.is_empty() && triangles.len() <= LANES);
+        let mut v = [[[0.0f32; LANES]; 3]; 3];
+        for (lane, tri) in triangles.iter().enumerate() {
+            for (vertex, p) in tri.iter().enumerate() {
+                for axis in 0..3 {
+                    v[vertex][axis][lane] = p[axis];
+                }
+            }
+        }
+        Block {
+            v: v.map(|vertex| vertex.map(f32x8::new)),
+            first: first as u32,
+            lanes: (1u32 << triangles.len()) - 1,
+        }
+    }
+
+    /// Updates `best` (and `best_t`) with the closest hit of this block
+    /// nearer than `best_t`.
+    #[inline(always)]
+    pub fn closest(
+        &self,
+        axes: &Axes,
+        ray: &Ray,
+        triangles: &[[Vec3A; 3]],
+        best_t: &mut f32,
+        best: &mut Option<TriangleHit>,
+    ) {
+        let Some(hits) = block_hits(self, axes, *best_t) else {
+            return;
+        };
+        let first = self.first as usize;
+        let (ts, b1s, b2s) = (hits.t.to_array(), hits.b1.to_array(), hits.b2.to_array());
+        let mut lanes = hits.mask;
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            if ts[lane] < *best_t {
+                *best_t = ts[lane];
+                *best = Some((first + lane, ts[lane], b1s[lane], b2s[lane]));
+            }
+        }
+        // Edge functions of exactly zero: the scalar test decides in double precision.
+        let mut lanes = hits.ambiguous;
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            let index = first + lane;
+            if let Some((t, b1, b2)) = ShearedRay::new(ray).intersect(&triangles[index], *best_t) {
+                *best_t = t;
+                *best = Some((index, t, b1, b2));
+            }
+        }
+    }
+
+    /// True when a triangle of this block is hit in (0, t_max).
+    #[inline(always)]
+    pub fn any(&self, axes: &Axes, ray: &Ray, triangles: &[[Vec3A; 3]], t_max: f32) -> bool {
+        let Some(hits) = block_hits(self, axes, t_max) else {
+            return false;
+        };
+        if hits.mask != 0 {
+            return true;
+        }
+        let mut lanes = hits.ambiguous;
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            if ShearedRay::new(ray)
+                .intersect(&triangles[self.first as usize + lane], t_max)
+                .is_some()
+            {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// Eight axis-aligned boxes, one lane each.
+#[derive(Clone, Debug)]
+pub struct Boxes8 {
+    min: [f32x8; 3],
+    max: [f32x8; 3],
+    /// Bit i set when lane i holds a box.
+    lanes: u32,
+}
+
+impl Boxes8 {
+    /// Up to [`LANES`] boxes given as (min, max).
+    pub fn new(boxes: &[(Vec3A, Vec3A)]) -> Self {
+        debug_assert!(boxes.len() <= LANES);
+        let mut min = [[0.0f32; LANES]; 3];
+        let mut max = [[0.0f32; LANES]; 3];
+        for (lane, (lo, hi)) in boxes.iter().enumerate() {
+            for axis in 0..3 {
+                min[axis][lane] = lo[axis];
+                max[axis][lane] = hi[axis];
+            }
+        }
+        Boxes8 {
+            min: min.map(f32x8::new),
+            max: max.map(f32x8::new),
+            lanes: (1u32 << boxes.len()) - 1,
+        }
+    }
+}
+
+/// The ray in the permuted, sheared frame of the watertight test.
+pub struct Axes {
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    origin: [f32x8; 3],
+    sx: f32x8,
+    sy: f32x8,
+    sz: f32x8,
+    /// Unpermuted origin and reciprocal direction, for slab tests.
+    box_origin: [f32x8; 3],
+    inv_direction: [f32x8; 3],
+}
+
+impl Axes {
+    #[inline]
+    pub fn new(ray: &Ray) -> Self {
+        let d = ray.direction;
+        let (kx, ky, kz) = permuted_axes(d);
+        let o = ray.origin;
+        Axes {
+            kx,
+            ky,
+            kz,
+            origin: [
+                f32x8::splat(o[kx]),
+                f32x8::splat(o[ky]),
+                f32x8::splat(o[kz]),
+            ],
+            sx: f32x8::splat(d[kx] / d[kz]),
+            sy: f32x8::splat(d[ky] / d[kz]),
+            sz: f32x8::splat(1.0 / d[kz]),
+            box_origin: [0, 1, 2].map(|axis| f32x8::splat(o[axis])),
+            inv_direction: [0, 1, 2].map(|axis| f32x8::splat(1.0 / d[axis])),
+        }
+    }
+
+    /// Slab test against eight boxes (pbrt-v4 6.8.7): the lanes of `valid`
+    /// whose box the ray enters in [0, t_max], and the entry distances. The
+    /// exit distance is enlarged by 1 + 2 gamma(3), which makes the test
+    /// conservative under rounding. A slab giving 0 x inf = NaN (a direction
+    /// component of zero and the origin on a face's plane) does not
+    /// constrain t: the ray runs inside that plane, which counts as inside.
+    #[inline(always)]
+    pub fn reaches(&self, boxes: &Boxes8, t_max: f32) -> (u32, [f32; LANES]) {
+        let mut t_near = f32x8::splat(0.0);
+        let mut t_far = f32x8::splat(t_max);
+        let widen = f32x8::splat(1.0 + 2.0 * gamma(3));
+        for axis in 0..3 {
+            let t0 = (boxes.min[axis] - self.box_origin[axis]) * self.inv_direction[axis];
+            let t1 = (boxes.max[axis] - self.box_origin[axis]) * self.inv_direction[axis];
+            let nan = t0.simd_ne(t0) | t1.simd_ne(t1);
+            t_near = nan.select(t_near, t_near.fast_max(t0.fast_min(t1)));
+            t_far = nan.select(t_far, t_far.fast_min(t0.fast_max(t1) * widen));
+        }
+        let reached = t_near.simd_le(t_far).to_bitmask() & boxes.lanes;
+        (reached, t_near.to_array())
+    }
+
+    /// Vertex in the sheared frame: (x - sx z, y - sy z, sz z), relative to the origin.
+    #[inline(always)]
+    fn shear(&self, v: &[f32x8; 3]) -> [f32x8; 3] {
+        let x = v[self.kx] - self.origin[0];
+        let y = v[self.ky] - self.origin[1];
+        let z = v[self.kz] - self.origin[2];
+        [x - self.sx * z, y - self.sy * z, self.sz * z]
+    }
+}
+
+/// Hits of one block.
+pub struct BlockHits {
+    t: f32x8,
+    b1: f32x8,
+    b2: f32x8,
+    /// Lanes hit in (0, t_max).
+    mask: u32,
+    /// Lanes with an edge function of exactly zero, which single precision
+    /// cannot decide; the scalar test redoes them in double precision.
+    ambiguous: u32,
+}
+
+/// The watertight test on eight triangles. Same operations as the scalar
+/// test in `triangle.rs`, so both agree to the bit.
+#[inline(always)]
+pub fn block_hits(block: &Block, axes: &Axes, t_max: f32) -> Option<BlockHits> {
+    let [ax, ay, az] = axes.shear(&block.v[0]);
+    let [bx, by, bz] = axes.shear(&block.v[1]);
+    let [cx, cy, cz] = axes.shear(&block.v[2]);
+    let e0 = cx * by - cy * bx;
+    let e1 = ax * cy - ay * cx;
+    let e2 = bx * ay - by * ax;
+    let zero = f32x8::splat(0.0);
+    let sign = f32x8::splat(-0.0);
+    let ambiguous =
+        (e0.simd_eq(zero) | e1.simd_eq(zero) | e2.simd_eq(zero)).to_bitmask() & block.lanes;
+    // With no edge function zero (ambiguous lanes are decided apart), the ray
+    // is inside when all three have the same sign bit: two XORs instead of
+    // six comparisons.
+    let mixed_signs = ((e0 ^ e1) | (e1 ^ e2)).to_bitmask();
+    let det = e0 + e1 + e2;
+    let t_scaled = e0 * az + e1 * bz + e2 * cz;
+    // t * det within (0, t_max * det), compared without dividing; the sign of
+    // det is moved onto t_scaled by XOR.
+    let t_abs = t_scaled ^ (det & sign);
+    let det_abs = det.abs();
+    let in_range =
+        t_abs.simd_gt(zero) & t_abs.simd_lt(f32x8::splat(t_max) * det_abs) & det_abs.simd_gt(zero);
+    let mut mask = in_range.to_bitmask() & !mixed_signs & block.lanes & !ambiguous;
+    if mask == 0 && ambiguous == 0 {
+        return None;
+    }
+    let inv_det = f32x8::splat(1.0) / det;
+    let t = t_scaled * inv_det;
+    if mask != 0 {
+        // Conservative bound on t's rounding error (pbrt-v4 6.8.4).
+        let max_z = az.abs().max(bz.abs()).max(cz.abs());
+        let max_x = ax.abs().max(bx.abs()).max(cx.abs());
+        let max_y = ay.abs().max(by.abs()).max(cy.abs());
+        let delta_z = f32x8::splat(gamma(3)) * max_z;
+        let delta_x = f32x8::splat(gamma(5)) * (max_x + max_z);
+        let delta_y = f32x8::splat(gamma(5)) * (max_y + max_z);
+        let delta_e = f32x8::splat(2.0)
+            * (f32x8::splat(gamma(2)) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+        let delta_t = f32x8::splat(3.0)
+            * (f32x8::splat(gamma(3)) * max_e * max_z + delta_e * max_z + delta_z * max_e)
+            * inv_det.abs();
+        mask &= t.simd_gt(delta_t).to_bitmask();
+    }
+    Some(BlockHits {
+        t,
+        b1: e1 * inv_det,
+        b2: e2 * inv_det,
+        mask,
+        ambiguous,
+    })
+}
+

@@ -1,0 +1,415 @@
+//! An 8-wide BVH traversed on the CPU: one SIMD slab test decides which of a
+//! node's eight children a ray enters, and leaves hold up to eight triangles
+//! tested as one block (`block.rs`).
+//!
+//! The tree comes from obvhs's binary BVH (PLOC and reinsertion); it is
+//! collapsed here because obvhs's own 8-wide layout (CWBVH, Ylitie et al.
+//! 2017) is made for GPUs: quantised child boxes decoded per node and leaves
+//! of at most three triangles tested one at a time. Measured with `cargo bench
+//! --bench scaling` (see the commit that added this file).
+
+use super::block::{Axes, Block, Boxes8, LANES, TriangleHit};
+use crate::math::Ray;
+use glam::Vec3A;
+use obvhs::bvh2::Bvh2;
+
+/// Traversal stack entries: a node pushes at most 7 children and pops one,
+/// so a tree of depth d needs at most 7 d + 1.
+const STACK_SIZE: usize = 128;
+
+/// Deepest tree the stack can hold.
+const MAX_DEPTH: usize = (STACK_SIZE - 1) / (LANES - 1);
+
+/// A child reference: a node index, or a leaf block index with the top bit set.
+const LEAF_BIT: u32 = 1 << 31;
+
+#[derive(Clone, Debug)]
+struct Node {
+    boxes: Boxes8,
+    children: [u32; LANES],
+}
+
+/// Nodes and leaf blocks of an 8-wide BVH over triangles.
+#[derive(Clone, Debug)]
+pub struct WideBvh {
+    nodes: Vec<Node>,
+    leaves: Vec<Block>,
+    /// The root when it is a single leaf (meshes of up to 8 triangles).
+    root: u32,
+}
+
+impl WideBvh {
+    /// Collapses `bvh2` (built over `triangles`). Returns the tree and the
+    /// order in which the caller must store the triangles (tree triangle i is
+    /// `triangles[order[i]]`), or None when the tree would be deeper than the
+    /// traversal stack allows.
+    pub fn from_bvh2(bvh2: &Bvh2, triangles: &[[Vec3A; 3]]) -> Option<(Self, Vec<usize>)> {
+        if bvh2.nodes.is_empty() {
+            return None;
+        }
+        let mut builder = Builder {
+            bvh2,
+            counts: subtree_counts(bvh2),
+            triangles,
+            nodes: Vec::new(),
+            leaves: Vec::new(),
+            order: Vec::with_capacity(triangles.len()),
+        };
+        let root = builder.collapse(0, 1)?;
+        let Builder {
+            nodes,
+            leaves,
+            order,
+            ..
+        } = builder;
+        Some((
+            WideBvh {
+                nodes,
+                leaves,
+                root,
+            },
+            order,
+        ))
+    }
+
+    /// Bytes of nodes and leaves.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(&self.nodes[..]) + std::mem::size_of_val(&self.leaves[..])
+    }
+
+    /// Closest hit in (0, t_max), front to back.
+    #[inline]
+    pub fn closest(&self, ray: &Ray, t_max: f32, triangles: &[[Vec3A; 3]]) -> Option<TriangleHit> {
+        let axes = Axes::new(ray);
+        let mut best = None;
+        let mut best_t = t_max;
+        let mut stack = [(0u32, 0.0f32); STACK_SIZE];
+        stack[0] = (self.root, 0.0);
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let (child, t_near) = stack[top];
+            if t_near > best_t {
+                continue;
+            }
+            if child & LEAF_BIT != 0 {
+                self.leaves[(child & !LEAF_BIT) as usize]
+                    .closest(&axes, ray, triangles, &mut best_t, &mut best);
+                continue;
+            }
+            let node = &self.nodes[child as usize];
+            let (mut reached, distances) = axes.reaches(&node.boxes, best_t);
+            // Push the reached children farthest first, so that the nearest
+            // is visited next and its hit culls the others.
+            let start = top;
+            while reached != 0 {
+                let lane = reached.trailing_zeros() as usize;
+                reached &= reached - 1;
+                let entry = (node.children[lane], distances[lane]);
+                let mut k = top;
+                while k > start && stack[k - 1].1 < entry.1 {
+                    stack[k] = stack[k - 1];
+                    k -= 1;
+                }
+                stack[k] = entry;
+                top += 1;
+            }
+        }
+        best
+    }
+
+    /// True when any triangle is hit in (0, t_max).
+    #[inline]
+    pub fn any(&self, ray: &Ray, t_max: f32, triangles: &[[Vec3A; 3]]) -> bool {
+        let axes = Axes::new(ray);
+        let mut stack = [0u32; STACK_SIZE];
+        stack[0] = self.root;
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let child = stack[top];
+            if child & LEAF_BIT != 0 {
+                if self.leaves[(child & !LEAF_BIT) as usize].any(&axes, ray, triangles, t_max) {
+                    return true;
+                }
+                continue;
+            }
+            let node = &self.nodes[child as usize];
+            let (mut reached, _) = axes.reaches(&node.boxes, t_max);
+            while reached != 0 {
+                let lane = reached.trailing_zeros() as usize;
+                reached &= reached - 1;
+                stack[top] = node.children[lane];
+                top += 1;
+            }
+        }
+        false
+    }
+}
+
+struct Builder<'a> {
+    bvh2: &'a Bvh2,
+    /// Primitives below each binary node.
+    counts: Vec<u32>,
+    triangles: &'a [[Vec3A; 3]],
+    nodes: Vec<Node>,
+    leaves: Vec<Block>,
+    order: Vec<usize>,
+}
+
+impl Builder<'_> {
+    /// Primitives below binary node `index`.
+    fn prim_count(&self, index: u32) -> usize {
+        self.counts[index as usize] as usize
+    }
+
+    /// Appends the primitives below binary node `index` to `out`.
+    fn gather(&self, index: u32, out: &mut Vec<usize>) {
+        let node = &self.bvh2.nodes[index as usize];
+        if node.is_leaf() {
+            let first = node.first_index as usize;
+            let prims = &self.bvh2.primitive_indices[first..first + node.prim_count as usize];
+            out.extend(prims.iter().map(|&p| p as usize));
+        } else {
+            self.gather(node.first_index, out);
+            self.gather(node.first_index + 1, out);
+        }
+    }
+
+    /// The wide node or leaf for binary node `index` at `depth`. A subtree
+    /// of at most eight triangles becomes one leaf block; otherwise the
+    /// node's children are opened, largest surface area first, until there
+    /// are eight (the usual collapse, as in Embree's BVH8 builder).
+    fn collapse(&mut self, index: u32, depth: usize) -> Option<u32> {
+        if depth > MAX_DEPTH {
+            return None;
+        }
+        let node = &self.bvh2.nodes[index as usize];
+        if node.is_leaf() && node.prim_count as usize > LANES {
+            return self.split_leaf(index);
+        }
+        if self.prim_count(index) <= LANES {
+            let mut prims = Vec::with_capacity(LANES);
+            self.gather(index, &mut prims);
+            let first = self.order.len();
+            let vertices: Vec<[Vec3A; 3]> = prims.iter().map(|&p| self.triangles[p]).collect();
+            self.order.extend_from_slice(&prims);
+            self.leaves.push(Block::new(&vertices, first));
+            return Some((self.leaves.len() - 1) as u32 | LEAF_BIT);
+        }
+        let mut children = vec![index];
+        while children.len() < LANES {
+            let widest = children
+                .iter()
+                .enumerate()
+                .filter(|&(_, &c)| {
+                    !self.bvh2.nodes[c as usize].is_leaf() && self.prim_count(c) > LANES
+                })
+                .max_by(|a, b| {
+                    let area = |c: u32| self.bvh2.nodes[c as usize].aabb().half_area();
+                    area(*a.1).total_cmp(&area(*b.1))
+                })
+                .map(|(i, _)| i);
+            let Some(i) = widest else { break };
+            let opened = children.swap_remove(i);
+            let first = self.bvh2.nodes[opened as usize].first_index;
+            children.extend([first, first + 1]);
+        }
+        self.push_node(children.len(), |builder, lane| {
+            let c = children[lane];
+            let aabb = *builder.bvh2.nodes[c as usize].aabb();
+            Some(((aabb.min, aabb.max), builder.collapse(c, depth + 1)?))
+        })
+    }
+
+    /// A binary leaf of more than eight triangles (obvhs leaves usually hold
+    /// one): a node over blocks of eight, or None past 64 triangles.
+    fn split_leaf(&mut self, index: u32) -> Option<u32> {
+        let mut prims = Vec::new();
+        self.gather(index, &mut prims);
+        let chunks: Vec<Vec<usize>> = prims.chunks(LANES).map(<[usize]>::to_vec).collect();
+        if chunks.len() > LANES {
+            return None;
+        }
+        self.push_node(chunks.len(), |builder, lane| {
+            let vertices: Vec<[Vec3A; 3]> =
+                chunks[lane].iter().map(|&p| builder.triangles[p]).collect();
+            let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+            for p in vertices.iter().flatten() {
+                (lo, hi) = (lo.min(*p), hi.max(*p));
+            }
+            let first = builder.order.len();
+            builder.order.extend_from_slice(&chunks[lane]);
+            builder.leaves.push(Block::new(&vertices, first));
+            Some(((lo, hi), (builder.leaves.len() - 1) as u32 | LEAF_BIT))
+        })
+    }
+
+    /// Adds a node with `count` children, `child(builder, lane)` giving
+    /// each child's box and reference (building it).
+    fn push_node(
+        &mut self,
+        count: usize,
+        mut child: impl FnMut(&mut Self, usize) -> Option<((Vec3A, Vec3A), u32)>,
+    ) -> Option<u32> {
+        // Reserve this node's slot before its children take theirs.
+        let slot = self.nodes.len();
+        self.nodes.push(Node {
+            boxes: Boxes8::new(&[]),
+            children: [0; LANES],
+        });
+        let mut boxes = Vec::with_capacity(LANES);
+        let mut refs = [0u32; LANES];
+        for (lane, r) in refs.iter_mut().enumerate().take(count) {
+            let (aabb, reference) = child(self, lane)?;
+            boxes.push(aabb);
+            *r = reference;
+        }
+        self.nodes[slot] = Node {
+            boxes: Boxes8::new(&boxes),
+            children: refs,
+        };
+        Some(slot as u32)
+    }
+}
+
+/// Primitive counts below every node of `bvh2`, by an explicit post-order
+/// walk (pathological inputs make deep binary trees).
+fn subtree_counts(bvh2: &Bvh2) -> Vec<u32> {
+    let mut counts = vec![0u32; bvh2.nodes.len()];
+    let mut stack = vec![(0u32, false)];
+    while let Some((index, children_done)) = stack.pop() {
+        let node = &bvh2.nodes[index as usize];
+        if node.is_leaf() {
+            counts[index as usize] = node.prim_count;
+        } else if children_done {
+            counts[index as usize] =
+                counts[node.first_index as usize] + counts[node.first_index as usize + 1];
+        } else {
+            stack.extend([
+                (index, true),
+                (node.first_index, false),
+                (node.first_index + 1, false),
+            ]);
+        }
+    }
+    counts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::triangle::ShearedRay;
+    use crate::accel::{build_bvh2, build_wide_bvh};
+    use crate::sampling::hash::{hash_combine, to_unit_float};
+    use obvhs::aabb::Aabb;
+
+    /// Brute force over every triangle: the nearest t, or None.
+    fn nearest(ray: &Ray, triangles: &[[Vec3A; 3]]) -> Option<f32> {
+        let sheared = ShearedRay::new(ray);
+        let mut best = f32::INFINITY;
+        for tri in triangles {
+            if let Some((t, _, _)) = sheared.intersect(tri, best) {
+                best = t;
+            }
+        }
+        best.is_finite().then_some(best)
+    }
+
+    fn check_against_brute_force(input: &[[Vec3A; 3]], rays: impl Iterator<Item = Ray>) {
+        let (bvh, order) = build_wide_bvh(input).expect("shallow tree");
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..input.len()).collect::<Vec<_>>(), "a permutation");
+        let triangles: Vec<[Vec3A; 3]> = order.iter().map(|&i| input[i]).collect();
+        let mut hits = 0;
+        for (i, ray) in rays.enumerate() {
+            let expected = nearest(&ray, &triangles);
+            let found = bvh.closest(&ray, f32::INFINITY, &triangles);
+            assert_eq!(found.map(|h| h.1), expected, "ray {i}");
+            if let Some((index, t, _, _)) = found {
+                // The reported triangle is hit at the reported t.
+                let own = ShearedRay::new(&ray).intersect(&triangles[index], f32::INFINITY);
+                assert_eq!(own.map(|h| h.0), Some(t), "ray {i}");
+                hits += 1;
+            }
+            assert_eq!(bvh.any(&ray, f32::INFINITY, &triangles), expected.is_some());
+            if let Some(t) = expected {
+                // Nothing is nearer than the nearest hit.
+                assert!(!bvh.any(&ray, t * 0.999, &triangles), "ray {i}");
+            }
+        }
+        assert!(hits > 100, "the rays must exercise hits ({hits})");
+    }
+
+    #[test]
+    fn agrees_with_brute_force_on_random_triangles() {
+        let u = |k: u64, i: u64| to_unit_float(hash_combine(k, i));
+        let input: Vec<[Vec3A; 3]> = (0..3000u64)
+            .map(|i| {
+                let centre = Vec3A::new(u(1, i), u(2, i), u(3, i)) * 2.0 - Vec3A::ONE;
+                let size = if i % 100 == 0 { 0.8 } else { 0.05 };
+                let p = |k| centre + (Vec3A::new(u(k, i), u(k + 1, i), u(k + 2, i)) - 0.5) * size;
+                [p(10), p(20), p(30)]
+            })
+            .collect();
+        let rays = (0..4000u64).map(|i| {
+            let origin = Vec3A::new(u(4, i), u(5, i), u(6, i)) * 3.0 - Vec3A::splat(1.5);
+            let direction = Vec3A::new(u(7, i), u(8, i), u(9, i)) * 2.0 - Vec3A::ONE;
+            Ray::new(origin, direction.normalize())
+        });
+        check_against_brute_force(&input, rays);
+    }
+
+    /// A grid of axis-aligned unit squares and rays with zero direction
+    /// components starting on the grid's planes: the slab test's NaN case.
+    #[test]
+    fn axis_aligned_grid_with_axis_parallel_rays() {
+        let u = |k: u64, i: u64| to_unit_float(hash_combine(k, i));
+        let mut input = Vec::new();
+        for axis in 0..3 {
+            for layer in 0..4 {
+                for a in 0..4 {
+                    for b in 0..4 {
+                        let corner = |da: f32, db: f32| {
+                            let mut p = Vec3A::splat(layer as f32);
+                            p[(axis + 1) % 3] = a as f32 + da;
+                            p[(axis + 2) % 3] = b as f32 + db;
+                            p
+                        };
+                        input.push([corner(0.0, 0.0), corner(1.0, 0.0), corner(1.0, 1.0)]);
+                        input.push([corner(0.0, 0.0), corner(1.0, 1.0), corner(0.0, 1.0)]);
+                    }
+                }
+            }
+        }
+        let grid = |v: f32| (v * 8.0).round() / 2.0 - 0.5;
+        let rays = (0..6000u64).filter_map(|i| {
+            let origin = Vec3A::new(grid(u(1, i)), grid(u(2, i)), grid(u(3, i)));
+            let mut direction = Vec3A::new(u(4, i), u(5, i), u(6, i)) * 2.0 - Vec3A::ONE;
+            for axis in 0..3 {
+                if u(7 + axis as u64, i) < 0.4 {
+                    direction[axis] = 0.0;
+                }
+            }
+            (direction != Vec3A::ZERO).then(|| Ray::new(origin, direction.normalize()))
+        });
+        check_against_brute_force(&input, rays);
+    }
+
+    #[test]
+    fn leaves_hold_up_to_eight_and_nodes_are_wide() {
+        let u = |k: u64, i: u64| to_unit_float(hash_combine(k, i));
+        let input: Vec<[Vec3A; 3]> = (0..1000u64)
+            .map(|i| {
+                let c = Vec3A::new(u(1, i), u(2, i), u(3, i));
+                [c, c + Vec3A::X * 0.01, c + Vec3A::Y * 0.01]
+            })
+            .collect();
+        let aabbs: Vec<Aabb> = input.iter().map(|t| Aabb::from_points(t)).collect();
+        let (bvh, _) = WideBvh::from_bvh2(&build_bvh2(&aabbs), &input).unwrap();
+        // Collapsing makes far fewer nodes than a binary tree's n - 1.
+        assert!(bvh.nodes.len() < 1000 / 4, "{} nodes", bvh.nodes.len());
+        assert!(bvh.leaves.len() < 1000 / 2, "{} leaves", bvh.leaves.len());
+    }
+}
