@@ -198,8 +198,8 @@ fn rays() {
         .collect();
     let rays = incoherent_rays(2_000_000, 250.0, Vec3A::new(278.0, 274.0, 280.0), 250.0);
     for (name, choice) in [
-        ("Cornell box (36 tris), soup", AccelChoice::Soup),
-        ("Cornell box (36 tris), CWBVH", AccelChoice::Bvh),
+        ("Cornell box (32 tris), soup", AccelChoice::Soup),
+        ("Cornell box (32 tris), 8-wide BVH", AccelChoice::Bvh),
     ] {
         let start = Instant::now();
         let g = Geometry::build_with(&cornell_tris, vec![], choice);

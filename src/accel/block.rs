@@ -271,4 +271,3 @@ pub fn block_hits(block: &Block, axes: &Axes, t_max: f32) -> Option<BlockHits> {
         ambiguous,
     })
 }
-

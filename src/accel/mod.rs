@@ -251,7 +251,9 @@ impl Geometry {
                 Some((bvh, order)) => {
                     for i in order {
                         geometry.tri_vertices.push(triangles[i].vertices);
-                        geometry.tri_shading.push(TriangleShading::new(&triangles[i]));
+                        geometry
+                            .tri_shading
+                            .push(TriangleShading::new(&triangles[i]));
                     }
                     geometry.tri_index = TriangleIndex::Bvh(bvh);
                 }

@@ -20,6 +20,9 @@ const STACK_SIZE: usize = 128;
 /// Deepest tree the stack can hold.
 const MAX_DEPTH: usize = (STACK_SIZE - 1) / (LANES - 1);
 
+/// Largest subtree made into one leaf block.
+const LEAF_MAX: usize = LANES;
+
 /// A child reference: a node index, or a leaf block index with the top bit set.
 const LEAF_BIT: u32 = 1 << 31;
 
@@ -93,8 +96,13 @@ impl WideBvh {
                 continue;
             }
             if child & LEAF_BIT != 0 {
-                self.leaves[(child & !LEAF_BIT) as usize]
-                    .closest(&axes, ray, triangles, &mut best_t, &mut best);
+                self.leaves[(child & !LEAF_BIT) as usize].closest(
+                    &axes,
+                    ray,
+                    triangles,
+                    &mut best_t,
+                    &mut best,
+                );
                 continue;
             }
             let node = &self.nodes[child as usize];
@@ -188,7 +196,7 @@ impl Builder<'_> {
         if node.is_leaf() && node.prim_count as usize > LANES {
             return self.split_leaf(index);
         }
-        if self.prim_count(index) <= LANES {
+        if self.prim_count(index) <= LEAF_MAX {
             let mut prims = Vec::with_capacity(LANES);
             self.gather(index, &mut prims);
             let first = self.order.len();
@@ -203,7 +211,7 @@ impl Builder<'_> {
                 .iter()
                 .enumerate()
                 .filter(|&(_, &c)| {
-                    !self.bvh2.nodes[c as usize].is_leaf() && self.prim_count(c) > LANES
+                    !self.bvh2.nodes[c as usize].is_leaf() && self.prim_count(c) > LEAF_MAX
                 })
                 .max_by(|a, b| {
                     let area = |c: u32| self.bvh2.nodes[c as usize].aabb().half_area();
@@ -320,7 +328,11 @@ mod tests {
         let (bvh, order) = build_wide_bvh(input).expect("shallow tree");
         let mut sorted = order.clone();
         sorted.sort_unstable();
-        assert_eq!(sorted, (0..input.len()).collect::<Vec<_>>(), "a permutation");
+        assert_eq!(
+            sorted,
+            (0..input.len()).collect::<Vec<_>>(),
+            "a permutation"
+        );
         let triangles: Vec<[Vec3A; 3]> = order.iter().map(|&i| input[i]).collect();
         let mut hits = 0;
         for (i, ray) in rays.enumerate() {
