@@ -146,6 +146,8 @@ pub struct Axes {
     /// Unpermuted origin and reciprocal direction, for slab tests.
     box_origin: [f32x8; 3],
     inv_direction: [f32x8; 3],
+    /// Some direction component is zero (its reciprocal infinite).
+    zero_direction: bool,
 }
 
 impl Axes {
@@ -168,6 +170,7 @@ impl Axes {
             sz: f32x8::splat(1.0 / d[kz]),
             box_origin: [0, 1, 2].map(|axis| f32x8::splat(o[axis])),
             inv_direction: [0, 1, 2].map(|axis| f32x8::splat(1.0 / d[axis])),
+            zero_direction: d.cmpeq(Vec3A::ZERO).any(),
         }
     }
 
@@ -185,9 +188,17 @@ impl Axes {
         for axis in 0..3 {
             let t0 = (boxes.min[axis] - self.box_origin[axis]) * self.inv_direction[axis];
             let t1 = (boxes.max[axis] - self.box_origin[axis]) * self.inv_direction[axis];
-            let nan = t0.simd_ne(t0) | t1.simd_ne(t1);
-            t_near = nan.select(t_near, t_near.fast_max(t0.fast_min(t1)));
-            t_far = nan.select(t_far, t_far.fast_min(t0.fast_max(t1) * widen));
+            let near = t_near.fast_max(t0.fast_min(t1));
+            let far = t_far.fast_min(t0.fast_max(t1) * widen);
+            // NaN needs an infinite reciprocal: only rays with a zero
+            // direction component pay for the check (a predictable branch).
+            if self.zero_direction {
+                let nan = t0.simd_ne(t0) | t1.simd_ne(t1);
+                t_near = nan.select(t_near, near);
+                t_far = nan.select(t_far, far);
+            } else {
+                (t_near, t_far) = (near, far);
+            }
         }
         let reached = t_near.simd_le(t_far).to_bitmask() & boxes.lanes;
         (reached, t_near.to_array())
