@@ -166,20 +166,6 @@ fn cuboid(min: Vec3A, max: Vec3A, material: u32) -> Vec<TriangleInput> {
         .collect()
 }
 
-/// A quad `corner + s u + t v` as two triangles.
-fn quad(corner: Vec3A, u: Vec3A, v: Vec3A, material: u32) -> [TriangleInput; 2] {
-    [
-        TriangleInput {
-            vertices: [corner, corner + u, corner + u + v],
-            material,
-        },
-        TriangleInput {
-            vertices: [corner, corner + u + v, corner + v],
-            material,
-        },
-    ]
-}
-
 impl StressSuite {
     /// The cases, built from the scenes in `scenes_dir` (the Cornell box and
     /// the glass-ball caustic scene).
@@ -246,9 +232,12 @@ impl StressSuite {
         slab.triangles
             .extend(cuboid(lo - Vec3A::Y * 5e-4, hi + Vec3A::Y * 5e-4, white));
         let mut sheet = cornell.clone();
-        sheet
-            .triangles
-            .extend(quad(lo, Vec3A::Z * 200.0, Vec3A::X * 200.0, white));
+        sheet.triangles.extend(TriangleInput::quad(
+            lo,
+            Vec3A::Z * 200.0,
+            Vec3A::X * 200.0,
+            white,
+        ));
         references.push(("cornell box with a sheet".into(), Scene::build(sheet)?));
         add("thin slab (1e-3 thick)".into(), slab, references.len() - 1)?;
 

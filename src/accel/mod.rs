@@ -45,6 +45,23 @@ pub struct TriangleInput {
     pub material: u32,
 }
 
+impl TriangleInput {
+    /// The parallelogram `corner + a u + b v`, a, b in [0, 1], as two
+    /// triangles wound like (u, v): the quads of scene files and test scenes.
+    pub fn quad(corner: Vec3A, u: Vec3A, v: Vec3A, material: u32) -> [TriangleInput; 2] {
+        [
+            TriangleInput {
+                vertices: [corner, corner + u, corner + u + v],
+                material,
+            },
+            TriangleInput {
+                vertices: [corner, corner + u + v, corner + v],
+                material,
+            },
+        ]
+    }
+}
+
 /// What a closest-hit query found.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceHit {

@@ -168,16 +168,7 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
                 ),
             ));
         }
-        let halves = [
-            TriangleInput {
-                vertices: [c, c + u, c + u + v],
-                material,
-            },
-            TriangleInput {
-                vertices: [c, c + u + v, c + v],
-                material,
-            },
-        ];
+        let halves = TriangleInput::quad(c, u, v, material);
         let emissive = materials[material as usize].is_emissive();
         match motion_of(q.velocity, quad.span(), emissive)? {
             Some(velocity) => moving.push(MovingInput {
