@@ -13,7 +13,7 @@ mod shared;
 
 use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
-use shared::uv_sphere;
+use shared::{coherent_rays, uv_sphere};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -80,23 +80,6 @@ fn incoherent_rays(count: u64, radius: f32, center: Vec3A, spread: f32) -> Vec<R
         .collect()
 }
 
-/// Primary-ray-like rays: one origin at distance 3, directions through a
-/// square grid covering the unit sphere, in scanline order.
-fn coherent_rays(side: u64) -> Vec<Ray> {
-    let origin = Vec3A::new(0.0, 0.0, 3.0);
-    (0..side * side)
-        .map(|i| {
-            let (x, y) = (
-                (i % side) as f32 / side as f32,
-                (i / side) as f32 / side as f32,
-            );
-            let target = Vec3A::new(2.2 * x - 1.1, 1.1 - 2.2 * y, 0.0);
-            Ray::new(origin, (target - origin).normalize())
-        })
-        .collect()
-}
-
-/// Rays per second of `trace` over `rays` with `threads` threads (median of 3).
 fn rays_per_second(rays: &[Ray], threads: usize, trace: impl Fn(&Ray) -> bool + Sync) -> f64 {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
