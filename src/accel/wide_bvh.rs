@@ -5,8 +5,9 @@
 //! The tree comes from obvhs's binary BVH (PLOC and reinsertion); it is
 //! collapsed here because obvhs's own 8-wide layout (CWBVH, Ylitie et al.
 //! 2017) is made for GPUs: quantised child boxes decoded per node and leaves
-//! of at most three triangles tested one at a time. Measured with `cargo bench
-//! --bench scaling` (see the commit that added this file).
+//! of at most three triangles tested one at a time. `cargo bench --bench
+//! micro -- rays_100k`, one thread: incoherent closest hit 1.55 -> 2.70 M
+//! rays/s, any hit 2.56 -> 4.32 M against obvhs's CWBVH traversal.
 
 use super::block::{Axes, Block, Boxes8, LANES, TriangleHit};
 use crate::math::Ray;
