@@ -183,7 +183,7 @@ impl Axes {
         }
     }
 
-    /// Slab test against eight boxes (pbrt-v4 6.8.7): the lanes of `valid`
+    /// Slab test against eight boxes (pbrt-v4 6.8.7): the lanes of `boxes`
     /// whose box the ray enters in [0, t_max], and the entry distances. The
     /// exit distance is enlarged by 1 + 2 gamma(3), which makes the test
     /// conservative under rounding. A slab giving 0 x inf = NaN (a direction
