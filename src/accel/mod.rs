@@ -243,6 +243,7 @@ fn build_shallow_cwbvh(aabbs: &[Aabb]) -> Option<CwBvh> {
     let bvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
     (bvh.nodes.is_empty() || cwbvh_depth(&bvh, 0) < CWBVH_STACK_DEPTH).then_some(bvh)
 }
+
 impl Geometry {
     /// Builds the BVHs and stores the triangles in leaf order.
     pub fn build(triangles: &[TriangleInput], spheres: Vec<Sphere>) -> Self {
@@ -267,12 +268,7 @@ impl Geometry {
             let vertices: Vec<[Vec3A; 3]> = triangles.iter().map(|t| t.vertices).collect();
             match build_wide_bvh(&vertices) {
                 Some((bvh, order)) => {
-                    for i in order {
-                        geometry.tri_vertices.push(triangles[i].vertices);
-                        geometry
-                            .tri_shading
-                            .push(TriangleShading::new(&triangles[i]));
-                    }
+                    geometry.store_in_order(triangles, order);
                     geometry.tri_index = TriangleIndex::Bvh(bvh);
                 }
                 None => {
@@ -312,12 +308,21 @@ impl Geometry {
         geometry
     }
 
+    /// Stores `triangles[i]` for each i of `order`: the order hit indices refer to.
+    fn store_in_order(
+        &mut self,
+        triangles: &[TriangleInput],
+        order: impl IntoIterator<Item = usize>,
+    ) {
+        for i in order {
+            self.tri_vertices.push(triangles[i].vertices);
+            self.tri_shading.push(TriangleShading::new(&triangles[i]));
+        }
+    }
+
     /// Stores the triangles in input order and tests them all, as a soup.
     fn store_soup(&mut self, triangles: &[TriangleInput]) {
-        for t in triangles {
-            self.tri_vertices.push(t.vertices);
-            self.tri_shading.push(TriangleShading::new(t));
-        }
+        self.store_in_order(triangles, 0..triangles.len());
         self.tri_index = TriangleIndex::Soup(TriangleSoup::new(&self.tri_vertices));
     }
 
