@@ -253,9 +253,14 @@ impl Sampler {
     }
 
     #[inline]
-    fn next_hash(&mut self) -> (u64, u32) {
-        let dim = self.dimension;
+    fn next_dimension(&mut self) -> u32 {
         self.dimension += 1;
+        self.dimension - 1
+    }
+
+    #[inline]
+    fn next_hash(&mut self) -> (u64, u32) {
+        let dim = self.next_dimension();
         (hash_combine(self.sample_key, dim as u64), dim)
     }
 
@@ -269,26 +274,34 @@ impl Sampler {
     /// One number in [0, 1).
     #[inline]
     pub fn next_1d(&mut self) -> f32 {
+        if self.kind == SamplerKind::Sobol {
+            let dim = self.next_dimension();
+            let key = hash_combine(self.pixel_key, dim as u64);
+            let index = nested_uniform_scramble(self.sample_index, key as u32);
+            return bits_to_unit_float(sobol_dimension_0(index, (key >> 32) as u32));
+        }
         let (h, dim) = self.next_hash();
         let u = to_unit_float(h);
         match self.kind {
-            SamplerKind::Independent => u,
             SamplerKind::Stratified | SamplerKind::MultiJittered => {
                 let s = self.stratum(dim);
                 ((s as f32 + u) / self.batch as f32).min(ONE_MINUS_EPSILON)
             }
-            SamplerKind::Sobol => {
-                let key = hash_combine(self.pixel_key, dim as u64);
-                let index = nested_uniform_scramble(self.sample_index, key as u32);
-                let x = nested_uniform_scramble(index.reverse_bits(), (key >> 32) as u32);
-                bits_to_unit_float(x)
-            }
+            _ => u,
         }
     }
 
     /// Two numbers in [0, 1)², stratified together as a pair.
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
+        if self.kind == SamplerKind::Sobol {
+            let dim = self.next_dimension();
+            let key = hash_combine(self.pixel_key, dim as u64);
+            let index = nested_uniform_scramble(self.sample_index, key as u32);
+            let x = sobol_dimension_0(index, (key >> 32) as u32);
+            let y = sobol_dimension_1(index, mix64(key) as u32);
+            return Vec2::new(bits_to_unit_float(x), bits_to_unit_float(y));
+        }
         let (h, dim) = self.next_hash();
         let u = to_unit_float(h);
         let v = to_unit_float(h << 24);
@@ -310,14 +323,7 @@ impl Sampler {
                     ((cy as f32 + (sx as f32 + v) / m as f32) / n as f32).min(ONE_MINUS_EPSILON),
                 )
             }
-            SamplerKind::Sobol => {
-                let key = hash_combine(self.pixel_key, dim as u64);
-                let index = nested_uniform_scramble(self.sample_index, key as u32);
-                let x = nested_uniform_scramble(index.reverse_bits(), (key >> 32) as u32);
-                let y = nested_uniform_scramble(sobol_dimension_1(index), mix64(key) as u32);
-                Vec2::new(bits_to_unit_float(x), bits_to_unit_float(y))
-            }
-            SamplerKind::Stratified => {
+            SamplerKind::Stratified | SamplerKind::Sobol => {
                 let s = self.stratum(dim);
                 let (sx, sy) = (s % self.grid_x, s / self.grid_x);
                 Vec2::new(
@@ -338,21 +344,36 @@ fn bits_to_unit_float(x: u32) -> f32 {
     (x >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
-/// The second dimension of the Sobol sequence (as bits of a fraction): its
-/// generator matrix is Pascal's triangle mod 2, whose columns follow
-/// v_0 = 2^31, v_{k+1} = v_k ^ (v_k >> 1).
+/// Point `index` of the first Sobol dimension (the van der Corput sequence:
+/// the index's bits mirrored into a fraction), Owen-scrambled with `seed`.
+/// Mirroring and the scramble's own two mirrors cancel down to one.
 #[inline]
-fn sobol_dimension_1(mut index: u32) -> u32 {
-    let mut v = 1u32 << 31;
-    let mut x = 0;
-    while index != 0 {
-        if index & 1 != 0 {
-            x ^= v;
-        }
-        index >>= 1;
-        v ^= v >> 1;
-    }
-    x
+fn sobol_dimension_0(index: u32, seed: u32) -> u32 {
+    laine_karras(index, seed).reverse_bits()
+}
+
+/// Point `index` of the second Sobol dimension, Owen-scrambled with `seed`.
+/// Its generator matrix is Pascal's triangle mod 2: fraction digit j is the
+/// XOR of the index bits k with C(k, j) odd, that is (Lucas) of the bits k
+/// whose binary digits include j's. That superset sum takes five shift-XOR
+/// steps, one per bit of a digit position, instead of a loop over the 32
+/// bits of a scrambled index with a data-dependent branch each (which cost
+/// a third of the render time: 2.0 against 3.0 M paths/s independent).
+#[inline]
+fn sobol_dimension_1(index: u32, seed: u32) -> u32 {
+    laine_karras(pascal_superset_xor(index), seed).reverse_bits()
+}
+
+/// Digit j (bit j, unmirrored) of Sobol's second dimension at `index`: the
+/// XOR of the index bits k whose binary digits include j's.
+#[inline]
+fn pascal_superset_xor(mut b: u32) -> u32 {
+    b ^= (b >> 1) & 0x5555_5555;
+    b ^= (b >> 2) & 0x3333_3333;
+    b ^= (b >> 4) & 0x0f0f_0f0f;
+    b ^= (b >> 8) & 0x00ff_00ff;
+    b ^= (b >> 16) & 0x0000_ffff;
+    b
 }
 
 /// Laine-Karras hash: a random permutation of a 32-bit word in which each
@@ -379,6 +400,38 @@ fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Sobol's second dimension from its generator matrix's columns
+    /// (v_0 = 2^31, v_{k+1} = v_k ^ (v_k >> 1)), one index bit at a time.
+    fn sobol_dimension_1_by_columns(mut index: u32) -> u32 {
+        let mut v = 1u32 << 31;
+        let mut x = 0;
+        while index != 0 {
+            if index & 1 != 0 {
+                x ^= v;
+            }
+            index >>= 1;
+            v ^= v >> 1;
+        }
+        x
+    }
+
+    #[test]
+    fn sobol_dimension_1_matches_its_generator_matrix() {
+        let mut index = 1u32;
+        for i in 0..20_000 {
+            index = if i < 4096 {
+                i
+            } else {
+                index.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15)
+            };
+            assert_eq!(
+                pascal_superset_xor(index).reverse_bits(),
+                sobol_dimension_1_by_columns(index),
+                "{index:#x}"
+            );
+        }
+    }
 
     #[test]
     fn same_coordinates_give_same_numbers() {
