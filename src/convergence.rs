@@ -5,7 +5,7 @@
 use crate::error::{Error, Result};
 use crate::image::{ErrorMetrics, Image};
 use crate::integrator::{IntegratorKind, IntegratorOptions, Strategy};
-use crate::render::{RenderSettings, Session};
+use crate::render::{Adaptive, RenderSettings, Session};
 use crate::sampling::{Domains, SamplerKind};
 use crate::scene::Scene;
 use crate::scene::light::LightSampling;
@@ -20,6 +20,8 @@ pub struct BenchConfig {
     pub sampler: SamplerKind,
     pub light_sampling: Option<LightSampling>,
     pub domains: Domains,
+    /// Adaptive sampling by noise after this many uniform spp (`distribute=N`).
+    pub distribute: Option<u32>,
 }
 
 impl BenchConfig {
@@ -55,6 +57,7 @@ impl BenchConfig {
         };
         let mut light_sampling = None;
         let mut domains = Domains::ALL;
+        let mut distribute = None;
         for option in parts {
             let (key, value) = option
                 .split_once('=')
@@ -90,6 +93,7 @@ impl BenchConfig {
                     })
                 }
                 "domains" => domains = Domains::parse(value, '+').map_err(err)?,
+                "distribute" => distribute = Some(number()?.max(1)),
                 _ => return Err(err(format!("unknown option `{key}`"))),
             }
         }
@@ -99,6 +103,7 @@ impl BenchConfig {
             sampler,
             light_sampling,
             domains,
+            distribute,
         })
     }
 }
@@ -194,7 +199,9 @@ pub fn measure(
             seed,
             planned_spp: spp,
             threads,
-            adaptive: None,
+            adaptive: config
+                .distribute
+                .map(|warmup_spp| Adaptive::Distribute { warmup_spp }),
             domains: config.domains,
             clamp: None,
         };
@@ -203,7 +210,13 @@ pub fn measure(
         let cpu_start = cpu_time::ProcessTime::try_now().ok();
         let mut done = 0;
         while done < spp {
-            let k = (spp - done).min(64);
+            // Distributing re-plans after every pass: let passes double.
+            let pass = if config.distribute.is_some() {
+                done.max(1)
+            } else {
+                spp
+            };
+            let k = (spp - done).min(pass).min(64);
             session.render_pass(k);
             done += k;
         }

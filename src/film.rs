@@ -6,6 +6,7 @@
 //! at most for one tile. The reconstruction filter is a box of one pixel:
 //! a pixel is the plain mean of the samples taken inside it (Mitsuba's `box`).
 
+use crate::allocation::PixelNoise;
 use crate::image::Image;
 use crate::math::Rgb;
 use std::sync::Mutex;
@@ -87,6 +88,25 @@ impl PixelSums {
             self.sum_sq[c] += value[c] * value[c] * weight;
         }
         self.count += n;
+    }
+
+    /// Samples taken, finite or not: the index of the pixel's next sample.
+    #[inline]
+    pub fn taken(&self) -> u32 {
+        self.count + self.non_finite
+    }
+
+    /// Unbiased per-sample variance, mean over the channels (0 with fewer
+    /// than two samples).
+    pub fn variance(&self) -> f64 {
+        if self.count < 2 {
+            return 0.0;
+        }
+        let n = f64::from(self.count);
+        (0..3)
+            .map(|c| ((self.sum_sq[c] - self.sum[c] * self.sum[c] / n) / (n - 1.0)).max(0.0))
+            .sum::<f64>()
+            / 3.0
     }
 
     /// Mean of the samples (zero without samples).
@@ -214,6 +234,23 @@ impl Film {
     /// The tiles, for passes to fill in parallel.
     pub fn tiles(&self) -> &[Mutex<Tile>] {
         &self.tiles
+    }
+
+    /// Samples taken and per-sample variance of every pixel, row-major: what
+    /// [`crate::allocation::plan`] needs.
+    pub fn noise(&self) -> Vec<PixelNoise> {
+        let mut out = vec![PixelNoise::default(); (self.width * self.height) as usize];
+        for tile in &self.tiles {
+            let tile = tile.lock().unwrap_or_else(|e| e.into_inner());
+            for (i, p) in tile.pixels.iter().enumerate() {
+                let (tx, ty) = (i as u32 % tile.width, i as u32 / tile.width);
+                out[((tile.y0 + ty) * self.width + tile.x0 + tx) as usize] = PixelNoise {
+                    taken: p.taken(),
+                    variance: p.variance(),
+                };
+            }
+        }
+        out
     }
 
     /// Copies the current means, standard errors and counts.

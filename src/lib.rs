@@ -6,6 +6,7 @@
 //! Only `viewer` (behind the default `viewer` feature) imports egui.
 
 pub mod accel;
+pub mod allocation;
 pub mod convergence;
 pub mod error;
 pub mod film;

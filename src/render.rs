@@ -11,12 +11,13 @@ use crate::error::{Error, Result};
 use crate::film::{Film, FilmSnapshot};
 use crate::integrator::{Integrator, LightTracer, RayCounts, sample_time};
 use crate::math::{Ray, Rgb};
+use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Domains, Sampler, SamplerKind};
 use crate::scene::Scene;
 use glam::Vec2;
 use rayon::prelude::*;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// How to render.
@@ -39,20 +40,27 @@ pub struct RenderSettings {
     pub clamp: Option<f32>,
 }
 
-/// Adaptive sampling: a pixel with at least `min_spp` samples whose relative
-/// standard error (luminance) is below `threshold` gets no further samples.
-/// It trades a little bias for time: the error estimate of a few samples is
-/// itself noisy, and pixels that look converged by chance stop early.
+/// Adaptive sampling: samples go where the noise is rather than evenly.
+/// Both modes trade a little bias for time: a pixel's later sample count
+/// depends on its earlier samples, whose error estimate is itself noisy.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Adaptive {
-    pub threshold: f32,
-    pub min_spp: u32,
+pub enum Adaptive {
+    /// A pixel with at least `min_spp` samples whose relative standard error
+    /// (luminance) is below `threshold` gets no further samples: for
+    /// relative noise (dark regions), and it saves time, not RMSE.
+    Stop { threshold: f32, min_spp: u32 },
+    /// After `warmup_spp` samples everywhere, each pass spreads its samples
+    /// (spp x pixels in all) over the pixels in proportion to their noise
+    /// ([`crate::allocation`]): minimises the RMSE for the time spent.
+    /// [`RenderStats::spp`] is then the mean count.
+    Distribute { warmup_spp: u32 },
 }
 
 /// Counters of a session so far.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RenderStats {
-    /// Samples per pixel completed (every pixel has this many).
+    /// Samples per pixel completed (every pixel has this many; with
+    /// [`Adaptive`] sampling, the mean over pixels of what passes planned).
     pub spp: u32,
     /// Camera samples taken (= camera paths).
     pub samples: u64,
@@ -86,6 +94,9 @@ pub struct Session {
     skipped: AtomicU64,
     render_nanos: AtomicU64,
     cancelled: AtomicBool,
+    /// Samples per pixel of the pass in progress under
+    /// [`Adaptive::Distribute`], made by its part 0 for all its parts.
+    pass_plan: Mutex<Option<Arc<Vec<u32>>>>,
 }
 
 impl Session {
@@ -119,6 +130,7 @@ impl Session {
             skipped: AtomicU64::new(0),
             render_nanos: AtomicU64::new(0),
             cancelled: AtomicBool::new(false),
+            pass_plan: Mutex::new(None),
         }
     }
 
@@ -161,7 +173,8 @@ impl Session {
                 self.light_pass(&tracer, first, spp);
             }
         } else {
-            self.camera_pass(first, spp, part, parts);
+            let plan = self.pass_plan(first, spp, part);
+            self.camera_pass(first, spp, plan.as_deref().map(Vec::as_slice), part, parts);
         }
         self.render_nanos
             .fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
@@ -178,9 +191,35 @@ impl Session {
         true
     }
 
-    /// Camera-driven estimators: samples `first..first + spp` of every pixel
-    /// of the tiles in part `part` of `parts`.
-    fn camera_pass(&self, first: u32, spp: u32, part: u32, parts: u32) {
+    /// Per-pixel sample counts for the pass of `spp` that starts at `first`
+    /// spp, under [`Adaptive::Distribute`] once the warm-up is done; made by
+    /// part 0 and shared by the other parts of the pass.
+    fn pass_plan(&self, first: u32, spp: u32, part: u32) -> Option<Arc<Vec<u32>>> {
+        let Some(Adaptive::Distribute { warmup_spp }) = self.settings.adaptive else {
+            return None;
+        };
+        let mut shared = self.pass_plan.lock().unwrap_or_else(|e| e.into_inner());
+        if part == 0 {
+            *shared = (first >= warmup_spp).then(|| {
+                let budget = u64::from(spp) * u64::from(self.film.width() * self.film.height());
+                let key = hash_combine(self.settings.seed, u64::from(first));
+                Arc::new(crate::allocation::plan(
+                    &self.film.noise(),
+                    self.film.width(),
+                    self.film.height(),
+                    budget,
+                    key,
+                ))
+            });
+        }
+        shared.clone()
+    }
+
+    /// Camera-driven estimators: `spp` samples (or `plan`'s count) more for
+    /// every pixel of the tiles in part `part` of `parts`. Samples are
+    /// numbered from `first`, or under [`Adaptive::Distribute`] from the
+    /// pixel's own count.
+    fn camera_pass(&self, first: u32, spp: u32, plan: Option<&[u32]>, part: u32, parts: u32) {
         let scene = &*self.scene;
         let settings = &self.settings;
         let deterministic = settings.integrator.is_deterministic();
@@ -207,14 +246,20 @@ impl Session {
                     for (i, pixel) in tile.pixels.iter_mut().enumerate() {
                         let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
                         let pixel_index = y * width + x;
-                        if let Some(a) = settings.adaptive
-                            && pixel.count >= a.min_spp
-                            && pixel.relative_standard_error() < a.threshold
-                        {
-                            skipped += u64::from(spp);
-                            continue;
-                        }
-                        for s in first..first + spp {
+                        let (begin, count) = match settings.adaptive {
+                            Some(Adaptive::Stop { threshold, min_spp })
+                                if pixel.count >= min_spp
+                                    && pixel.relative_standard_error() < threshold =>
+                            {
+                                skipped += u64::from(spp);
+                                continue;
+                            }
+                            Some(Adaptive::Distribute { .. }) => {
+                                (pixel.taken(), plan.map_or(spp, |p| p[pixel_index as usize]))
+                            }
+                            _ => (first, spp),
+                        };
+                        for s in begin..begin + count {
                             sampler.start(pixel_index, s);
                             let ray = camera_ray(scene, &mut sampler, x, y, deterministic, general);
                             counts.camera += 1;
@@ -348,7 +393,12 @@ pub fn camera_ray(
     general: bool,
 ) -> Ray {
     let mut film_point = Vec2::new(x as f32, y as f32) + sampler.next_2d_for(Domain::Pixel);
-    let mut lens = sampler.next_2d_for(Domain::Lens);
+    let lens_dim = sampler.skip();
+    let mut lens = if scene.camera.aperture_radius > 0.0 {
+        sampler.get_2d_for(lens_dim, Domain::Lens)
+    } else {
+        Vec2::splat(0.5)
+    };
     let mut time = sample_time(scene, sampler, general);
     if deterministic {
         film_point = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);

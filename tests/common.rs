@@ -5,7 +5,7 @@ use std::sync::Arc;
 use tracelab::film::FilmSnapshot;
 use tracelab::image::Image;
 use tracelab::integrator::Integrator;
-use tracelab::render::{RenderSettings, RenderStats, Session};
+use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
 use tracelab::sampling::SamplerKind;
 use tracelab::scene::Scene;
 
@@ -34,13 +34,28 @@ pub fn render_with(
     threads: usize,
     pass: u32,
 ) -> (FilmSnapshot, RenderStats) {
+    render_adaptive(integrator, sampler, None, scene, spp, seed, threads, pass)
+}
+
+/// [`render_with`] with adaptive sampling.
+#[allow(clippy::too_many_arguments)]
+pub fn render_adaptive(
+    integrator: Integrator,
+    sampler: SamplerKind,
+    adaptive: Option<Adaptive>,
+    scene: Scene,
+    spp: u32,
+    seed: u64,
+    threads: usize,
+    pass: u32,
+) -> (FilmSnapshot, RenderStats) {
     let settings = RenderSettings {
         integrator,
         sampler,
         seed,
         planned_spp: spp,
         threads,
-        adaptive: None,
+        adaptive,
         domains: Default::default(),
         clamp: None,
     };

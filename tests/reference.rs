@@ -13,8 +13,9 @@
 //! ray tracing without branching, and light tracing (rendered in 1-spp passes,
 //! for which its film's standard error is exact).
 
-use crate::common::{cornell_box, mean_and_standard_error, reference, render_with};
+use crate::common::{cornell_box, mean_and_standard_error, reference, render_adaptive};
 use tracelab::integrator::{IntegratorKind, IntegratorOptions, Strategy};
+use tracelab::render::Adaptive;
 use tracelab::sampling::SamplerKind;
 
 fn options(kind: IntegratorKind, max_depth: u32) -> IntegratorOptions {
@@ -26,15 +27,26 @@ fn options(kind: IntegratorKind, max_depth: u32) -> IntegratorOptions {
 }
 
 fn check_against_reference(options: IntegratorOptions, reference_name: &str, variance_name: &str) {
+    check_adaptive_against_reference(options, None, reference_name, variance_name);
+}
+
+/// Checks a 64-spp render (mean spp when adaptive); returns its RMSE.
+fn check_adaptive_against_reference(
+    options: IntegratorOptions,
+    adaptive: Option<Adaptive>,
+    reference_name: &str,
+    variance_name: &str,
+) -> f64 {
     let pass = if options.kind == IntegratorKind::Light {
         1
     } else {
         8
     };
-    let (snapshot, stats) = render_with(
-        cornell_box(),
+    let (snapshot, stats) = render_adaptive(
         options.build(),
         SamplerKind::Independent,
+        adaptive,
+        cornell_box(),
         64,
         1,
         0,
@@ -77,6 +89,7 @@ fn check_against_reference(options: IntegratorOptions, reference_name: &str, var
             ref_mean[c]
         );
     }
+    measured
 }
 
 #[test]
@@ -130,5 +143,32 @@ fn light_tracing_matches_mitsuba_on_the_cornell_box() {
         options(IntegratorKind::Light, 8),
         "cornell_box_path_ref.exr",
         "cornell_box_path_ref_var.exr",
+    );
+}
+
+/// Samples spread by noise (after 8 spp everywhere) pass the same test: the
+/// per-pixel standard errors follow each pixel's own count, so a bias from
+/// the allocation (a pixel's count depending on its own samples) would show
+/// as excess RMSE or a shifted mean. And the RMSE must fall well below the
+/// uniform render's of the same total: Neyman allocation on this scene cuts
+/// independent sampling's MSE about sixfold (the light's edge pixels carry
+/// most of it), so a 1.5x smaller RMSE is a margin no noise reaches.
+#[test]
+fn path_tracing_with_samples_spread_by_noise_matches_mitsuba_with_less_error() {
+    let uniform = check_adaptive_against_reference(
+        options(IntegratorKind::Path, 8),
+        None,
+        "cornell_box_path_ref.exr",
+        "cornell_box_path_ref_var.exr",
+    );
+    let spread = check_adaptive_against_reference(
+        options(IntegratorKind::Path, 8),
+        Some(Adaptive::Distribute { warmup_spp: 8 }),
+        "cornell_box_path_ref.exr",
+        "cornell_box_path_ref_var.exr",
+    );
+    assert!(
+        spread * 1.5 < uniform,
+        "RMSE spread by noise {spread:.5}, uniform {uniform:.5}"
     );
 }

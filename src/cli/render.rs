@@ -143,6 +143,11 @@ pub struct RenderArgs {
     /// Samples every pixel takes before adaptive sampling may stop it.
     #[arg(long, default_value_t = 16)]
     adaptive_min_spp: u32,
+    /// Adaptive sampling for the least RMSE per time: after N samples in
+    /// every pixel, each pass spends its samples (spp x pixels) where the
+    /// per-pixel noise is; --spp is then the mean over pixels.
+    #[arg(long, value_name = "N", conflicts_with = "adaptive")]
+    distribute: Option<u32>,
     /// Exposure in stops for PNG output.
     #[arg(long, default_value_t = 0.0)]
     exposure: f32,
@@ -290,10 +295,16 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         seed: args.seed,
         planned_spp: target_spp.unwrap_or(0),
         threads: args.threads,
-        adaptive: args.adaptive.map(|threshold| Adaptive {
-            threshold,
-            min_spp: args.adaptive_min_spp.max(2),
-        }),
+        adaptive: match (args.adaptive, args.distribute) {
+            (Some(threshold), _) => Some(Adaptive::Stop {
+                threshold,
+                min_spp: args.adaptive_min_spp.max(2),
+            }),
+            (None, Some(warmup)) => Some(Adaptive::Distribute {
+                warmup_spp: warmup.max(2),
+            }),
+            (None, None) => None,
+        },
         domains: args.domains.unwrap_or_default(),
         clamp: args.clamp,
     };
@@ -540,15 +551,25 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
             eprintln!("specialised for this scene: skipped {}", skipped.join(", "));
         }
     }
-    if let Some(a) = settings.adaptive {
-        let planned = stats.samples + stats.skipped;
-        eprintln!(
-            "adaptive sampling (biased): {:.1}% of {} planned samples skipped (relative error < {}, after {} spp)",
-            100.0 * stats.skipped as f64 / planned.max(1) as f64,
-            planned,
-            a.threshold,
-            a.min_spp
-        );
+    match settings.adaptive {
+        Some(Adaptive::Stop { threshold, min_spp }) => {
+            let planned = stats.samples + stats.skipped;
+            eprintln!(
+                "adaptive sampling (biased): {:.1}% of {} planned samples skipped (relative error < {threshold}, after {min_spp} spp)",
+                100.0 * stats.skipped as f64 / planned.max(1) as f64,
+                planned,
+            );
+        }
+        Some(Adaptive::Distribute { warmup_spp }) => {
+            let counts = &session.snapshot().samples;
+            let (min, max) = (counts.iter().min(), counts.iter().max());
+            eprintln!(
+                "adaptive sampling (slightly biased): samples spread by noise after {warmup_spp} spp; per pixel {} to {}",
+                min.unwrap_or(&0),
+                max.unwrap_or(&0)
+            );
+        }
+        None => {}
     }
     if let Some(limit) = settings.clamp {
         eprintln!(

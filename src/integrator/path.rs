@@ -186,11 +186,17 @@ impl PathTracer {
             let wo = frame.to_local(wo_world);
             // Every vertex consumes the same dimensions, so that stratified
             // samplers keep dimensions aligned across samples.
+            // The lobe and roulette numbers are computed only when used.
             let u_light_select = sampler.next_1d_for(Domain::Light);
             let u_light = sampler.next_2d_for(Domain::Light);
-            let u_lobe = sampler.next_1d_for(Domain::Bsdf);
+            let lobe_dim = sampler.skip();
+            let u_lobe = if matches!(bsdf, Bsdf::Diffuse { .. }) {
+                0.0
+            } else {
+                sampler.get_1d_for(lobe_dim, Domain::Bsdf)
+            };
             let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
-            let u_roulette = sampler.next_1d();
+            let roulette_dim = sampler.skip();
 
             if self.nee && !(SPECULAR && bsdf.is_specular()) {
                 if let Some(ls) = scene.lights.sample(hit.point, u_light_select, u_light) {
@@ -227,6 +233,7 @@ impl PathTracer {
 
             if self.russian_roulette && bounces > self.rr_depth {
                 let q = beta.max_element().min(0.95);
+                let u_roulette = sampler.get_1d_for(roulette_dim, Domain::Other);
                 let survived = survives_roulette(&mut beta, u_roulette);
                 observer.roulette(q, survived);
                 if !survived {

@@ -210,20 +210,45 @@ impl Sampler {
     /// is selected, independent otherwise. Consumes one dimension either way.
     #[inline]
     pub fn next_1d_for(&mut self, domain: Domain) -> f32 {
+        let dim = self.skip();
+        self.get_1d_for(dim, domain)
+    }
+
+    /// Consumes a dimension without computing its numbers, for a request a
+    /// path makes only sometimes (Russian roulette, a lobe choice, a lens
+    /// point): later requests keep their dimensions either way, and the
+    /// numbers are computed, by [`Sampler::get_1d_for`], only when needed.
+    #[inline]
+    pub fn skip(&mut self) -> u32 {
+        self.dimension += 1;
+        self.dimension - 1
+    }
+
+    /// The number of dimension `dim` (one [`Sampler::skip`] returned) of
+    /// the current sample: what [`Sampler::next_1d_for`] would have drawn.
+    #[inline]
+    pub fn get_1d_for(&self, dim: u32, domain: Domain) -> f32 {
         if self.domains.contains(domain) {
-            self.next_1d()
+            self.get_1d(dim)
         } else {
-            to_unit_float(self.next_hash().0)
+            to_unit_float(self.hash(dim))
         }
     }
 
     /// Two numbers in [0, 1)² for `domain` (see [`Sampler::next_1d_for`]).
     #[inline]
     pub fn next_2d_for(&mut self, domain: Domain) -> Vec2 {
+        let dim = self.skip();
+        self.get_2d_for(dim, domain)
+    }
+
+    /// The pair of dimension `dim` (see [`Sampler::get_1d_for`]).
+    #[inline]
+    pub fn get_2d_for(&self, dim: u32, domain: Domain) -> Vec2 {
         if self.domains.contains(domain) {
-            self.next_2d()
+            self.get_2d(dim)
         } else {
-            let h = self.next_hash().0;
+            let h = self.hash(dim);
             Vec2::new(to_unit_float(h), to_unit_float(h << 24))
         }
     }
@@ -253,15 +278,8 @@ impl Sampler {
     }
 
     #[inline]
-    fn next_dimension(&mut self) -> u32 {
-        self.dimension += 1;
-        self.dimension - 1
-    }
-
-    #[inline]
-    fn next_hash(&mut self) -> (u64, u32) {
-        let dim = self.next_dimension();
-        (hash_combine(self.sample_key, dim as u64), dim)
+    fn hash(&self, dim: u32) -> u64 {
+        hash_combine(self.sample_key, dim as u64)
     }
 
     /// Permutation seed shared by all samples of one batch in one dimension.
@@ -274,14 +292,25 @@ impl Sampler {
     /// One number in [0, 1).
     #[inline]
     pub fn next_1d(&mut self) -> f32 {
+        let dim = self.skip();
+        self.get_1d(dim)
+    }
+
+    /// Two numbers in [0, 1)², stratified together as a pair.
+    #[inline]
+    pub fn next_2d(&mut self) -> Vec2 {
+        let dim = self.skip();
+        self.get_2d(dim)
+    }
+
+    #[inline]
+    fn get_1d(&self, dim: u32) -> f32 {
         if self.kind == SamplerKind::Sobol {
-            let dim = self.next_dimension();
             let key = hash_combine(self.pixel_key, dim as u64);
             let index = nested_uniform_scramble(self.sample_index, key as u32);
             return bits_to_unit_float(sobol_dimension_0(index, (key >> 32) as u32));
         }
-        let (h, dim) = self.next_hash();
-        let u = to_unit_float(h);
+        let u = to_unit_float(self.hash(dim));
         match self.kind {
             SamplerKind::Stratified | SamplerKind::MultiJittered => {
                 let s = self.stratum(dim);
@@ -291,18 +320,16 @@ impl Sampler {
         }
     }
 
-    /// Two numbers in [0, 1)², stratified together as a pair.
     #[inline]
-    pub fn next_2d(&mut self) -> Vec2 {
+    fn get_2d(&self, dim: u32) -> Vec2 {
         if self.kind == SamplerKind::Sobol {
-            let dim = self.next_dimension();
             let key = hash_combine(self.pixel_key, dim as u64);
             let index = nested_uniform_scramble(self.sample_index, key as u32);
             let x = sobol_dimension_0(index, (key >> 32) as u32);
             let y = sobol_dimension_1(index, mix64(key) as u32);
             return Vec2::new(bits_to_unit_float(x), bits_to_unit_float(y));
         }
-        let (h, dim) = self.next_hash();
+        let h = self.hash(dim);
         let u = to_unit_float(h);
         let v = to_unit_float(h << 24);
         match self.kind {
