@@ -151,6 +151,16 @@ impl PathTracer {
         let mut prev_point = ray.origin;
         let mut bounces = 0;
         loop {
+            // Every vertex consumes the same five dimensions (light choice,
+            // light point, lobe, BSDF direction, roulette), so stratified
+            // samplers keep dimensions aligned across samples. The numbers
+            // that do not depend on the hit are drawn before the ray is
+            // traced: their hash chains then overlap with the traversal
+            // instead of stalling the light sample after it.
+            let vertex_dim = sampler.reserve(5);
+            let u_light_select = sampler.get_1d_for(vertex_dim, Domain::Light);
+            let u_light = sampler.get_2d_for(vertex_dim + 1, Domain::Light);
+            let u_bsdf = sampler.get_2d_for(vertex_dim + 3, Domain::Bsdf);
             let Some(hit) = scene.geometry.intersect(&ray) else {
                 observer.escaped();
                 break;
@@ -184,19 +194,12 @@ impl PathTracer {
             let bsdf = material.bsdf;
             let frame = Frame::from_normal(hit.normal);
             let wo = frame.to_local(wo_world);
-            // Every vertex consumes the same dimensions, so that stratified
-            // samplers keep dimensions aligned across samples.
             // The lobe and roulette numbers are computed only when used.
-            let u_light_select = sampler.next_1d_for(Domain::Light);
-            let u_light = sampler.next_2d_for(Domain::Light);
-            let lobe_dim = sampler.skip();
             let u_lobe = if matches!(bsdf, Bsdf::Diffuse { .. }) {
                 0.0
             } else {
-                sampler.get_1d_for(lobe_dim, Domain::Bsdf)
+                sampler.get_1d_for(vertex_dim + 2, Domain::Bsdf)
             };
-            let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
-            let roulette_dim = sampler.skip();
 
             if self.nee && !(SPECULAR && bsdf.is_specular()) {
                 if let Some(ls) = scene.lights.sample(hit.point, u_light_select, u_light) {
@@ -233,7 +236,7 @@ impl PathTracer {
 
             if self.russian_roulette && bounces > self.rr_depth {
                 let q = beta.max_element().min(0.95);
-                let u_roulette = sampler.get_1d_for(roulette_dim, Domain::Other);
+                let u_roulette = sampler.get_1d_for(vertex_dim + 4, Domain::Other);
                 let survived = survives_roulette(&mut beta, u_roulette);
                 observer.roulette(q, survived);
                 if !survived {

@@ -220,8 +220,14 @@ impl Sampler {
     /// numbers are computed, by [`Sampler::get_1d_for`], only when needed.
     #[inline]
     pub fn skip(&mut self) -> u32 {
-        self.dimension += 1;
-        self.dimension - 1
+        self.reserve(1)
+    }
+
+    /// Consumes `n` dimensions at once; returns the first.
+    #[inline]
+    pub fn reserve(&mut self, n: u32) -> u32 {
+        self.dimension += n;
+        self.dimension - n
     }
 
     /// The number of dimension `dim` (one [`Sampler::skip`] returned) of
