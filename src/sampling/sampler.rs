@@ -159,6 +159,9 @@ pub struct Sampler {
     batch_key: u64,
     sample_key: u64,
     sample_index: u32,
+    /// `sample_index` with its bits mirrored: where every Sobol request's
+    /// index scramble starts.
+    reversed_index: u32,
     dimension: u32,
     /// Samples stratified together. Sample `i` belongs to batch `i / batch`;
     /// rendering past a planned count simply starts another stratified batch,
@@ -192,6 +195,7 @@ impl Sampler {
             batch_key: 0,
             sample_key: 0,
             sample_index: 0,
+            reversed_index: 0,
             dimension: 0,
             batch,
             grid_x,
@@ -275,6 +279,7 @@ impl Sampler {
             0x8000_0000_0000_0000 | (sample_index / self.batch) as u64,
         );
         self.sample_index = sample_index;
+        self.reversed_index = sample_index.reverse_bits();
         self.dimension = 0;
     }
 
@@ -309,11 +314,22 @@ impl Sampler {
         self.get_2d(dim)
     }
 
+    /// The sample's index in the Sobol sequence of one dimension (pair):
+    /// Owen's nested uniform scramble of the index (Burley 2020: mirrored,
+    /// each digit flipped by a hash of the digits above it), which shuffles
+    /// the samples differently per dimension (padding) while mapping every
+    /// aligned power-of-two block onto another, so prefixes of 2^k samples
+    /// stay nets.
+    #[inline]
+    fn sobol_index(&self, seed: u32) -> u32 {
+        laine_karras(self.reversed_index, seed).reverse_bits()
+    }
+
     #[inline]
     fn get_1d(&self, dim: u32) -> f32 {
         if self.kind == SamplerKind::Sobol {
             let key = hash_combine(self.pixel_key, dim as u64);
-            let index = nested_uniform_scramble(self.sample_index, key as u32);
+            let index = self.sobol_index(key as u32);
             return bits_to_unit_float(sobol_dimension_0(index, (key >> 32) as u32));
         }
         let u = to_unit_float(self.hash(dim));
@@ -330,7 +346,7 @@ impl Sampler {
     fn get_2d(&self, dim: u32) -> Vec2 {
         if self.kind == SamplerKind::Sobol {
             let key = hash_combine(self.pixel_key, dim as u64);
-            let index = nested_uniform_scramble(self.sample_index, key as u32);
+            let index = self.sobol_index(key as u32);
             let x = sobol_dimension_0(index, (key >> 32) as u32);
             let y = sobol_dimension_1(index, mix64(key) as u32);
             return Vec2::new(bits_to_unit_float(x), bits_to_unit_float(y));
@@ -419,15 +435,6 @@ fn laine_karras(mut x: u32, seed: u32) -> u32 {
     x ^= x.wrapping_mul(0xc7af_e638);
     x ^= x.wrapping_mul(0x8d22_f6e6);
     x
-}
-
-/// Owen's nested uniform scramble of a fraction's bits (Burley 2020): each
-/// digit is flipped by a hash of the digits above it. Applied to a sample
-/// index it shuffles the sequence while mapping every aligned power-of-two
-/// block onto another, so prefixes of 2^k samples stay nets.
-#[inline]
-fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
-    laine_karras(x.reverse_bits(), seed).reverse_bits()
 }
 
 #[cfg(test)]
