@@ -37,28 +37,27 @@ pub fn to_unit_float(h: u64) -> f32 {
 /// of different pixels and dimensions.
 const SMALL_PERMUTATION: u32 = 8;
 
-/// Element `i` of the permutation of `[0, n)` numbered `hash(seed) mod n!`.
+/// Element `i` of a uniformly random permutation of `[0, n)` chosen by
+/// `seed`: its Lehmer code's digits (the rank of each element among those
+/// still available) are drawn by multiplying a 64-bit hash by each radix
+/// n, n - 1, ... and taking the high word, which is uniform up to n! / 2^64.
+/// Only the digits up to position `i` are drawn, without a division
+/// (decoding a code modulo n! by factorials made multi-jittered sampling
+/// 4x slower than Sobol).
 #[inline]
 fn small_permute(i: u32, n: u32, seed: u32) -> u32 {
-    let factorial = |k: u32| (1..=k).product::<u32>();
-    let mut code =
-        (mix64(u64::from(seed) ^ 0x2545_f491_4f6c_dd1d) % u64::from(factorial(n))) as u32;
+    let mut h = mix64(u64::from(seed) ^ 0x2545_f491_4f6c_dd1d);
     let mut available = (1u32 << n) - 1;
-    for position in 0..n {
-        let weight = factorial(n - 1 - position);
-        let mut k = code / weight;
-        code %= weight;
-        // The k-th element still available.
-        let mut element = 0;
-        loop {
-            if available & (1 << element) != 0 {
-                if k == 0 {
-                    break;
-                }
-                k -= 1;
-            }
-            element += 1;
+    for position in 0..=i {
+        let product = u128::from(h) * u128::from(n - position);
+        let k = (product >> 64) as u32;
+        h = product as u64;
+        // The k-th element still available: clear the k lowest set bits.
+        let mut rest = available;
+        for _ in 0..k {
+            rest &= rest - 1;
         }
+        let element = rest.trailing_zeros();
         if position == i {
             return element;
         }

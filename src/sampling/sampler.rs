@@ -365,8 +365,11 @@ impl Sampler {
                 let key = hash_combine(self.batch_key, dim as u64);
                 let s = permute(self.sample_index % self.batch, self.batch, key as u32);
                 let (cx, cy) = (s % m, s / m);
-                let sx = permute(cx, m, (key >> 32) as u32 ^ 0x68bc_21eb);
-                let sy = permute(cy, n, (key >> 32) as u32 ^ 0x02e5_be93);
+                // Seeds from a fresh hash: seeds that differ by a constant
+                // XOR gave correlated small permutations (chi-square test).
+                let axes_key = mix64(key);
+                let sx = permute(cx, m, axes_key as u32);
+                let sy = permute(cy, n, (axes_key >> 32) as u32);
                 Vec2::new(
                     ((cx as f32 + (sy as f32 + u) / n as f32) / m as f32).min(ONE_MINUS_EPSILON),
                     ((cy as f32 + (sx as f32 + v) / m as f32) / n as f32).min(ONE_MINUS_EPSILON),
