@@ -11,6 +11,7 @@ use egui_kittest::{Harness, SnapshotOptions};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use tracelab::integrator::IntegratorKind;
+use tracelab::render::Adaptive;
 use tracelab::sampling::SamplerKind;
 use tracelab::viewer::{Launch, Window};
 
@@ -72,6 +73,20 @@ fn controls_drive_the_renderer_and_export_writes_files() {
         .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 4)));
     step_until(&mut harness, "the first render", finished);
     assert_eq!(harness.state().app.frame().views[0].stats.spp, 4);
+
+    // Adaptive sampling by noise, on and off again.
+    click(&mut harness, "Adaptive: spread samples by noise");
+    step_until(&mut harness, "adaptive sampling", |w| {
+        finished(w)
+            && matches!(
+                w.app.frame().views[0].settings.adaptive,
+                Some(Adaptive::Distribute { .. })
+            )
+    });
+    click(&mut harness, "Adaptive: spread samples by noise");
+    step_until(&mut harness, "uniform sampling", |w| {
+        finished(w) && w.app.frame().views[0].settings.adaptive.is_none()
+    });
 
     // Switch the estimator.
     harness.get_by_label("Light tracing").click();

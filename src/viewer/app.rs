@@ -10,7 +10,7 @@ use super::launch::{Launch, list_scene_files, resolve_scene_path};
 use super::settings::{Config, Display, Settings, load_settings, settings_file};
 use crate::image::Image;
 use crate::live::{ErrorPoint, LiveConfig, LiveFrame, LiveRender};
-use crate::render::RenderSettings;
+use crate::render::{Adaptive, RenderSettings};
 use crate::scene::camera::Camera;
 use crate::scene::{Limits, Scene};
 use eframe::egui::{self, ColorImage, TextureHandle, TextureOptions};
@@ -18,6 +18,9 @@ use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
+
+/// Uniform samples per pixel before "spread samples by noise" takes over.
+const SPREAD_WARMUP_SPP: u32 = 4;
 
 /// A convergence curve of a configuration that is no longer rendering.
 #[derive(Clone, Debug)]
@@ -366,7 +369,9 @@ impl ViewerApp {
                         seed: c.seed,
                         planned_spp: target.unwrap_or(0),
                         threads: 0,
-                        adaptive: None,
+                        adaptive: c.spread_by_noise.then_some(Adaptive::Distribute {
+                            warmup_spp: SPREAD_WARMUP_SPP,
+                        }),
                         domains: c.domains,
                         clamp: None,
                     },

@@ -201,6 +201,19 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
             ui.checkbox(&mut d.bsdf, "BSDF");
         });
     });
+    if !matches!(
+        options.kind,
+        IntegratorKind::Light | IntegratorKind::Whitted
+    ) {
+        ui.checkbox(
+            &mut config.spread_by_noise,
+            "Adaptive: spread samples by noise",
+        )
+        .on_hover_text(
+            "After a few samples everywhere, each pass spends its samples where the \
+                 per-pixel noise is (Neyman allocation): least RMSE for the time",
+        );
+    }
     ui.horizontal(|ui| {
         let label = ui.label("Seed");
         ui.add(egui::DragValue::new(&mut config.seed))

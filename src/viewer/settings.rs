@@ -2,7 +2,7 @@
 //! persists between runs. Render settings (which restart accumulation) and
 //! display settings (which never do) are kept apart.
 
-use crate::integrator::IntegratorOptions;
+use crate::integrator::{IntegratorKind, IntegratorOptions};
 use crate::live::Lock;
 use crate::math::OffsetMode;
 use crate::sampling::{Domains, SamplerKind};
@@ -17,6 +17,9 @@ pub struct Config {
     /// Domains the sampler applies to (the rest are independent).
     pub domains: Domains,
     pub seed: u64,
+    /// Adaptive sampling: after a few samples everywhere, each pass spends
+    /// its samples where the noise is ([`crate::render::Adaptive::Distribute`]).
+    pub spread_by_noise: bool,
 }
 
 impl Default for Config {
@@ -26,6 +29,7 @@ impl Default for Config {
             sampler: SamplerKind::Independent,
             domains: Domains::ALL,
             seed: 0,
+            spread_by_noise: false,
         }
     }
 }
@@ -35,15 +39,15 @@ impl Config {
     pub fn label(&self) -> String {
         let i = &self.integrator;
         let estimator = match i.kind {
-            crate::integrator::IntegratorKind::Whitted => format!("whitted d{}", i.max_depth),
-            crate::integrator::IntegratorKind::Mcrt => format!(
+            IntegratorKind::Whitted => format!("whitted d{}", i.max_depth),
+            IntegratorKind::Mcrt => format!(
                 "mcrt d{} n{} m{}",
                 i.max_depth, i.shadow_rays, i.glossy_rays
             ),
-            crate::integrator::IntegratorKind::Path => {
+            IntegratorKind::Path => {
                 format!("path d{} {:?}", i.max_depth, i.strategy).to_lowercase()
             }
-            crate::integrator::IntegratorKind::Light => format!("light d{}", i.max_depth),
+            IntegratorKind::Light => format!("light d{}", i.max_depth),
         };
         let d = self.domains;
         let partial = if self.sampler != SamplerKind::Independent && d != Domains::ALL {
@@ -62,7 +66,12 @@ impl Config {
         } else {
             String::new()
         };
-        format!("{estimator} {}{partial}", self.sampler.name())
+        let adaptive = if self.spread_by_noise && self.integrator.kind != IntegratorKind::Light {
+            " adaptive"
+        } else {
+            ""
+        };
+        format!("{estimator} {}{partial}{adaptive}", self.sampler.name())
     }
 }
 
