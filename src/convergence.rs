@@ -320,6 +320,10 @@ mod tests {
         assert_eq!(c.sampler, SamplerKind::Sobol);
         assert_eq!(c.integrator.strategy, Strategy::Light);
         assert_eq!(c.light_sampling, Some(LightSampling::SolidAngle));
+        assert_eq!(c.distribute, None);
+        let c = BenchConfig::parse("path:sobol:distribute=4").unwrap();
+        assert_eq!(c.distribute, Some(4));
+        assert!(BenchConfig::parse("path:sobol:distribute=x").is_err());
         assert!(BenchConfig::parse("paht:sobol").is_err());
         assert!(BenchConfig::parse("path:sobel").is_err());
         assert!(BenchConfig::parse("path:sobol:depth=3").is_err());

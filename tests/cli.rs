@@ -98,6 +98,42 @@ fn renders_the_cornell_box_and_compares_images() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(image::open(&png).unwrap().width() == 32);
 
+    // Samples spread by noise after 2 spp: the summary gives the spread.
+    let o = tracelab(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--spp",
+        "8",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--sampler",
+        "sobol",
+        "--distribute",
+        "2",
+        "--out",
+        exr.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("samples spread by noise after 2 spp; per pixel "),
+        "{}",
+        stderr(&o)
+    );
+    assert_fails(
+        &tracelab(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--adaptive",
+            "0.1",
+            "--distribute",
+            "2",
+        ]),
+        2,
+        &["--distribute"],
+    );
+
     let o = tracelab(&["compare", exr.to_str().unwrap(), exr.to_str().unwrap()]);
     assert!(o.status.success());
     assert!(
