@@ -72,6 +72,12 @@ struct ViewArgs {
     /// Start a side-by-side comparison (B = A with the Sobol sampler).
     #[arg(long)]
     compare: bool,
+    /// Start with adaptive sampling by noise on (after 4 spp everywhere).
+    #[arg(long)]
+    distribute: bool,
+    /// What the image area shows first.
+    #[arg(long, value_enum)]
+    show: Option<ShowArg>,
     /// Render threads (default: one per core).
     #[arg(long, default_value_t = 0)]
     threads: usize,
@@ -100,6 +106,8 @@ pub fn run(cli: Cli) -> Result<()> {
             screenshot: None,
             after_spp: 64,
             compare: false,
+            distribute: false,
+            show: None,
             threads: 0,
             fresh: false,
             export_dir: None,
@@ -144,9 +152,29 @@ fn view(args: ViewArgs) -> Result<()> {
         screenshot: args.screenshot,
         after_spp: args.after_spp,
         compare: args.compare,
+        distribute: args.distribute,
+        show: args.show.map(|s| match s {
+            ShowArg::Image => tracelab::viewer::ViewMode::Image,
+            ShowArg::Difference => tracelab::viewer::ViewMode::Difference,
+            ShowArg::StdError => tracelab::viewer::ViewMode::StandardError,
+            ShowArg::Fireflies => tracelab::viewer::ViewMode::Fireflies,
+            ShowArg::Samples => tracelab::viewer::ViewMode::Samples,
+        }),
         threads: args.threads,
         export_dir: args.export_dir,
     })
+}
+
+/// The viewer's image modes on the command line.
+#[cfg(feature = "viewer")]
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum ShowArg {
+    Image,
+    Difference,
+    StdError,
+    Fireflies,
+    /// Samples per pixel (where adaptive sampling spends them).
+    Samples,
 }
 
 fn integrator_kind(arg: IntegratorArg) -> IntegratorKind {

@@ -146,6 +146,12 @@ impl ViewerApp {
             settings.target_spp = spp.max(1);
             settings.unlimited = false;
         }
+        if launch.distribute {
+            settings.a.spread_by_noise = true;
+        }
+        if let Some(mode) = launch.show {
+            settings.display.view = mode;
+        }
         if launch.compare {
             settings.compare = true;
             settings.b = Config {

@@ -76,6 +76,9 @@ pub fn sequential(t: f32) -> Color32 {
 /// Upper end of the standard-error colour scale (relative error).
 pub const STANDARD_ERROR_SCALE: f32 = 0.5;
 
+/// Samples per pixel at the top of the samples view's colour scale (log2).
+pub const SAMPLES_SCALE_LOG2: f32 = 12.0;
+
 /// Relative standard error of a pixel (luminance-weighted).
 #[inline]
 pub fn relative_standard_error(mean: [f32; 3], se: [f32; 3]) -> f32 {
@@ -139,6 +142,11 @@ pub fn render_view(
                     Color32::from_rgb(c.r() / 3, c.g() / 3, c.b() / 3)
                 }
             })
+            .collect(),
+        ViewMode::Samples => view
+            .samples
+            .iter()
+            .map(|&n| sequential((n.max(1) as f32).log2() / SAMPLES_SCALE_LOG2))
             .collect(),
     };
     ColorImage::new([w, h], pixels)

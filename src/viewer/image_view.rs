@@ -3,7 +3,9 @@
 //! (shift + scroll); a pixel inspector under the cursor; view-mode legends.
 
 use super::app::ViewerApp;
-use super::display::{STANDARD_ERROR_SCALE, diverging, relative_standard_error, sequential};
+use super::display::{
+    SAMPLES_SCALE_LOG2, STANDARD_ERROR_SCALE, diverging, relative_standard_error, sequential,
+};
 use super::settings::{CompareLayout, ViewMode};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Vec2, pos2, vec2};
 
@@ -226,6 +228,11 @@ fn legend(painter: &egui::Painter, rect: Rect, mode: ViewMode) {
         ViewMode::Difference => ("-1", "+1 (A - B, x exposure)".into(), |t| {
             diverging(2.0 * t - 1.0)
         }),
+        ViewMode::Samples => (
+            "1",
+            format!("{} spp (log scale)", 1u32 << SAMPLES_SCALE_LOG2 as u32),
+            sequential,
+        ),
         _ => return,
     };
     let bar = Rect::from_min_size(rect.right_top() + vec2(-230.0, 10.0), vec2(200.0, 12.0));

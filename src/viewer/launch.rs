@@ -1,6 +1,7 @@
 //! How the viewer is started: the launch options from the command line (or
 //! a test), and where scene files are found.
 
+use super::settings::ViewMode;
 use crate::integrator::IntegratorKind;
 use std::path::{Path, PathBuf};
 
@@ -16,6 +17,10 @@ pub struct Launch {
     pub after_spp: u32,
     /// Open a side-by-side comparison (A as given, B with the Sobol sampler).
     pub compare: bool,
+    /// Start with adaptive sampling by noise on.
+    pub distribute: bool,
+    /// Start in this view mode.
+    pub show: Option<ViewMode>,
     /// Render threads (0 = one per core).
     pub threads: usize,
     /// Start from default settings instead of the saved ones.

@@ -19,11 +19,11 @@ pub mod stats;
 
 pub use app::ViewerApp;
 pub use launch::Launch;
+pub use settings::ViewMode;
 
 use crate::error::{Error, Result};
 use eframe::egui::{self, Color32, Key, RichText};
 use panel::Editing;
-use settings::ViewMode;
 use std::time::{Duration, Instant};
 
 /// How long toasts stay.

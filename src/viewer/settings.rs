@@ -96,14 +96,18 @@ pub enum ViewMode {
     StandardError,
     /// The image with non-finite samples and fireflies marked.
     Fireflies,
+    /// Samples per pixel in false colour (log scale): where adaptive
+    /// sampling spends its samples.
+    Samples,
 }
 
 impl ViewMode {
-    pub const ALL: [ViewMode; 4] = [
+    pub const ALL: [ViewMode; 5] = [
         ViewMode::Image,
         ViewMode::Difference,
         ViewMode::StandardError,
         ViewMode::Fireflies,
+        ViewMode::Samples,
     ];
 
     pub fn label(self) -> &'static str {
@@ -112,6 +116,7 @@ impl ViewMode {
             ViewMode::Difference => "Difference",
             ViewMode::StandardError => "Std. error",
             ViewMode::Fireflies => "Fireflies",
+            ViewMode::Samples => "Samples",
         }
     }
 }
