@@ -6,6 +6,7 @@
 
 use super::display::render_view;
 use super::export::{export_path, write_color_image, write_exr};
+pub use super::image_view::ViewTransform;
 use super::launch::{Launch, list_scene_files, resolve_scene_path};
 use super::settings::{Config, Display, Settings, load_settings, settings_file};
 use crate::image::Image;
@@ -43,23 +44,6 @@ pub enum Capture {
     Window { path: PathBuf, quit_after: bool },
     /// The comparison sheet layout.
     Sheet { path: PathBuf },
-}
-
-/// Zoom and pan of the image area.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ViewTransform {
-    /// Screen points per image pixel; `None` fits the image to the area.
-    pub zoom: Option<f32>,
-    pub pan: egui::Vec2,
-}
-
-impl Default for ViewTransform {
-    fn default() -> Self {
-        ViewTransform {
-            zoom: None,
-            pan: egui::Vec2::ZERO,
-        }
-    }
 }
 
 /// Everything whose change restarts rendering: the render settings, the
