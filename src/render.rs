@@ -41,8 +41,9 @@ pub struct RenderSettings {
 }
 
 /// Adaptive sampling: samples go where the noise is rather than evenly.
-/// Both modes trade a little bias for time: a pixel's later sample count
-/// depends on its earlier samples, whose error estimate is itself noisy.
+/// `Stop` trades a little bias for time (a pixel's count depends on its own
+/// noisy error estimate); `Distribute` sets a pixel's count from its
+/// neighbours' noise, which keeps its mean unbiased to first order.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Adaptive {
     /// A pixel with at least `min_spp` samples whose relative standard error
