@@ -411,6 +411,61 @@ fn triangle_light_spherical_triangle_sampling() {
     }
 }
 
+/// A reference point and a big emissive parallelogram above it, as two
+/// triangles for the geometry and one light.
+fn parallelogram_light(sampling: LightSampling) -> (Vec3A, Lights, Geometry) {
+    let reference = Vec3A::new(0.2, -0.1, 0.0);
+    let p0 = Vec3A::new(-1.0, -1.5, 0.8);
+    let (e1, e2) = (Vec3A::new(2.5, 0.5, 0.2), Vec3A::new(0.3, 2.5, -0.4));
+    let facing = e1.cross(e2).normalize();
+    let light = Light::Parallelogram {
+        p0,
+        e1,
+        e2,
+        // Facing down, towards the reference point.
+        normal: -facing * facing.z.signum(),
+        area: e1.cross(e2).length(),
+        radiance: Rgb::ONE,
+        two_sided: false,
+        sampling,
+    };
+    let corner = p0 + e1 + e2;
+    let geometry = Geometry::build(
+        &[
+            TriangleInput {
+                vertices: [p0, p0 + e1, p0 + e2],
+                material: 0,
+            },
+            TriangleInput {
+                vertices: [corner, p0 + e2, p0 + e1],
+                material: 0,
+            },
+        ],
+        vec![],
+    );
+    (reference, Lights::new(vec![light]), geometry)
+}
+
+#[test]
+fn parallelogram_light_area_sampling_in_solid_angle() {
+    let (reference, lights, geometry) = parallelogram_light(LightSampling::Area);
+    check_light("parallelogram light", 14, reference, &lights, &geometry);
+}
+
+#[test]
+fn parallelogram_light_solid_angle_sampling() {
+    // A half chosen by its share of the solid angle, then Arvo's sampling
+    // in it: the density must be constant, 1 / (both halves' solid angle).
+    let (reference, lights, geometry) = parallelogram_light(LightSampling::SolidAngle);
+    check_light(
+        "parallelogram light, solid angle",
+        16,
+        reference,
+        &lights,
+        &geometry,
+    );
+}
+
 #[test]
 fn triangle_light_points_are_uniform_by_area() {
     // Barycentric histogram: each of 10x10 cells of the (b1, b2) square

@@ -87,3 +87,19 @@ fn every_estimator_renders_every_scene_without_non_finite_samples() {
         }
     }
 }
+
+/// The Cornell box's light (a quad in its OBJ, two triangles) is sampled as
+/// one parallelogram of its full area, 130 x 105 mm.
+#[test]
+fn the_cornell_box_light_is_one_parallelogram() {
+    use tracelab::scene::light::Light;
+    let scene = crate::common::cornell_box();
+    let lights = scene.lights.as_slice();
+    assert_eq!(lights.len(), 1, "{lights:?}");
+    let Light::Parallelogram { area, normal, .. } = lights[0] else {
+        panic!("{:?}", lights[0]);
+    };
+    assert!((area - 130.0 * 105.0).abs() < 0.5, "{area}");
+    // One-sided, facing down into the box.
+    assert!(normal.y < -0.999, "{normal}");
+}

@@ -241,6 +241,21 @@ fn point_equivalent(light: &Light, reference: Vec3A) -> (Vec3A, Vec3A, Rgb) {
             let cos = if two_sided { cos.abs() } else { cos.max(0.0) };
             (centroid, centroid, radiance * (area * cos))
         }
+        Light::Parallelogram {
+            p0,
+            e1,
+            e2,
+            normal,
+            area,
+            radiance,
+            two_sided,
+            ..
+        } => {
+            let centre = p0 + (e1 + e2) * 0.5;
+            let cos = normal.dot((reference - centre).normalize_or_zero());
+            let cos = if two_sided { cos.abs() } else { cos.max(0.0) };
+            (centre, centre, radiance * (area * cos))
+        }
         Light::Sphere {
             center,
             radius,

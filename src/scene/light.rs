@@ -42,6 +42,21 @@ pub enum Light {
         two_sided: bool,
         sampling: LightSampling,
     },
+    /// An emissive parallelogram `p0 + s e1 + t e2` (s, t in [0, 1]): two
+    /// triangles of a mesh that share a diagonal, such as the Cornell box's
+    /// light, sampled as one. One 2D sample then covers the whole quad
+    /// (a stratified 2D point stays stratified over it), with no light
+    /// choice between its halves and no square root for a triangle.
+    Parallelogram {
+        p0: Vec3A,
+        e1: Vec3A,
+        e2: Vec3A,
+        normal: Vec3A,
+        area: f32,
+        radiance: Rgb,
+        two_sided: bool,
+        sampling: LightSampling,
+    },
     /// An emissive sphere, emitting outwards (and inwards when two-sided).
     Sphere {
         center: Vec3A,
@@ -82,6 +97,12 @@ impl Light {
     pub fn power(&self) -> f32 {
         match *self {
             Light::Triangle {
+                area,
+                radiance,
+                two_sided,
+                ..
+            }
+            | Light::Parallelogram {
                 area,
                 radiance,
                 two_sided,
@@ -131,6 +152,47 @@ impl Light {
                 let b = square_to_uniform_triangle(u);
                 let point = p0 + b.x * e1 + b.y * e2;
                 let error = gamma(6) * (p0.abs() + (b.x * e1).abs() + (b.y * e2).abs());
+                area_sample(reference, point, error, normal, area, radiance, two_sided)
+            }
+            Light::Parallelogram {
+                p0,
+                e1,
+                e2,
+                normal,
+                area,
+                radiance,
+                two_sided,
+                sampling,
+            } => {
+                if sampling == LightSampling::SolidAngle
+                    && let Some(omegas) = parallelogram_solid_angles(reference, p0, e1, e2)
+                {
+                    // Uniform over the union of the halves' spherical
+                    // triangles: a half in proportion to its solid angle.
+                    let total = omegas[0] + omegas[1];
+                    let split = omegas[0] / total;
+                    let (half, ux) = if u.x < split {
+                        (0, u.x / split)
+                    } else {
+                        (1, (u.x - split) / (1.0 - split))
+                    };
+                    let [q0, q1, q2] = parallelogram_halves(p0, e1, e2)[half];
+                    let u = Vec2::new(ux.min(ONE_MINUS_EPSILON), u.y);
+                    let mut s = triangle_solid_angle_sample(
+                        reference,
+                        q0,
+                        q1 - q0,
+                        q2 - q0,
+                        normal,
+                        radiance,
+                        two_sided,
+                        u,
+                    )?;
+                    s.pdf = 1.0 / total;
+                    return Some(s);
+                }
+                let point = p0 + u.x * e1 + u.y * e2;
+                let error = gamma(6) * (p0.abs() + (u.x * e1).abs() + (u.y * e2).abs());
                 area_sample(reference, point, error, normal, area, radiance, two_sided)
             }
             Light::Sphere {
@@ -228,6 +290,21 @@ impl Light {
                 }
                 dist2 / (cos_light * area)
             }
+            Light::Parallelogram {
+                p0,
+                e1,
+                e2,
+                area,
+                sampling,
+                ..
+            } => {
+                if sampling == LightSampling::SolidAngle
+                    && let Some(omegas) = parallelogram_solid_angles(reference, p0, e1, e2)
+                {
+                    return 1.0 / (omegas[0] + omegas[1]);
+                }
+                dist2 / (cos_light * area)
+            }
             Light::Sphere {
                 center,
                 radius,
@@ -246,6 +323,30 @@ impl Light {
             Light::Point { .. } => 0.0,
         }
     }
+}
+
+/// The two triangles of a parallelogram, split along the diagonal e1 - e2.
+#[inline]
+fn parallelogram_halves(p0: Vec3A, e1: Vec3A, e2: Vec3A) -> [[Vec3A; 3]; 2] {
+    [[p0, p0 + e1, p0 + e2], [p0 + e1 + e2, p0 + e2, p0 + e1]]
+}
+
+/// The solid angles of a parallelogram's halves seen from `reference`, when
+/// spherical-triangle sampling is accurate for both; else `None` (area
+/// sampling), the same decision in `sample` and `pdf`.
+#[inline]
+fn parallelogram_solid_angles(
+    reference: Vec3A,
+    p0: Vec3A,
+    e1: Vec3A,
+    e2: Vec3A,
+) -> Option<[f32; 2]> {
+    let omegas =
+        parallelogram_halves(p0, e1, e2).map(|v| spherical_triangle::solid_angle(reference, v));
+    omegas
+        .iter()
+        .all(|&omega| spherical_triangle::usable(omega))
+        .then_some(omegas)
 }
 
 /// A direction uniform in the solid angle of a triangle light, with the point
@@ -425,6 +526,21 @@ impl Light {
                 let error = gamma(6) * (p0.abs() + (b.x * e1).abs() + (b.y * e2).abs());
                 (point, error, normal, area, radiance, two_sided)
             }
+            Light::Parallelogram {
+                p0,
+                e1,
+                e2,
+                normal,
+                area,
+                radiance,
+                two_sided,
+                ..
+            } => {
+                let u = u_position;
+                let point = p0 + u.x * e1 + u.y * e2;
+                let error = gamma(6) * (p0.abs() + (u.x * e1).abs() + (u.y * e2).abs());
+                (point, error, normal, area, radiance, two_sided)
+            }
             Light::Sphere {
                 center,
                 radius,
@@ -505,7 +621,10 @@ impl Lights {
     pub fn with_sampling(&self, mode: LightSampling) -> Lights {
         let mut lights = self.lights.clone();
         for light in &mut lights {
-            if let Light::Triangle { sampling, .. } | Light::Sphere { sampling, .. } = light {
+            if let Light::Triangle { sampling, .. }
+            | Light::Parallelogram { sampling, .. }
+            | Light::Sphere { sampling, .. } = light
+            {
                 *sampling = mode;
             }
         }

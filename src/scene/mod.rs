@@ -3,6 +3,7 @@
 
 pub mod camera;
 pub mod description;
+pub mod emitters;
 pub mod light;
 pub mod load;
 pub mod material;
@@ -12,6 +13,7 @@ use crate::accel::{Geometry, Sphere, TriangleInput};
 use crate::error::{Error, Result};
 use crate::math::OffsetMode;
 use camera::Camera;
+use emitters::EmitterShape;
 use glam::Vec3A;
 use light::{Light, LightSampling, Lights};
 use material::{Bsdf, Material};
@@ -280,24 +282,60 @@ impl Scene {
             );
         }
         let mut lights = Vec::new();
-        for i in 0..geometry.triangle_count() {
-            let material = &input.materials[geometry.triangle_material(i) as usize];
-            if material.is_emissive() {
-                let [p0, p1, p2] = geometry.triangles()[i];
-                let (e1, e2) = (p1 - p0, p2 - p0);
-                let cross = e1.cross(e2);
-                geometry.set_triangle_light(i, lights.len() as u32);
-                lights.push(Light::Triangle {
+        let emissive: Vec<usize> = (0..geometry.triangle_count())
+            .filter(|&i| input.materials[geometry.triangle_material(i) as usize].is_emissive())
+            .collect();
+        let shapes = emitters::group_emitters(geometry.triangles(), &emissive, |i| {
+            geometry.triangle_material(i)
+        });
+        for shape in shapes {
+            let first = match shape {
+                EmitterShape::Triangle(i) => i,
+                EmitterShape::Parallelogram { triangles, .. } => triangles[0],
+            };
+            let material = &input.materials[geometry.triangle_material(first) as usize];
+            let (radiance, two_sided) = (material.emission, material.two_sided_emission);
+            let sampling = input.triangle_sampling;
+            let light = match shape {
+                EmitterShape::Triangle(i) => {
+                    let [p0, p1, p2] = geometry.triangles()[i];
+                    let (e1, e2) = (p1 - p0, p2 - p0);
+                    let cross = e1.cross(e2);
+                    geometry.set_triangle_light(i, lights.len() as u32);
+                    Light::Triangle {
+                        p0,
+                        e1,
+                        e2,
+                        normal: cross.normalize(),
+                        area: 0.5 * cross.length(),
+                        radiance,
+                        two_sided,
+                        sampling,
+                    }
+                }
+                EmitterShape::Parallelogram {
+                    triangles,
                     p0,
                     e1,
                     e2,
-                    normal: cross.normalize(),
-                    area: 0.5 * cross.length(),
-                    radiance: material.emission,
-                    two_sided: material.two_sided_emission,
-                    sampling: input.triangle_sampling,
-                });
-            }
+                } => {
+                    let cross = e1.cross(e2);
+                    for i in triangles {
+                        geometry.set_triangle_light(i, lights.len() as u32);
+                    }
+                    Light::Parallelogram {
+                        p0,
+                        e1,
+                        e2,
+                        normal: cross.normalize(),
+                        area: cross.length(),
+                        radiance,
+                        two_sided,
+                        sampling,
+                    }
+                }
+            };
+            lights.push(light);
         }
         for i in 0..geometry.spheres().len() {
             let s = geometry.spheres()[i];
