@@ -31,13 +31,14 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn paths_per_second(threads: usize) -> f64 {
-    paths_per_second_with(threads, false)
-}
-
 /// `general`: force the general path loop instead of the one specialised for
 /// the Cornell box (Lambertian only, no specular surfaces).
 fn paths_per_second_with(threads: usize, general: bool) -> f64 {
+    median(path_runs(threads, general))
+}
+
+/// Paths/s of 5 renders of 32 spp each, in run order.
+fn path_runs(threads: usize, general: bool) -> Vec<f64> {
     let scene = Arc::new(
         Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml"))
             .unwrap(),
@@ -65,7 +66,7 @@ fn paths_per_second_with(threads: usize, general: bool) -> f64 {
             stats.samples as f64 / stats.render_time.as_secs_f64()
         })
         .collect();
-    median(runs)
+    runs
 }
 
 fn incoherent_rays(count: u64, radius: f32, center: Vec3A, spread: f32) -> Vec<Ray> {
@@ -136,11 +137,18 @@ fn main() {
     }
 }
 
+/// The median with the range of the runs beside it: on a shared machine
+/// single renders scatter by 5-10%, and the range says how much.
 fn paths() {
     for threads in [1, 2] {
+        let mut runs = path_runs(threads, false);
+        runs.sort_by(|a, b| a.partial_cmp(b).unwrap());
         println!(
-            "Cornell box 256x256, path tracing (8 bounces, NEE+MIS), {threads} thread(s): {:.3} M paths/s",
-            paths_per_second(threads) * 1e-6
+            "Cornell box 256x256, path tracing (8 bounces, NEE+MIS), {threads} thread(s): {:.3} M paths/s (median of {}; range {:.3}-{:.3})",
+            median(runs.clone()) * 1e-6,
+            runs.len(),
+            runs[0] * 1e-6,
+            runs[runs.len() - 1] * 1e-6
         );
     }
 }
