@@ -15,7 +15,7 @@ use tracelab::accel::{Geometry, NO_LIGHT, TriangleInput};
 use tracelab::math::{Frame, Rgb};
 use tracelab::sampling::hash::{hash_combine, to_unit_float};
 use tracelab::sampling::warp::*;
-use tracelab::scene::light::{Light, LightSampling, Lights};
+use tracelab::scene::light::{Light, LightSampling, Lights, PlanarEmitter};
 use tracelab::scene::material::{Bsdf, fresnel_dielectric};
 
 /// Number of `assert_fits` calls below.
@@ -363,7 +363,7 @@ fn triangle_light(sampling: LightSampling) -> (Vec3A, Lights, Geometry) {
     let (e1, e2) = (p1 - p0, p2 - p0);
     // Facing down, towards the reference point.
     let normal = -e1.cross(e2).normalize() * e1.cross(e2).normalize().z.signum();
-    let light = Light::Triangle {
+    let light = Light::Triangle(PlanarEmitter {
         p0,
         e1,
         e2,
@@ -372,7 +372,7 @@ fn triangle_light(sampling: LightSampling) -> (Vec3A, Lights, Geometry) {
         radiance: Rgb::ONE,
         two_sided: false,
         sampling,
-    };
+    });
     let geometry = Geometry::build(
         &[TriangleInput {
             vertices: [p0, p1, p2],
@@ -418,7 +418,7 @@ fn parallelogram_light(sampling: LightSampling) -> (Vec3A, Lights, Geometry) {
     let p0 = Vec3A::new(-1.0, -1.5, 0.8);
     let (e1, e2) = (Vec3A::new(2.5, 0.5, 0.2), Vec3A::new(0.3, 2.5, -0.4));
     let facing = e1.cross(e2).normalize();
-    let light = Light::Parallelogram {
+    let light = Light::Parallelogram(PlanarEmitter {
         p0,
         e1,
         e2,
@@ -428,7 +428,7 @@ fn parallelogram_light(sampling: LightSampling) -> (Vec3A, Lights, Geometry) {
         radiance: Rgb::ONE,
         two_sided: false,
         sampling,
-    };
+    });
     let corner = p0 + e1 + e2;
     let geometry = Geometry::build(
         &[

@@ -96,10 +96,10 @@ fn the_cornell_box_light_is_one_parallelogram() {
     let scene = crate::common::cornell_box();
     let lights = scene.lights.as_slice();
     assert_eq!(lights.len(), 1, "{lights:?}");
-    let Light::Parallelogram { area, normal, .. } = lights[0] else {
+    let Light::Parallelogram(light) = lights[0] else {
         panic!("{:?}", lights[0]);
     };
-    assert!((area - 130.0 * 105.0).abs() < 0.5, "{area}");
+    assert!((light.area - 130.0 * 105.0).abs() < 0.5, "{}", light.area);
     // One-sided, facing down into the box.
-    assert!(normal.y < -0.999, "{normal}");
+    assert!(light.normal.y < -0.999, "{}", light.normal);
 }

@@ -15,7 +15,7 @@ use super::RayCounts;
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::scene::Scene;
-use crate::scene::light::Light;
+use crate::scene::light::{Light, PlanarEmitter};
 use crate::scene::material::{Bsdf, fresnel_dielectric};
 use glam::Vec3A;
 
@@ -226,36 +226,8 @@ fn point_equivalent(light: &Light, reference: Vec3A) -> (Vec3A, Vec3A, Rgb) {
             position,
             intensity,
         } => (position, position, intensity),
-        Light::Triangle {
-            p0,
-            e1,
-            e2,
-            normal,
-            area,
-            radiance,
-            two_sided,
-            ..
-        } => {
-            let centroid = p0 + (e1 + e2) / 3.0;
-            let cos = normal.dot((reference - centroid).normalize_or_zero());
-            let cos = if two_sided { cos.abs() } else { cos.max(0.0) };
-            (centroid, centroid, radiance * (area * cos))
-        }
-        Light::Parallelogram {
-            p0,
-            e1,
-            e2,
-            normal,
-            area,
-            radiance,
-            two_sided,
-            ..
-        } => {
-            let centre = p0 + (e1 + e2) * 0.5;
-            let cos = normal.dot((reference - centre).normalize_or_zero());
-            let cos = if two_sided { cos.abs() } else { cos.max(0.0) };
-            (centre, centre, radiance * (area * cos))
-        }
+        Light::Triangle(p) => planar_point(&p, p.p0 + (p.e1 + p.e2) / 3.0, reference),
+        Light::Parallelogram(p) => planar_point(&p, p.p0 + (p.e1 + p.e2) * 0.5, reference),
         Light::Sphere {
             center,
             radius,
@@ -268,4 +240,12 @@ fn point_equivalent(light: &Light, reference: Vec3A) -> (Vec3A, Vec3A, Rgb) {
             (center, surface, intensity)
         }
     }
+}
+
+/// A flat emitter as a point at `centre`: a Lambertian emitter's intensity
+/// Le A cos towards `reference`.
+fn planar_point(p: &PlanarEmitter, centre: Vec3A, reference: Vec3A) -> (Vec3A, Vec3A, Rgb) {
+    let cos = p.normal.dot((reference - centre).normalize_or_zero());
+    let cos = if p.two_sided { cos.abs() } else { cos.max(0.0) };
+    (centre, centre, p.radiance * (p.area * cos))
 }

@@ -31,32 +31,14 @@ pub enum LightSampling {
 /// One light source.
 #[derive(Clone, Copy, Debug)]
 pub enum Light {
-    /// An emissive triangle `p0 + b1 e1 + b2 e2`.
-    Triangle {
-        p0: Vec3A,
-        e1: Vec3A,
-        e2: Vec3A,
-        normal: Vec3A,
-        area: f32,
-        radiance: Rgb,
-        two_sided: bool,
-        sampling: LightSampling,
-    },
-    /// An emissive parallelogram `p0 + s e1 + t e2` (s, t in [0, 1]): two
+    /// An emissive triangle: `p0 + b1 e1 + b2 e2` with b1 + b2 <= 1.
+    Triangle(PlanarEmitter),
+    /// An emissive parallelogram: `p0 + s e1 + t e2` with s, t in [0, 1]; two
     /// triangles of a mesh that share a diagonal, such as the Cornell box's
-    /// light, sampled as one. One 2D sample then covers the whole quad
-    /// (a stratified 2D point stays stratified over it), with no light
-    /// choice between its halves and no square root for a triangle.
-    Parallelogram {
-        p0: Vec3A,
-        e1: Vec3A,
-        e2: Vec3A,
-        normal: Vec3A,
-        area: f32,
-        radiance: Rgb,
-        two_sided: bool,
-        sampling: LightSampling,
-    },
+    /// light, sampled as one. One 2D sample then covers the whole quad (a
+    /// stratified 2D point stays stratified over it), with no light choice
+    /// between its halves and no square root for a triangle.
+    Parallelogram(PlanarEmitter),
     /// An emissive sphere, emitting outwards (and inwards when two-sided).
     Sphere {
         center: Vec3A,
@@ -67,6 +49,91 @@ pub enum Light {
     },
     /// An isotropic point light of `intensity` (W/sr per channel).
     Point { position: Vec3A, intensity: Rgb },
+}
+
+/// A flat emitter spanned by `e1` and `e2` from `p0`: a triangle or a
+/// parallelogram, as its [`Light`] variant says.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanarEmitter {
+    pub p0: Vec3A,
+    pub e1: Vec3A,
+    pub e2: Vec3A,
+    /// Unit normal of the emitting side (one-sided emitters).
+    pub normal: Vec3A,
+    pub area: f32,
+    pub radiance: Rgb,
+    pub two_sided: bool,
+    pub sampling: LightSampling,
+}
+
+impl PlanarEmitter {
+    /// The point `p0 + b.x e1 + b.y e2` and its rounding error bound.
+    #[inline]
+    fn point(&self, b: Vec2) -> (Vec3A, Vec3A) {
+        let (p0, e1, e2) = (self.p0, self.e1, self.e2);
+        let point = p0 + b.x * e1 + b.y * e2;
+        let error = gamma(6) * (p0.abs() + (b.x * e1).abs() + (b.y * e2).abs());
+        (point, error)
+    }
+
+    /// The point at `b` sampled uniformly by area, seen from `reference`.
+    #[inline]
+    fn area_sample(&self, reference: Vec3A, b: Vec2) -> Option<LightSample> {
+        let (point, error) = self.point(b);
+        area_sample(
+            reference,
+            point,
+            error,
+            self.normal,
+            self.area,
+            self.radiance,
+            self.two_sided,
+        )
+    }
+
+    /// A direction uniform in the solid angle of the triangle `o + b1 a +
+    /// b2 b` (this emitter or a half of it), with the point where it meets
+    /// the triangle (found as barycentrics, so that the point lies on the
+    /// triangle with the usual error bound).
+    #[inline]
+    fn solid_angle_sample(
+        &self,
+        reference: Vec3A,
+        (o, a, b): (Vec3A, Vec3A, Vec3A),
+        u: Vec2,
+    ) -> Option<LightSample> {
+        let (wi, pdf) = spherical_triangle::sample(reference, [o, o + a, o + b], u)?;
+        let cos_light = -self.normal.dot(wi);
+        if !(cos_light > 0.0 || (self.two_sided && cos_light < 0.0)) {
+            return None;
+        }
+        // Möller-Trumbore for the barycentrics of the hit of reference + t wi.
+        let pvec = wi.cross(b);
+        let det = a.dot(pvec);
+        if det == 0.0 {
+            return None;
+        }
+        let tvec = reference - o;
+        let b1 = (tvec.dot(pvec) / det).clamp(0.0, 1.0);
+        let qvec = tvec.cross(a);
+        let b2 = (wi.dot(qvec) / det).clamp(0.0, 1.0 - b1);
+        let point = o + b1 * a + b2 * b;
+        let error = gamma(6) * (o.abs() + (b1 * a).abs() + (b2 * b).abs());
+        let distance = (point - reference).length();
+        if !(distance > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        Some(LightSample {
+            point,
+            error,
+            normal: self.normal,
+            wi,
+            distance,
+            radiance: self.radiance,
+            pdf,
+            delta: false,
+        })
+    }
 }
 
 /// A point sampled on a light, seen from a shading point.
@@ -96,18 +163,9 @@ impl Light {
     /// Emitted power in luminance units, used to choose lights.
     pub fn power(&self) -> f32 {
         match *self {
-            Light::Triangle {
-                area,
-                radiance,
-                two_sided,
-                ..
+            Light::Triangle(p) | Light::Parallelogram(p) => {
+                luminance(p.radiance) * p.area * PI * if p.two_sided { 2.0 } else { 1.0 }
             }
-            | Light::Parallelogram {
-                area,
-                radiance,
-                two_sided,
-                ..
-            } => luminance(radiance) * area * PI * if two_sided { 2.0 } else { 1.0 },
             Light::Sphere {
                 radius,
                 radiance,
@@ -130,42 +188,20 @@ impl Light {
     #[inline]
     fn sample(&self, reference: Vec3A, u: Vec2) -> Option<LightSample> {
         match *self {
-            Light::Triangle {
-                p0,
-                e1,
-                e2,
-                normal,
-                area,
-                radiance,
-                two_sided,
-                sampling,
-            } => {
-                if sampling == LightSampling::SolidAngle {
-                    let vertices = [p0, p0 + e1, p0 + e2];
-                    let omega = spherical_triangle::solid_angle(reference, vertices);
-                    if spherical_triangle::usable(omega) {
-                        return triangle_solid_angle_sample(
-                            reference, p0, e1, e2, normal, radiance, two_sided, u,
-                        );
+            Light::Triangle(p) => {
+                if p.sampling == LightSampling::SolidAngle {
+                    let vertices = [p.p0, p.p0 + p.e1, p.p0 + p.e2];
+                    if spherical_triangle::usable(spherical_triangle::solid_angle(
+                        reference, vertices,
+                    )) {
+                        return p.solid_angle_sample(reference, (p.p0, p.e1, p.e2), u);
                     }
                 }
-                let b = square_to_uniform_triangle(u);
-                let point = p0 + b.x * e1 + b.y * e2;
-                let error = gamma(6) * (p0.abs() + (b.x * e1).abs() + (b.y * e2).abs());
-                area_sample(reference, point, error, normal, area, radiance, two_sided)
+                p.area_sample(reference, square_to_uniform_triangle(u))
             }
-            Light::Parallelogram {
-                p0,
-                e1,
-                e2,
-                normal,
-                area,
-                radiance,
-                two_sided,
-                sampling,
-            } => {
-                if sampling == LightSampling::SolidAngle
-                    && let Some(omegas) = parallelogram_solid_angles(reference, p0, e1, e2)
+            Light::Parallelogram(p) => {
+                if p.sampling == LightSampling::SolidAngle
+                    && let Some(omegas) = parallelogram_solid_angles(reference, &p)
                 {
                     // Uniform over the union of the halves' spherical
                     // triangles: a half in proportion to its solid angle.
@@ -176,24 +212,13 @@ impl Light {
                     } else {
                         (1, (u.x - split) / (1.0 - split))
                     };
-                    let [q0, q1, q2] = parallelogram_halves(p0, e1, e2)[half];
                     let u = Vec2::new(ux.min(ONE_MINUS_EPSILON), u.y);
-                    let mut s = triangle_solid_angle_sample(
-                        reference,
-                        q0,
-                        q1 - q0,
-                        q2 - q0,
-                        normal,
-                        radiance,
-                        two_sided,
-                        u,
-                    )?;
+                    let mut s =
+                        p.solid_angle_sample(reference, parallelogram_halves(&p)[half], u)?;
                     s.pdf = 1.0 / total;
                     return Some(s);
                 }
-                let point = p0 + u.x * e1 + u.y * e2;
-                let error = gamma(6) * (p0.abs() + (u.x * e1).abs() + (u.y * e2).abs());
-                area_sample(reference, point, error, normal, area, radiance, two_sided)
+                p.area_sample(reference, u)
             }
             Light::Sphere {
                 center,
@@ -274,36 +299,25 @@ impl Light {
         let dist2 = to_light.length_squared();
         let cos_light = normal.dot(to_light).abs() / dist2.sqrt();
         match *self {
-            Light::Triangle {
-                p0,
-                e1,
-                e2,
-                area,
-                sampling,
-                ..
-            } => {
-                if sampling == LightSampling::SolidAngle {
-                    let omega = spherical_triangle::solid_angle(reference, [p0, p0 + e1, p0 + e2]);
+            Light::Triangle(p) => {
+                if p.sampling == LightSampling::SolidAngle {
+                    let omega = spherical_triangle::solid_angle(
+                        reference,
+                        [p.p0, p.p0 + p.e1, p.p0 + p.e2],
+                    );
                     if spherical_triangle::usable(omega) {
                         return 1.0 / omega;
                     }
                 }
-                dist2 / (cos_light * area)
+                dist2 / (cos_light * p.area)
             }
-            Light::Parallelogram {
-                p0,
-                e1,
-                e2,
-                area,
-                sampling,
-                ..
-            } => {
-                if sampling == LightSampling::SolidAngle
-                    && let Some(omegas) = parallelogram_solid_angles(reference, p0, e1, e2)
+            Light::Parallelogram(p) => {
+                if p.sampling == LightSampling::SolidAngle
+                    && let Some(omegas) = parallelogram_solid_angles(reference, &p)
                 {
                     return 1.0 / (omegas[0] + omegas[1]);
                 }
-                dist2 / (cos_light * area)
+                dist2 / (cos_light * p.area)
             }
             Light::Sphere {
                 center,
@@ -325,76 +339,24 @@ impl Light {
     }
 }
 
-/// The two triangles of a parallelogram, split along the diagonal e1 - e2.
+/// The two triangles of a parallelogram, split along the diagonal e1 - e2,
+/// each as (corner, edge, edge).
 #[inline]
-fn parallelogram_halves(p0: Vec3A, e1: Vec3A, e2: Vec3A) -> [[Vec3A; 3]; 2] {
-    [[p0, p0 + e1, p0 + e2], [p0 + e1 + e2, p0 + e2, p0 + e1]]
+fn parallelogram_halves(p: &PlanarEmitter) -> [(Vec3A, Vec3A, Vec3A); 2] {
+    [(p.p0, p.e1, p.e2), (p.p0 + p.e1 + p.e2, -p.e1, -p.e2)]
 }
 
 /// The solid angles of a parallelogram's halves seen from `reference`, when
 /// spherical-triangle sampling is accurate for both; else `None` (area
 /// sampling), the same decision in `sample` and `pdf`.
 #[inline]
-fn parallelogram_solid_angles(
-    reference: Vec3A,
-    p0: Vec3A,
-    e1: Vec3A,
-    e2: Vec3A,
-) -> Option<[f32; 2]> {
-    let omegas =
-        parallelogram_halves(p0, e1, e2).map(|v| spherical_triangle::solid_angle(reference, v));
+fn parallelogram_solid_angles(reference: Vec3A, p: &PlanarEmitter) -> Option<[f32; 2]> {
+    let omegas = parallelogram_halves(p)
+        .map(|(o, a, b)| spherical_triangle::solid_angle(reference, [o, o + a, o + b]));
     omegas
         .iter()
         .all(|&omega| spherical_triangle::usable(omega))
         .then_some(omegas)
-}
-
-/// A direction uniform in the solid angle of a triangle light, with the point
-/// where it meets the triangle (found as barycentrics, so that the point lies
-/// on the triangle with the usual error bound).
-#[allow(clippy::too_many_arguments)]
-#[inline]
-fn triangle_solid_angle_sample(
-    reference: Vec3A,
-    p0: Vec3A,
-    e1: Vec3A,
-    e2: Vec3A,
-    normal: Vec3A,
-    radiance: Rgb,
-    two_sided: bool,
-    u: Vec2,
-) -> Option<LightSample> {
-    let (wi, pdf) = spherical_triangle::sample(reference, [p0, p0 + e1, p0 + e2], u)?;
-    let cos_light = -normal.dot(wi);
-    if !(cos_light > 0.0 || (two_sided && cos_light < 0.0)) {
-        return None;
-    }
-    // Möller-Trumbore for the barycentrics of the hit of reference + t wi.
-    let pvec = wi.cross(e2);
-    let det = e1.dot(pvec);
-    if det == 0.0 {
-        return None;
-    }
-    let tvec = reference - p0;
-    let b1 = (tvec.dot(pvec) / det).clamp(0.0, 1.0);
-    let qvec = tvec.cross(e1);
-    let b2 = (wi.dot(qvec) / det).clamp(0.0, 1.0 - b1);
-    let point = p0 + b1 * e1 + b2 * e2;
-    let error = gamma(6) * (p0.abs() + (b1 * e1).abs() + (b2 * e2).abs());
-    let distance = (point - reference).length();
-    if !(distance > 0.0 && pdf.is_finite()) {
-        return None;
-    }
-    Some(LightSample {
-        point,
-        error,
-        normal,
-        wi,
-        distance,
-        radiance,
-        pdf,
-        delta: false,
-    })
 }
 
 /// Rounding error bound of a point re-projected onto a sphere (pbrt-v4
@@ -511,35 +473,14 @@ impl Light {
     #[inline]
     fn sample_emission(&self, u_position: Vec2, u_direction: Vec2) -> Option<EmissionSample> {
         let (point, error, normal, area, radiance, two_sided) = match *self {
-            Light::Triangle {
-                p0,
-                e1,
-                e2,
-                normal,
-                area,
-                radiance,
-                two_sided,
-                ..
-            } => {
-                let b = square_to_uniform_triangle(u_position);
-                let point = p0 + b.x * e1 + b.y * e2;
-                let error = gamma(6) * (p0.abs() + (b.x * e1).abs() + (b.y * e2).abs());
-                (point, error, normal, area, radiance, two_sided)
-            }
-            Light::Parallelogram {
-                p0,
-                e1,
-                e2,
-                normal,
-                area,
-                radiance,
-                two_sided,
-                ..
-            } => {
-                let u = u_position;
-                let point = p0 + u.x * e1 + u.y * e2;
-                let error = gamma(6) * (p0.abs() + (u.x * e1).abs() + (u.y * e2).abs());
-                (point, error, normal, area, radiance, two_sided)
+            Light::Triangle(p) | Light::Parallelogram(p) => {
+                let b = if matches!(self, Light::Triangle(_)) {
+                    square_to_uniform_triangle(u_position)
+                } else {
+                    u_position
+                };
+                let (point, error) = p.point(b);
+                (point, error, p.normal, p.area, p.radiance, p.two_sided)
             }
             Light::Sphere {
                 center,
@@ -621,11 +562,10 @@ impl Lights {
     pub fn with_sampling(&self, mode: LightSampling) -> Lights {
         let mut lights = self.lights.clone();
         for light in &mut lights {
-            if let Light::Triangle { sampling, .. }
-            | Light::Parallelogram { sampling, .. }
-            | Light::Sphere { sampling, .. } = light
-            {
-                *sampling = mode;
+            match light {
+                Light::Triangle(p) | Light::Parallelogram(p) => p.sampling = mode,
+                Light::Sphere { sampling, .. } => *sampling = mode,
+                Light::Point { .. } => {}
             }
         }
         Lights {

@@ -15,7 +15,7 @@ use crate::math::OffsetMode;
 use camera::Camera;
 use emitters::EmitterShape;
 use glam::Vec3A;
-use light::{Light, LightSampling, Lights};
+use light::{Light, LightSampling, Lights, PlanarEmitter};
 use material::{Bsdf, Material};
 use std::path::Path;
 use std::sync::Arc;
@@ -302,7 +302,7 @@ impl Scene {
                     let (e1, e2) = (p1 - p0, p2 - p0);
                     let cross = e1.cross(e2);
                     geometry.set_triangle_light(i, lights.len() as u32);
-                    Light::Triangle {
+                    Light::Triangle(PlanarEmitter {
                         p0,
                         e1,
                         e2,
@@ -311,7 +311,7 @@ impl Scene {
                         radiance,
                         two_sided,
                         sampling,
-                    }
+                    })
                 }
                 EmitterShape::Parallelogram {
                     triangles,
@@ -323,7 +323,7 @@ impl Scene {
                     for i in triangles {
                         geometry.set_triangle_light(i, lights.len() as u32);
                     }
-                    Light::Parallelogram {
+                    Light::Parallelogram(PlanarEmitter {
                         p0,
                         e1,
                         e2,
@@ -332,7 +332,7 @@ impl Scene {
                         radiance,
                         two_sided,
                         sampling,
-                    }
+                    })
                 }
             };
             lights.push(light);
