@@ -288,54 +288,40 @@ impl Scene {
         let shapes = emitters::group_emitters(geometry.triangles(), &emissive, |i| {
             geometry.triangle_material(i)
         });
-        for shape in shapes {
-            let first = match shape {
-                EmitterShape::Triangle(i) => i,
-                EmitterShape::Parallelogram { triangles, .. } => triangles[0],
-            };
-            let material = &input.materials[geometry.triangle_material(first) as usize];
-            let (radiance, two_sided) = (material.emission, material.two_sided_emission);
-            let sampling = input.triangle_sampling;
-            let light = match shape {
+        for shape in &shapes {
+            // The triangles the light is made of, its corner and edges, and
+            // its area as a fraction of |e1 x e2|.
+            let (members, [p0, e1, e2], fraction) = match shape {
                 EmitterShape::Triangle(i) => {
-                    let [p0, p1, p2] = geometry.triangles()[i];
-                    let (e1, e2) = (p1 - p0, p2 - p0);
-                    let cross = e1.cross(e2);
-                    geometry.set_triangle_light(i, lights.len() as u32);
-                    Light::Triangle(PlanarEmitter {
-                        p0,
-                        e1,
-                        e2,
-                        normal: cross.normalize(),
-                        area: 0.5 * cross.length(),
-                        radiance,
-                        two_sided,
-                        sampling,
-                    })
+                    let [p0, p1, p2] = geometry.triangles()[*i];
+                    (std::slice::from_ref(i), [p0, p1 - p0, p2 - p0], 0.5)
                 }
                 EmitterShape::Parallelogram {
                     triangles,
                     p0,
                     e1,
                     e2,
-                } => {
-                    let cross = e1.cross(e2);
-                    for i in triangles {
-                        geometry.set_triangle_light(i, lights.len() as u32);
-                    }
-                    Light::Parallelogram(PlanarEmitter {
-                        p0,
-                        e1,
-                        e2,
-                        normal: cross.normalize(),
-                        area: cross.length(),
-                        radiance,
-                        two_sided,
-                        sampling,
-                    })
-                }
+                } => (&triangles[..], [*p0, *e1, *e2], 1.0),
             };
-            lights.push(light);
+            let material = &input.materials[geometry.triangle_material(members[0]) as usize];
+            for &i in members {
+                geometry.set_triangle_light(i, lights.len() as u32);
+            }
+            let cross = e1.cross(e2);
+            let emitter = PlanarEmitter {
+                p0,
+                e1,
+                e2,
+                normal: cross.normalize(),
+                area: fraction * cross.length(),
+                radiance: material.emission,
+                two_sided: material.two_sided_emission,
+                sampling: input.triangle_sampling,
+            };
+            lights.push(match shape {
+                EmitterShape::Triangle(_) => Light::Triangle(emitter),
+                EmitterShape::Parallelogram { .. } => Light::Parallelogram(emitter),
+            });
         }
         for i in 0..geometry.spheres().len() {
             let s = geometry.spheres()[i];
