@@ -14,7 +14,9 @@ pub const LANES: usize = 8;
 pub type TriangleHit = (usize, f32, f32, f32);
 
 /// Up to eight triangles: `v[vertex][axis]`, one lane per triangle.
+/// Aligned to cache lines: 320 bytes, five lines, not six.
 #[derive(Clone, Debug)]
+#[repr(align(64))]
 pub struct Block {
     v: [[f32x8; 3]; 3],
     /// Index of the block's first triangle; its triangles are contiguous.

@@ -27,7 +27,10 @@ const LEAF_MAX: usize = LANES;
 /// A child reference: a node index, or a leaf block index with the top bit set.
 const LEAF_BIT: u32 = 1 << 31;
 
+/// Aligned to cache lines: 256 bytes are then exactly four lines, not five
+/// half-used ones (a `Vec` of 32-byte-aligned nodes may start mid-line).
 #[derive(Clone, Debug)]
+#[repr(align(64))]
 struct Node {
     boxes: Boxes8,
     children: [u32; LANES],
