@@ -119,8 +119,8 @@ impl Block {
 /// Eight axis-aligned boxes, one lane each.
 #[derive(Clone, Debug)]
 pub struct Boxes8 {
-    min: [f32x8; 3],
-    max: [f32x8; 3],
+    /// The six bounding planes: min x, y, z, then max x, y, z.
+    planes: [f32x8; 6],
     /// Bit i set when lane i holds a box.
     lanes: u32,
 }
@@ -137,9 +137,9 @@ impl Boxes8 {
                 max[axis][lane] = hi[axis];
             }
         }
+        let [min, max] = [min, max].map(|planes| planes.map(f32x8::new));
         Boxes8 {
-            min: min.map(f32x8::new),
-            max: max.map(f32x8::new),
+            planes: [min[0], min[1], min[2], max[0], max[1], max[2]],
             lanes: (1u32 << boxes.len()) - 1,
         }
     }
@@ -192,9 +192,13 @@ impl Axes {
 /// because the triangle soup tests no boxes: its three divisions were 6% of
 /// a Cornell box render there.
 pub struct SlabAxes {
+    /// Per axis, the index in [`Boxes8`]'s planes of the plane the ray
+    /// enters by (min for a positive direction) and of the one it leaves by.
+    near: [usize; 3],
+    far: [usize; 3],
     origin: [f32x8; 3],
     inv_direction: [f32x8; 3],
-    /// Some direction component is zero (its reciprocal infinite).
+    /// Some reciprocal of a direction component is infinite.
     zero_direction: bool,
 }
 
@@ -202,10 +206,17 @@ impl SlabAxes {
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
         let (o, d) = (ray.origin, ray.direction);
+        let inv = d.recip();
+        // By the sign bit: a direction component of -0 has reciprocal -inf,
+        // for which the max plane is entered first, as for any negative one.
+        let negative = |axis: usize| usize::from(d[axis].is_sign_negative());
         SlabAxes {
+            near: [0, 1, 2].map(|axis| axis + 3 * negative(axis)),
+            far: [0, 1, 2].map(|axis| axis + 3 * (1 - negative(axis))),
             origin: [0, 1, 2].map(|axis| f32x8::splat(o[axis])),
-            inv_direction: [0, 1, 2].map(|axis| f32x8::splat(1.0 / d[axis])),
-            zero_direction: d.cmpeq(Vec3A::ZERO).any(),
+            inv_direction: [0, 1, 2].map(|axis| f32x8::splat(inv[axis])),
+            // Zero or subnormal components: their reciprocal overflows.
+            zero_direction: !inv.is_finite(),
         }
     }
 
@@ -221,10 +232,12 @@ impl SlabAxes {
         let mut t_far = f32x8::splat(t_max);
         let widen = f32x8::splat(1.0 + 2.0 * gamma(3));
         for axis in 0..3 {
-            let t0 = (boxes.min[axis] - self.origin[axis]) * self.inv_direction[axis];
-            let t1 = (boxes.max[axis] - self.origin[axis]) * self.inv_direction[axis];
-            let near = t_near.fast_max(t0.fast_min(t1));
-            let far = t_far.fast_min(t0.fast_max(t1) * widen);
+            // The direction's sign says which plane is entered first, so no
+            // min and max of the two distances are needed.
+            let t0 = (boxes.planes[self.near[axis]] - self.origin[axis]) * self.inv_direction[axis];
+            let t1 = (boxes.planes[self.far[axis]] - self.origin[axis]) * self.inv_direction[axis];
+            let near = t_near.fast_max(t0);
+            let far = t_far.fast_min(t1 * widen);
             // NaN needs an infinite reciprocal: only rays with a zero
             // direction component pay for the check (a predictable branch).
             if self.zero_direction {
