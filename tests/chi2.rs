@@ -18,8 +18,8 @@ use tracelab::sampling::warp::*;
 use tracelab::scene::light::{Light, LightSampling, Lights, PlanarEmitter};
 use tracelab::scene::material::{Bsdf, fresnel_dielectric};
 
-/// Number of `assert_fits` calls below.
-const TESTS_IN_FILE: f64 = 26.0;
+/// Number of `assert_fits` calls below (the significance is split over them).
+const TESTS_IN_FILE: f64 = 28.0;
 const COS_BINS: usize = 20;
 const PHI_BINS: usize = 40;
 const SUBDIVISIONS: usize = 16;
@@ -351,36 +351,52 @@ fn check_light(name: &str, seed: u64, reference: Vec3A, lights: &Lights, geometr
     );
 }
 
+/// Where the light tests look from: below the emitters of the two helpers.
+const LIGHT_TEST_REFERENCE: Vec3A = Vec3A::new(0.2, -0.1, 0.0);
+
+/// A flat emitter of radiance 1 spanned by `e1`, `e2` from `p0`, facing down
+/// towards [`LIGHT_TEST_REFERENCE`], with area `fraction` |e1 x e2|; and the
+/// geometry of `triangles`, to find where a direction lands on it.
+fn emitter_above(
+    p0: Vec3A,
+    e1: Vec3A,
+    e2: Vec3A,
+    fraction: f32,
+    sampling: LightSampling,
+    triangles: &[[Vec3A; 3]],
+) -> (PlanarEmitter, Geometry) {
+    let facing = e1.cross(e2).normalize();
+    let emitter = PlanarEmitter {
+        p0,
+        e1,
+        e2,
+        normal: -facing * facing.z.signum(),
+        area: fraction * e1.cross(e2).length(),
+        radiance: Rgb::ONE,
+        two_sided: false,
+        sampling,
+    };
+    let inputs: Vec<TriangleInput> = triangles
+        .iter()
+        .map(|&vertices| TriangleInput {
+            vertices,
+            material: 0,
+        })
+        .collect();
+    (emitter, Geometry::build(&inputs, vec![]))
+}
+
 /// A reference point, a big emissive triangle above it, and the lights and
 /// geometry to find where a direction lands on it.
 fn triangle_light(sampling: LightSampling) -> (Vec3A, Lights, Geometry) {
-    let reference = Vec3A::new(0.2, -0.1, 0.0);
     let [p0, p1, p2] = [
         Vec3A::new(-1.0, -1.5, 0.8),
         Vec3A::new(1.5, -0.5, 1.2),
         Vec3A::new(-0.5, 1.5, 0.5),
     ];
-    let (e1, e2) = (p1 - p0, p2 - p0);
-    // Facing down, towards the reference point.
-    let normal = -e1.cross(e2).normalize() * e1.cross(e2).normalize().z.signum();
-    let light = Light::Triangle(PlanarEmitter {
-        p0,
-        e1,
-        e2,
-        normal,
-        area: 0.5 * e1.cross(e2).length(),
-        radiance: Rgb::ONE,
-        two_sided: false,
-        sampling,
-    });
-    let geometry = Geometry::build(
-        &[TriangleInput {
-            vertices: [p0, p1, p2],
-            material: 0,
-        }],
-        vec![],
-    );
-    (reference, Lights::new(vec![light]), geometry)
+    let (emitter, geometry) = emitter_above(p0, p1 - p0, p2 - p0, 0.5, sampling, &[[p0, p1, p2]]);
+    let lights = Lights::new(vec![Light::Triangle(emitter)]);
+    (LIGHT_TEST_REFERENCE, lights, geometry)
 }
 
 #[test]
@@ -414,36 +430,13 @@ fn triangle_light_spherical_triangle_sampling() {
 /// A reference point and a big emissive parallelogram above it, as two
 /// triangles for the geometry and one light.
 fn parallelogram_light(sampling: LightSampling) -> (Vec3A, Lights, Geometry) {
-    let reference = Vec3A::new(0.2, -0.1, 0.0);
     let p0 = Vec3A::new(-1.0, -1.5, 0.8);
     let (e1, e2) = (Vec3A::new(2.5, 0.5, 0.2), Vec3A::new(0.3, 2.5, -0.4));
-    let facing = e1.cross(e2).normalize();
-    let light = Light::Parallelogram(PlanarEmitter {
-        p0,
-        e1,
-        e2,
-        // Facing down, towards the reference point.
-        normal: -facing * facing.z.signum(),
-        area: e1.cross(e2).length(),
-        radiance: Rgb::ONE,
-        two_sided: false,
-        sampling,
-    });
     let corner = p0 + e1 + e2;
-    let geometry = Geometry::build(
-        &[
-            TriangleInput {
-                vertices: [p0, p0 + e1, p0 + e2],
-                material: 0,
-            },
-            TriangleInput {
-                vertices: [corner, p0 + e2, p0 + e1],
-                material: 0,
-            },
-        ],
-        vec![],
-    );
-    (reference, Lights::new(vec![light]), geometry)
+    let halves = [[p0, p0 + e1, p0 + e2], [corner, p0 + e2, p0 + e1]];
+    let (emitter, geometry) = emitter_above(p0, e1, e2, 1.0, sampling, &halves);
+    let lights = Lights::new(vec![Light::Parallelogram(emitter)]);
+    (LIGHT_TEST_REFERENCE, lights, geometry)
 }
 
 #[test]
