@@ -158,7 +158,13 @@ impl PathTracer {
             // traced: their hash chains then overlap with the traversal
             // instead of stalling the light sample after it.
             let vertex_dim = sampler.reserve(5);
-            let u_light_select = sampler.get_1d_for(vertex_dim, Domain::Light);
+            // One light needs no choice (the Cornell box): skipping that
+            // number leaves the image bit-identical.
+            let u_light_select = if scene.lights.has_choice() {
+                sampler.get_1d_for(vertex_dim, Domain::Light)
+            } else {
+                0.0
+            };
             let u_light = sampler.get_2d_for(vertex_dim + 1, Domain::Light);
             let u_bsdf = sampler.get_2d_for(vertex_dim + 3, Domain::Bsdf);
             let Some(hit) = scene.geometry.intersect(&ray) else {

@@ -590,6 +590,12 @@ impl Lights {
         self.selection.is_none()
     }
 
+    /// True when sampling chooses between lights: with one light the
+    /// choice's random number is not read, so callers may skip drawing it.
+    pub fn has_choice(&self) -> bool {
+        self.lights.len() > 1
+    }
+
     /// Chooses a light with `u_select` and a point on it with `u`, for next-event
     /// estimation from `reference`. The pdf includes the selection probability.
     #[inline]
