@@ -209,6 +209,7 @@ impl Session {
                     self.film.width(),
                     self.film.height(),
                     budget,
+                    crate::allocation::variance_exponent(self.settings.sampler),
                     key,
                 ))
             });
