@@ -320,9 +320,11 @@ impl Geometry {
         }
     }
 
-    /// Stores the triangles in input order and tests them all, as a soup.
+    /// Stores the triangles for a soup (those in a face of their bounding
+    /// box last) and tests them all.
     fn store_soup(&mut self, triangles: &[TriangleInput]) {
-        self.store_in_order(triangles, 0..triangles.len());
+        let vertices: Vec<[Vec3A; 3]> = triangles.iter().map(|t| t.vertices).collect();
+        self.store_in_order(triangles, TriangleSoup::order(&vertices));
         self.tri_index = TriangleIndex::Soup(TriangleSoup::new(&self.tri_vertices));
     }
 
