@@ -232,6 +232,14 @@ impl Session {
                 .tiles()
                 .par_iter()
                 .enumerate()
+                // One job per tile, so an idle thread can take any tile not
+                // started. Left to itself rayon runs quarters of the tile
+                // list as unsplittable runs once nothing is stolen early:
+                // with samples spread by noise one thread then rendered a
+                // run of heavy tiles alone while the other waited (2 threads:
+                // 99% of the passes' CPU time busy with Neyman shares, 80%
+                // with the variance^2/5 ones).
+                .with_max_len(1)
                 .for_each(|(index, tile)| {
                     if index as u32 % parts != part || self.cancelled.load(Ordering::Relaxed) {
                         return;
@@ -298,36 +306,40 @@ impl Session {
         let (width, height) = (self.film.width(), self.film.height());
         let splats = SplatBuffer::new(width, height);
         self.pool.install(|| {
-            self.film.tiles().par_iter().for_each(|tile| {
-                if self.cancelled.load(Ordering::Relaxed) {
-                    return;
-                }
-                let (x0, y0, tile_width, tile_height) = {
-                    let t = tile.lock().unwrap_or_else(|e| e.into_inner());
-                    (t.x0, t.y0, t.width, t.height)
-                };
-                let mut sampler =
-                    Sampler::new(settings.sampler, settings.seed, settings.planned_spp)
-                        .with_domains(settings.domains);
-                let mut counts = RayCounts::default();
-                let mut non_finite = 0u64;
-                for i in 0..tile_width * tile_height {
-                    let (x, y) = (x0 + i % tile_width, y0 + i / tile_width);
-                    for s in first..first + spp {
-                        sampler.start(y * width + x, s);
-                        tracer.trace_particle(scene, &mut sampler, &mut counts, |splat| {
-                            if !splats.add(splat.film, splat.value) {
-                                non_finite += 1;
-                            }
-                        });
+            self.film
+                .tiles()
+                .par_iter()
+                .with_max_len(1)
+                .for_each(|tile| {
+                    if self.cancelled.load(Ordering::Relaxed) {
+                        return;
                     }
-                }
-                self.add_counts(
-                    u64::from(tile_width * tile_height * spp),
-                    &counts,
-                    non_finite,
-                );
-            });
+                    let (x0, y0, tile_width, tile_height) = {
+                        let t = tile.lock().unwrap_or_else(|e| e.into_inner());
+                        (t.x0, t.y0, t.width, t.height)
+                    };
+                    let mut sampler =
+                        Sampler::new(settings.sampler, settings.seed, settings.planned_spp)
+                            .with_domains(settings.domains);
+                    let mut counts = RayCounts::default();
+                    let mut non_finite = 0u64;
+                    for i in 0..tile_width * tile_height {
+                        let (x, y) = (x0 + i % tile_width, y0 + i / tile_width);
+                        for s in first..first + spp {
+                            sampler.start(y * width + x, s);
+                            tracer.trace_particle(scene, &mut sampler, &mut counts, |splat| {
+                                if !splats.add(splat.film, splat.value) {
+                                    non_finite += 1;
+                                }
+                            });
+                        }
+                    }
+                    self.add_counts(
+                        u64::from(tile_width * tile_height * spp),
+                        &counts,
+                        non_finite,
+                    );
+                });
         });
         if self.cancelled.load(Ordering::Relaxed) {
             return;
