@@ -23,6 +23,9 @@ use std::f32::consts::FRAC_1_PI;
 /// empty default and the render uses [`NoObserver`], a zero-sized type, so
 /// the observed loop compiles to the plain one.
 pub trait PathObserver {
+    /// Events in path order: each shadow ray is traced when its light sample
+    /// is drawn. Ordinary rendering defers it until the next ray is known.
+    const IN_ORDER: bool = true;
     /// The path reached vertex `bounce` (0 = first hit) with throughput `beta`.
     fn vertex(&mut self, _bounce: u32, _hit: &SurfaceHit, _beta: Rgb) {}
     /// Emission found at the vertex, its MIS weight and what it added.
@@ -49,7 +52,49 @@ pub trait PathObserver {
 /// The observer of ordinary rendering: hears nothing.
 pub struct NoObserver;
 
-impl PathObserver for NoObserver {}
+impl PathObserver for NoObserver {
+    const IN_ORDER: bool = false;
+}
+
+/// A light sample whose shadow ray is still to be traced.
+struct PendingShadow {
+    ray: Ray,
+    ls: LightSample,
+    f: Rgb,
+    weight: f32,
+    /// What the sample adds when the light is visible.
+    added: Rgb,
+}
+
+impl PendingShadow {
+    /// What the sample adds, given whether its shadow ray got through.
+    #[inline(always)]
+    fn finish<O: PathObserver>(
+        self,
+        visible: bool,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> Rgb {
+        counts.shadow += 1;
+        let added = if visible { self.added } else { Rgb::ZERO };
+        observer.light_sample(&self.ls, self.f, self.weight, visible, added);
+        added
+    }
+
+    /// Traces the shadow ray, if any: what it adds.
+    #[inline(always)]
+    fn trace<O: PathObserver>(
+        pending: Option<Self>,
+        scene: &Scene,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> Rgb {
+        pending.map_or(Rgb::ZERO, |shadow| {
+            let visible = !scene.geometry.occluded(&shadow.ray);
+            shadow.finish(visible, counts, observer)
+        })
+    }
+}
 
 /// Settings of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -207,6 +252,11 @@ impl PathTracer {
                 sampler.get_1d_for(vertex_dim + 2, Domain::Bsdf)
             };
 
+            // The shadow ray is traced once the next ray is known, next to
+            // that ray's traversal: the two are independent, and with no
+            // shading between them the core overlaps them (Cornell box,
+            // Sobol: 3.45 -> 3.61 M paths/s; independent: 3.80 -> 4.07).
+            let mut pending = None;
             if self.nee && !(SPECULAR && bsdf.is_specular()) {
                 if let Some(ls) = scene.lights.sample(hit.point, u_light_select, u_light) {
                     let wi = frame.to_local(ls.wi);
@@ -217,20 +267,27 @@ impl PathTracer {
                         } else {
                             self.mis.weight(ls.pdf, pdf::<DIFFUSE_ONLY>(&bsdf, wo, wi))
                         };
-                        counts.shadow += 1;
-                        let visible = !scene.geometry.occluded(&shadow_ray(&hit, &ls));
-                        let added = if visible {
-                            beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf)
-                        } else {
-                            Rgb::ZERO
+                        let shadow = PendingShadow {
+                            ray: shadow_ray(&hit, &ls),
+                            added: beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf),
+                            ls,
+                            f,
+                            weight,
                         };
-                        radiance += added;
-                        observer.light_sample(&ls, f, weight, visible, added);
+                        // An observer hears of the light sample before the
+                        // bounce; the image is the same either way.
+                        if O::IN_ORDER {
+                            let visible = !scene.geometry.occluded(&shadow.ray);
+                            radiance += shadow.finish(visible, counts, observer);
+                        } else {
+                            pending = Some(shadow);
+                        }
                     }
                 }
             }
 
             let Some(sample) = sample::<DIFFUSE_ONLY>(&bsdf, wo, u_lobe, u_bsdf) else {
+                radiance += PendingShadow::trace(pending, scene, counts, observer);
                 break;
             };
             observer.bsdf_sample(&sample);
@@ -246,16 +303,19 @@ impl PathTracer {
                 let survived = survives_roulette(&mut beta, u_roulette);
                 observer.roulette(q, survived);
                 if !survived {
+                    radiance += PendingShadow::trace(pending, scene, counts, observer);
                     break;
                 }
             }
             if beta.max_element() <= 0.0 {
+                radiance += PendingShadow::trace(pending, scene, counts, observer);
                 break;
             }
 
             let wi_world = frame.to_world(sample.wi);
             ray = hit.spawn_ray(wi_world);
             counts.bounce += 1;
+            radiance += PendingShadow::trace(pending, scene, counts, observer);
         }
         radiance
     }
