@@ -388,6 +388,41 @@ fn unreadable_reference_images_are_named() {
 }
 
 #[test]
+fn bench_plots_are_png_or_svg_by_extension() {
+    let dir = temp_dir("cli-bench-plots");
+    let scene = repo_path("scenes/cornell_box.toml");
+    let reference = repo_path("tests/data/cornell_box_path_ref.exr");
+    let (png, svg) = (dir.join("rmse.png"), dir.join("rmse.svg"));
+    let bench = |plot: &Path, plot_time: &Path| {
+        tracelab(&[
+            "bench",
+            scene.to_str().unwrap(),
+            "--reference",
+            reference.to_str().unwrap(),
+            "--config",
+            "path:sobol",
+            "--max-spp",
+            "2",
+            "--plot",
+            plot.to_str().unwrap(),
+            "--plot-time",
+            plot_time.to_str().unwrap(),
+        ])
+    };
+    let o = bench(&png, &svg);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&png).unwrap();
+    assert!(bytes.starts_with(b"\x89PNG"), "a PNG, not SVG text");
+    assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
+    // Another extension fails before any rendering, naming the file.
+    let jpg = dir.join("rmse.jpg");
+    let o = bench(&jpg, &svg);
+    assert_fails(&o, 1, &["rmse.jpg", ".svg or .png"]);
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("measuring"));
+    assert!(!jpg.exists());
+}
+
+#[test]
 fn malformed_mtl_statements_name_file_and_line() {
     let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n";
     let mtl = "newmtl a\nKs 0.1 0.1 0.1\nKd 0.5\n";

@@ -1,5 +1,5 @@
 //! `tracelab bench`: error against a reference at 1, 2, 4, ... spp for
-//! several configurations, as a table, CSV and log-log SVG plots.
+//! several configurations, as a table, CSV and log-log plots (SVG or PNG).
 
 use super::render::{override_resolution, render_spp};
 use clap::Args;
@@ -9,7 +9,7 @@ use tracelab::convergence::{
     BenchConfig, Checkpoint, StopAt, log_log_slope, mean_variance, measure, time_to_rmse,
 };
 use tracelab::image::{Image, check_writable};
-use tracelab::plot::{Series, log_log_svg};
+use tracelab::plot::{PlotFormat, Series, log_log_plot};
 use tracelab::render::{RenderSettings, Session};
 use tracelab::scene::{Limits, Scene};
 use tracelab::{Error, Result};
@@ -66,13 +66,13 @@ pub struct BenchArgs {
     /// CSV of every checkpoint.
     #[arg(long)]
     csv: Option<PathBuf>,
-    /// Log-log plot (SVG) of RMSE against samples per pixel.
+    /// Log-log plot of RMSE against samples per pixel (.svg or .png).
     #[arg(long)]
     plot: Option<PathBuf>,
-    /// Log-log plot (SVG) of RMSE against render time.
+    /// Log-log plot of RMSE against render time (.svg or .png).
     #[arg(long)]
     plot_time: Option<PathBuf>,
-    /// Log-log plot (SVG) of RMSE against rays per pixel (equal-cost comparison).
+    /// Log-log plot of RMSE against rays per pixel, an equal-cost comparison (.svg or .png).
     #[arg(long)]
     plot_rays: Option<PathBuf>,
     /// Title of the plots.
@@ -97,6 +97,14 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
         .flatten()
     {
         check_writable(path)?;
+    }
+    // A plot's format comes from its extension: a wrong one fails now, not
+    // after the renders.
+    for path in [&args.plot, &args.plot_time, &args.plot_rays]
+        .into_iter()
+        .flatten()
+    {
+        PlotFormat::of(path)?;
     }
     let mut scene = Scene::load(&args.scene)?;
     override_resolution(&mut scene, args.width, args.height, &Limits::default())?;
@@ -221,7 +229,7 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
                     points: points.iter().map(|p| (x(p), p.rmse)).collect(),
                 })
                 .collect();
-            log_log_svg(path, &args.title, x_label, "RMSE", &series)?;
+            log_log_plot(path, &args.title, x_label, "RMSE", &series)?;
             eprintln!("wrote {}", path.display());
         }
     }

@@ -27,7 +27,7 @@ enum Command {
     #[cfg(feature = "viewer")]
     View(ViewArgs),
     /// Measure error against a reference at 1, 2, 4, ... spp for several
-    /// configurations; print a table, write CSV and log-log plots (SVG).
+    /// configurations; print a table, write CSV and log-log plots (SVG or PNG).
     Bench(bench::BenchArgs),
     /// The numerical stress suite: scaled, far-away and awkward scenes against
     /// their references; exits non-zero when a case fails.
