@@ -144,29 +144,22 @@ impl Plot<'_> {
     where
         DB::ErrorType: 'static,
     {
-        let Plot {
-            title,
-            x_label,
-            y_label,
-            series,
-            range: (x0, x1, y0, y1),
-            guides,
-        } = *self;
+        let (x0, x1, y0, y1) = self.range;
         root.fill(&WHITE)?;
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
+            .caption(self.title, ("sans-serif", 20))
             .margin(12)
             .x_label_area_size(42)
             .y_label_area_size(64)
             .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
         chart
             .configure_mesh()
-            .x_desc(x_label)
-            .y_desc(y_label)
+            .x_desc(self.x_label)
+            .y_desc(self.y_label)
             .x_label_formatter(&|v| format_number(*v))
             .y_label_formatter(&|v| format_number(*v))
             .draw()?;
-        if let Some((gx, gy)) = guides {
+        if let Some((gx, gy)) = self.guides {
             for (name, slope) in [("1/sqrt(N)", -0.5), ("1/N", -1.0)] {
                 let end = (x1, gy * (x1 / gx).powf(slope));
                 chart
@@ -180,7 +173,7 @@ impl Plot<'_> {
                     });
             }
         }
-        for (i, s) in series.iter().enumerate() {
+        for (i, s) in self.series.iter().enumerate() {
             let color = PALETTE[i % PALETTE.len()];
             chart
                 .draw_series(LineSeries::new(
