@@ -67,21 +67,7 @@ struct PendingShadow {
 }
 
 impl PendingShadow {
-    /// What the sample adds, given whether its shadow ray got through.
-    #[inline(always)]
-    fn finish<O: PathObserver>(
-        self,
-        visible: bool,
-        counts: &mut RayCounts,
-        observer: &mut O,
-    ) -> Rgb {
-        counts.shadow += 1;
-        let added = if visible { self.added } else { Rgb::ZERO };
-        observer.light_sample(&self.ls, self.f, self.weight, visible, added);
-        added
-    }
-
-    /// Traces the shadow ray, if any: what it adds.
+    /// Traces the shadow ray, if any: what the light sample adds.
     #[inline(always)]
     fn trace<O: PathObserver>(
         pending: Option<Self>,
@@ -89,10 +75,14 @@ impl PendingShadow {
         counts: &mut RayCounts,
         observer: &mut O,
     ) -> Rgb {
-        pending.map_or(Rgb::ZERO, |shadow| {
-            let visible = !scene.geometry.occluded(&shadow.ray);
-            shadow.finish(visible, counts, observer)
-        })
+        let Some(shadow) = pending else {
+            return Rgb::ZERO;
+        };
+        counts.shadow += 1;
+        let visible = !scene.geometry.occluded(&shadow.ray);
+        let added = if visible { shadow.added } else { Rgb::ZERO };
+        observer.light_sample(&shadow.ls, shadow.f, shadow.weight, visible, added);
+        added
     }
 }
 
@@ -277,8 +267,7 @@ impl PathTracer {
                         // An observer hears of the light sample before the
                         // bounce; the image is the same either way.
                         if O::IN_ORDER {
-                            let visible = !scene.geometry.occluded(&shadow.ray);
-                            radiance += shadow.finish(visible, counts, observer);
+                            radiance += PendingShadow::trace(Some(shadow), scene, counts, observer);
                         } else {
                             pending = Some(shadow);
                         }
