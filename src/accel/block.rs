@@ -162,7 +162,8 @@ impl Axes {
         let d = ray.direction;
         let (kx, ky, kz) = permuted_axes(d);
         let shear = shear_factors(d, kx, ky, kz);
-        let o = ray.origin;
+        // Array indexing: glam's `Index` on Vec3A is a match per access.
+        let o = ray.origin.to_array();
         Axes {
             kx,
             ky,

@@ -445,7 +445,15 @@ impl Geometry {
     }
 
     /// Closest hit along `ray` in (0, ray.t_max), at `ray.time`.
-    #[inline]
+    ///
+    /// This, [`Geometry::occluded`], the sampler's draws and the light
+    /// sample are always inlined into the integrators' loops: LLVM kept
+    /// them out of line, and every call spilled the path's vector state (on
+    /// x86-64 all vector registers are caller-saved). Profile-guided
+    /// optimisation inlined them and ran 6-12% faster; inlining them by hand
+    /// cut callgrind's count on a Cornell box path from 7374 to 6859
+    /// instructions and gives most of that gain without a profile.
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
         let mut hit = self.intersect_all(ray);
         if let (OffsetMode::Fixed(_), Some(h)) = (self.offset, &mut hit) {
@@ -454,7 +462,7 @@ impl Geometry {
         hit
     }
 
-    #[inline]
+    #[inline(always)]
     fn intersect_all(&self, ray: &Ray) -> Option<SurfaceHit> {
         let mut best = self.intersect_static(ray);
         if self.moving.is_empty() {
@@ -479,7 +487,7 @@ impl Geometry {
     }
 
     /// Closest hit among the geometry at rest.
-    #[inline]
+    #[inline(always)]
     fn intersect_static(&self, ray: &Ray) -> Option<SurfaceHit> {
         let mut best_t = ray.t_max;
         let (mut best_tri, mut best_b1, mut best_b2) = (u32::MAX, 0.0, 0.0);
@@ -561,7 +569,7 @@ impl Geometry {
 
     /// True when anything blocks `ray` in (0, ray.t_max) at `ray.time`
     /// (shadow rays).
-    #[inline]
+    #[inline(always)]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.occluded_static(ray)
             || self.moving.iter().any(|m| {
@@ -572,7 +580,7 @@ impl Geometry {
             })
     }
 
-    #[inline]
+    #[inline(always)]
     fn occluded_static(&self, ray: &Ray) -> bool {
         let triangle_blocks = match &self.tri_index {
             TriangleIndex::Empty => false,

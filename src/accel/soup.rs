@@ -102,7 +102,7 @@ impl TriangleSoup {
     }
 
     /// Closest hit in (0, t_max).
-    #[inline]
+    #[inline(always)]
     pub fn closest(&self, ray: &Ray, t_max: f32, triangles: &[[Vec3A; 3]]) -> Option<TriangleHit> {
         let axes = Axes::new(ray);
         let mut best = None;
@@ -114,7 +114,7 @@ impl TriangleSoup {
     }
 
     /// True when any triangle is hit in (0, t_max).
-    #[inline]
+    #[inline(always)]
     pub fn any(&self, ray: &Ray, t_max: f32, triangles: &[[Vec3A; 3]]) -> bool {
         let axes = Axes::new(ray);
         let blocks = if self.inner_blocks < self.blocks.len() && self.segment_inside(ray, t_max) {
@@ -122,9 +122,12 @@ impl TriangleSoup {
         } else {
             &self.blocks[..]
         };
-        blocks
-            .iter()
-            .any(|block| block.any(&axes, ray, triangles, t_max))
+        for block in blocks {
+            if block.any(&axes, ray, triangles, t_max) {
+                return true;
+            }
+        }
+        false
     }
 }
 

@@ -23,7 +23,7 @@ pub struct ShearedRay {
 pub fn permuted_axes(d: Vec3A) -> (usize, usize, usize) {
     let kz = d.abs().max_position();
     let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
-    if d[kz] < 0.0 {
+    if d.to_array()[kz] < 0.0 {
         (ky, kx, kz)
     } else {
         (kx, ky, kz)
@@ -34,6 +34,7 @@ pub fn permuted_axes(d: Vec3A) -> (usize, usize, usize) {
 /// two products, the same in the scalar and the eight-lane test.
 #[inline(always)]
 pub fn shear_factors(d: Vec3A, kx: usize, ky: usize, kz: usize) -> (f32, f32, f32) {
+    let d = d.to_array();
     let sz = 1.0 / d[kz];
     (d[kx] * sz, d[ky] * sz, sz)
 }

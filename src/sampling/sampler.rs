@@ -236,7 +236,7 @@ impl Sampler {
 
     /// The number of dimension `dim` (one [`Sampler::skip`] returned) of
     /// the current sample: what [`Sampler::next_1d_for`] would have drawn.
-    #[inline]
+    #[inline(always)]
     pub fn get_1d_for(&self, dim: u32, domain: Domain) -> f32 {
         if self.domains.contains(domain) {
             self.get_1d(dim)
@@ -246,14 +246,14 @@ impl Sampler {
     }
 
     /// Two numbers in [0, 1)² for `domain` (see [`Sampler::next_1d_for`]).
-    #[inline]
+    #[inline(always)]
     pub fn next_2d_for(&mut self, domain: Domain) -> Vec2 {
         let dim = self.skip();
         self.get_2d_for(dim, domain)
     }
 
     /// The pair of dimension `dim` (see [`Sampler::get_1d_for`]).
-    #[inline]
+    #[inline(always)]
     pub fn get_2d_for(&self, dim: u32, domain: Domain) -> Vec2 {
         if self.domains.contains(domain) {
             self.get_2d(dim)
@@ -325,7 +325,7 @@ impl Sampler {
         laine_karras(self.reversed_index, seed).reverse_bits()
     }
 
-    #[inline]
+    #[inline(always)]
     fn get_1d(&self, dim: u32) -> f32 {
         if self.kind == SamplerKind::Sobol {
             let key = hash_combine(self.pixel_key, dim as u64);
@@ -342,7 +342,7 @@ impl Sampler {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn get_2d(&self, dim: u32) -> Vec2 {
         if self.kind == SamplerKind::Sobol {
             let key = hash_combine(self.pixel_key, dim as u64);

@@ -185,7 +185,7 @@ impl Light {
     }
 
     /// Samples a point on the light as seen from `reference`; `pdf` excludes selection.
-    #[inline]
+    #[inline(always)]
     fn sample(&self, reference: Vec3A, u: Vec2) -> Option<LightSample> {
         match *self {
             Light::Triangle(p) => {
@@ -598,10 +598,15 @@ impl Lights {
 
     /// Chooses a light with `u_select` and a point on it with `u`, for next-event
     /// estimation from `reference`. The pdf includes the selection probability.
-    #[inline]
+    #[inline(always)]
     pub fn sample(&self, reference: Vec3A, u_select: f32, u: Vec2) -> Option<LightSample> {
         let table = self.selection.as_ref()?;
-        let (index, pmf) = table.sample(u_select);
+        // One light needs no choice (the Cornell box); its pmf is 1.
+        let (index, pmf) = if self.has_choice() {
+            table.sample(u_select)
+        } else {
+            (0, table.pmf(0))
+        };
         let mut s = self.lights[index].sample(reference, u)?;
         s.pdf *= pmf;
         s.error = self.offset.spawn_error(s.error, s.normal);
