@@ -14,14 +14,14 @@ pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
     }
     // theta = pi/4 (y/x) in the left and right wedges, pi/2 - pi/4 (x/y) in
     // the others; cos(pi/2 - phi) = sin(phi) keeps the argument in
-    // [-pi/4, pi/4], where a short polynomial is exact to about an ulp.
-    if o.x.abs() > o.y.abs() {
-        let (sin, cos) = sin_cos_quarter_pi(FRAC_PI_4 * (o.y / o.x));
-        o.x * Vec2::new(cos, sin)
-    } else {
-        let (sin, cos) = sin_cos_quarter_pi(FRAC_PI_4 * (o.x / o.y));
-        o.y * Vec2::new(sin, cos)
-    }
+    // [-pi/4, pi/4], where a short polynomial is exact to about an ulp. The
+    // wedge is chosen by selects: a branch on it is a coin flip per bounce
+    // (callgrind: 1.7 mispredictions per Cornell box path).
+    let left_right = o.x.abs() > o.y.abs();
+    let (radius, across) = if left_right { (o.x, o.y) } else { (o.y, o.x) };
+    let (sin, cos) = sin_cos_quarter_pi(FRAC_PI_4 * (across / radius));
+    let (along_x, along_y) = if left_right { (cos, sin) } else { (sin, cos) };
+    radius * Vec2::new(along_x, along_y)
 }
 
 /// sin and cos of x in [-pi/4, pi/4] by the minimax polynomials of Cephes'
