@@ -24,7 +24,8 @@ use std::f32::consts::FRAC_1_PI;
 /// the observed loop compiles to the plain one.
 pub trait PathObserver {
     /// Events in path order: each shadow ray is traced when its light sample
-    /// is drawn. Ordinary rendering defers it until the next ray is known.
+    /// is drawn. Ordinary rendering (false) defers it until the next ray is
+    /// known and reports no light samples.
     const IN_ORDER: bool = true;
     /// The path reached vertex `bounce` (0 = first hit) with throughput `beta`.
     fn vertex(&mut self, _bounce: u32, _hit: &SurfaceHit, _beta: Rgb) {}
@@ -56,33 +57,29 @@ impl PathObserver for NoObserver {
     const IN_ORDER: bool = false;
 }
 
-/// A light sample whose shadow ray is still to be traced.
+/// A shadow ray still to be traced and what its light sample adds when the
+/// light is visible; only these two travel to where it is traced (the light
+/// sample itself is for observers, which trace it at once).
 struct PendingShadow {
     ray: Ray,
-    ls: LightSample,
-    f: Rgb,
-    weight: f32,
-    /// What the sample adds when the light is visible.
     added: Rgb,
 }
 
 impl PendingShadow {
-    /// Traces the shadow ray, if any: what the light sample adds.
+    /// Traces the shadow ray: whether the light is visible.
     #[inline(always)]
-    fn trace<O: PathObserver>(
-        pending: Option<Self>,
-        scene: &Scene,
-        counts: &mut RayCounts,
-        observer: &mut O,
-    ) -> Rgb {
-        let Some(shadow) = pending else {
-            return Rgb::ZERO;
-        };
+    fn visible(&self, scene: &Scene, counts: &mut RayCounts) -> bool {
         counts.shadow += 1;
-        let visible = !scene.geometry.occluded(&shadow.ray);
-        let added = if visible { shadow.added } else { Rgb::ZERO };
-        observer.light_sample(&shadow.ls, shadow.f, shadow.weight, visible, added);
-        added
+        !scene.geometry.occluded(&self.ray)
+    }
+
+    /// What a deferred light sample adds, if there is one.
+    #[inline(always)]
+    fn trace(pending: Option<Self>, scene: &Scene, counts: &mut RayCounts) -> Rgb {
+        match pending {
+            Some(shadow) if shadow.visible(scene, counts) => shadow.added,
+            _ => Rgb::ZERO,
+        }
     }
 }
 
@@ -260,14 +257,14 @@ impl PathTracer {
                         let shadow = PendingShadow {
                             ray: shadow_ray(&hit, &ls),
                             added: beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf),
-                            ls,
-                            f,
-                            weight,
                         };
                         // An observer hears of the light sample before the
                         // bounce; the image is the same either way.
                         if O::IN_ORDER {
-                            radiance += PendingShadow::trace(Some(shadow), scene, counts, observer);
+                            let visible = shadow.visible(scene, counts);
+                            let added = if visible { shadow.added } else { Rgb::ZERO };
+                            observer.light_sample(&ls, f, weight, visible, added);
+                            radiance += added;
                         } else {
                             pending = Some(shadow);
                         }
@@ -303,7 +300,7 @@ impl PathTracer {
                 Some(hit.spawn_ray(frame.to_world(sample.wi)))
             };
             // Whether or not the path goes on, its light sample counts.
-            radiance += PendingShadow::trace(pending, scene, counts, observer);
+            radiance += PendingShadow::trace(pending, scene, counts);
             let Some(next) = next else {
                 break;
             };
