@@ -21,8 +21,18 @@ pub struct ShearedRay {
 /// triangle keeps its winding.
 #[inline]
 pub fn permuted_axes(d: Vec3A) -> (usize, usize, usize) {
-    let kz = d.abs().max_position();
-    let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    // The largest |d| component, the first of equal ones (as glam's
+    // `max_position`), chosen by selects: every ray does this once.
+    let a = d.abs();
+    let y_wins = a.y > a.x;
+    let largest = if y_wins { a.y } else { a.x };
+    let kz = if a.z > largest {
+        2
+    } else {
+        usize::from(y_wins)
+    };
+    const NEXT: [usize; 3] = [1, 2, 0];
+    let (kx, ky) = (NEXT[kz], NEXT[NEXT[kz]]);
     if d.to_array()[kz] < 0.0 {
         (ky, kx, kz)
     } else {
@@ -107,5 +117,34 @@ impl ShearedRay {
             return None;
         }
         Some((t, e1 * inv_det, e2 * inv_det))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The select form picks the axes glam's `max_position` did, ties and
+    /// zeros included (the first of equal components wins).
+    #[test]
+    fn permuted_axes_match_the_first_largest_component() {
+        let reference = |d: Vec3A| {
+            let kz = d.abs().max_position();
+            let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            if d[kz] < 0.0 {
+                (ky, kx, kz)
+            } else {
+                (kx, ky, kz)
+            }
+        };
+        let values = [0.0f32, -0.0, 0.5, -0.5, 1.0, -1.0, 2.0, f32::NAN];
+        for x in values {
+            for y in values {
+                for z in values {
+                    let d = Vec3A::new(x, y, z);
+                    assert_eq!(permuted_axes(d), reference(d), "{d}");
+                }
+            }
+        }
     }
 }

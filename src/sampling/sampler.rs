@@ -274,10 +274,17 @@ impl Sampler {
         let pixel_key = hash_combine(self.seed_key, pixel as u64);
         self.pixel_key = pixel_key;
         self.sample_key = hash_combine(pixel_key, sample_index as u64);
-        self.batch_key = hash_combine(
-            pixel_key,
-            0x8000_0000_0000_0000 | (sample_index / self.batch) as u64,
-        );
+        // Only the strata permutations read the batch key (a hash and a
+        // division per camera sample that Sobol and independent skip).
+        if matches!(
+            self.kind,
+            SamplerKind::Stratified | SamplerKind::MultiJittered
+        ) {
+            self.batch_key = hash_combine(
+                pixel_key,
+                0x8000_0000_0000_0000 | (sample_index / self.batch) as u64,
+            );
+        }
         self.sample_index = sample_index;
         self.reversed_index = sample_index.reverse_bits();
         self.dimension = 0;
