@@ -199,8 +199,9 @@ pub struct SlabAxes {
     far: [usize; 3],
     origin: [f32x8; 3],
     inv_direction: [f32x8; 3],
-    /// Some reciprocal of a direction component is infinite.
-    zero_direction: bool,
+    /// The reciprocals, enlarged once per ray so that exit distances come
+    /// out conservative without a product per node (see [`Self::reaches`]).
+    inv_direction_far: [f32x8; 3],
 }
 
 impl SlabAxes {
@@ -208,49 +209,81 @@ impl SlabAxes {
     pub fn new(ray: &Ray) -> Self {
         let (o, d) = (ray.origin, ray.direction);
         let inv = d.recip();
+        let inv_far = inv * (1.0 + 2.0 * gamma(4));
         // By the sign bit: a direction component of -0 has reciprocal -inf,
         // for which the max plane is entered first, as for any negative one.
         let negative = |axis: usize| usize::from(d[axis].is_sign_negative());
+        let (inv, inv_far) = (inv.to_array(), inv_far.to_array());
         SlabAxes {
             near: [0, 1, 2].map(|axis| axis + 3 * negative(axis)),
             far: [0, 1, 2].map(|axis| axis + 3 * (1 - negative(axis))),
             origin: [0, 1, 2].map(|axis| f32x8::splat(o[axis])),
-            inv_direction: [0, 1, 2].map(|axis| f32x8::splat(inv[axis])),
-            // Zero or subnormal components: their reciprocal overflows.
-            zero_direction: !inv.is_finite(),
+            inv_direction: inv.map(f32x8::splat),
+            inv_direction_far: inv_far.map(f32x8::splat),
         }
     }
 
     /// Slab test against eight boxes (pbrt-v4 6.8.7): the lanes of `boxes`
-    /// whose box the ray enters in [0, t_max], and the entry distances. The
-    /// exit distance is enlarged by 1 + 2 gamma(3), which makes the test
-    /// conservative under rounding. A slab giving 0 x inf = NaN (a direction
-    /// component of zero and the origin on a face's plane) does not
-    /// constrain t: the ray runs inside that plane, which counts as inside.
+    /// whose box the ray enters in [0, t_max], and the entry distances.
+    ///
+    /// Conservative under rounding: an entry distance (a difference, a
+    /// reciprocal and a product) is within gamma(3) of the exact one; an
+    /// exit distance, through the reciprocal enlarged by W = 1 + 2 gamma(4)
+    /// (one rounding more), is at least W (1 - gamma(4)) > 1 + gamma(3)
+    /// times the exact one, so a box the exact ray enters is never missed.
+    ///
+    /// A slab giving 0 x inf = NaN (a direction component of zero and the
+    /// origin on a face's plane) does not constrain t: the ray runs inside
+    /// that plane, which counts as inside: a NaN distance keeps the running
+    /// bound.
     #[inline(always)]
     pub fn reaches(&self, boxes: &Boxes8, t_max: f32) -> (u32, [f32; LANES]) {
         let mut t_near = f32x8::splat(0.0);
         let mut t_far = f32x8::splat(t_max);
-        let widen = f32x8::splat(1.0 + 2.0 * gamma(3));
         for axis in 0..3 {
             // The direction's sign says which plane is entered first, so no
             // min and max of the two distances are needed.
             let t0 = (boxes.planes[self.near[axis]] - self.origin[axis]) * self.inv_direction[axis];
-            let t1 = (boxes.planes[self.far[axis]] - self.origin[axis]) * self.inv_direction[axis];
-            let near = t_near.fast_max(t0);
-            let far = t_far.fast_min(t1 * widen);
-            // NaN needs an infinite reciprocal: only rays with a zero
-            // direction component pay for the check (a predictable branch).
-            if self.zero_direction {
-                let nan = t0.simd_ne(t0) | t1.simd_ne(t1);
-                t_near = nan.select(t_near, near);
-                t_far = nan.select(t_far, far);
-            } else {
-                (t_near, t_far) = (near, far);
-            }
+            let t1 =
+                (boxes.planes[self.far[axis]] - self.origin[axis]) * self.inv_direction_far[axis];
+            t_near = max_unless_nan(t0, t_near);
+            t_far = min_unless_nan(t1, t_far);
         }
         let reached = t_near.simd_le(t_far).to_bitmask() & boxes.lanes;
         (reached, t_near.to_array())
+    }
+}
+
+/// max(a, b) per lane, b where a is NaN. x86's max instruction has exactly
+/// these semantics (it returns its second operand when either is NaN);
+/// elsewhere an ordered comparison does it. A check of the NaN per node
+/// instead cost the traversal a compare and branch per axis.
+#[inline(always)]
+fn max_unless_nan(a: f32x8, b: f32x8) -> f32x8 {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    {
+        use std::arch::x86_64::_mm256_max_ps;
+        // SAFETY: the build enables AVX (the cfg above).
+        f32x8::from(unsafe { _mm256_max_ps(a.into(), b.into()) })
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+    {
+        a.simd_gt(b).select(a, b)
+    }
+}
+
+/// min(a, b) per lane, b where a is NaN (as [`max_unless_nan`]).
+#[inline(always)]
+fn min_unless_nan(a: f32x8, b: f32x8) -> f32x8 {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    {
+        use std::arch::x86_64::_mm256_min_ps;
+        // SAFETY: the build enables AVX (the cfg above).
+        f32x8::from(unsafe { _mm256_min_ps(a.into(), b.into()) })
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+    {
+        a.simd_lt(b).select(a, b)
     }
 }
 
@@ -325,4 +358,30 @@ pub fn block_hits(block: &Block, axes: &Axes, t_max: f32) -> Option<BlockHits> {
         mask,
         ambiguous,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slab_bounds_keep_the_running_value_where_the_distance_is_nan() {
+        let nan = f32::NAN;
+        let a = f32x8::new([nan, 1.0, -2.0, 5.0, nan, 0.0, -0.0, f32::INFINITY]);
+        let b = f32x8::new([3.0, 2.0, -1.0, 4.0, -7.0, -0.0, 0.0, 1.0]);
+        let max = max_unless_nan(a, b).to_array();
+        let min = min_unless_nan(a, b).to_array();
+        assert_eq!(max[..5], [3.0, 2.0, -1.0, 5.0, -7.0]);
+        assert_eq!(min[..5], [3.0, 1.0, -2.0, 4.0, -7.0]);
+        assert_eq!((max[7], min[7]), (f32::INFINITY, 1.0));
+        // Equal zeros: either is a bound of the same value.
+        assert!(max[5] == 0.0 && min[6] == 0.0);
+    }
+
+    #[test]
+    fn exit_distances_are_enlarged_beyond_the_entry_rounding() {
+        // W (1 - gamma(4)) > 1 + gamma(3): the margin reaches() relies on.
+        let w = 1.0 + 2.0 * gamma(4);
+        assert!(f64::from(w) * (1.0 - f64::from(gamma(4))) > 1.0 + f64::from(gamma(3)));
+    }
 }
