@@ -189,6 +189,7 @@ impl PathTracer {
             // that do not depend on the hit are drawn before the ray is
             // traced: their hash chains then overlap with the traversal
             // instead of stalling the light sample after it.
+            sampler.enter_path_vertex(bounces);
             let vertex_dim = sampler.reserve(5);
             // One light needs no choice (the Cornell box): skipping that
             // number leaves the image bit-identical.

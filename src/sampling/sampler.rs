@@ -173,7 +173,22 @@ pub struct Sampler {
     grid_y: u32,
     /// Domains that use `kind`; the rest are independent.
     domains: Domains,
+    /// Dimensions from this one on are independent (see
+    /// [`Sampler::enter_path_vertex`]).
+    independent_from: u32,
 }
+
+/// Path vertices (the camera ray's hit is vertex 0) whose numbers the Sobol
+/// sampler takes from its sequence; deeper vertices get independent numbers.
+/// A 2D Sobol point costs an index scramble, two Owen scrambles and Sobol's
+/// second dimension where an independent pair costs one hash, and deep
+/// bounces, already averaged over the earlier vertices' directions, gain
+/// next to nothing from stratification. Cornell box, path tracing spread by
+/// noise, seeds 1 and 2, 2 threads: RMSE at 64 spp +0.4% (0.00492 ->
+/// 0.00494), render time -7% (1.11 -> 1.04 s), error x time -6%; with one
+/// vertex +1% RMSE for -8% time; with all vertices (pbrt-v4's padded Sobol)
+/// the slowest.
+pub const SOBOL_PATH_VERTICES: u32 = 2;
 
 impl Sampler {
     /// A sampler for a render with `planned_spp` samples per pixel (0 = unknown).
@@ -201,6 +216,7 @@ impl Sampler {
             grid_x,
             grid_y: batch / grid_x,
             domains: Domains::ALL,
+            independent_from: u32::MAX,
         }
     }
 
@@ -238,7 +254,7 @@ impl Sampler {
     /// the current sample: what [`Sampler::next_1d_for`] would have drawn.
     #[inline(always)]
     pub fn get_1d_for(&self, dim: u32, domain: Domain) -> f32 {
-        if self.domains.contains(domain) {
+        if dim < self.independent_from && self.domains.contains(domain) {
             self.get_1d(dim)
         } else {
             to_unit_float(self.hash(dim))
@@ -255,11 +271,21 @@ impl Sampler {
     /// The pair of dimension `dim` (see [`Sampler::get_1d_for`]).
     #[inline(always)]
     pub fn get_2d_for(&self, dim: u32, domain: Domain) -> Vec2 {
-        if self.domains.contains(domain) {
+        if dim < self.independent_from && self.domains.contains(domain) {
             self.get_2d(dim)
         } else {
             let h = self.hash(dim);
             Vec2::new(to_unit_float(h), to_unit_float(h << 24))
+        }
+    }
+
+    /// Tells the sampler that a path reached its vertex `vertex` (0 for the
+    /// camera ray's hit): from vertex [`SOBOL_PATH_VERTICES`] on, the Sobol
+    /// sampler's numbers are independent ones.
+    #[inline(always)]
+    pub fn enter_path_vertex(&mut self, vertex: u32) {
+        if vertex == SOBOL_PATH_VERTICES && self.kind == SamplerKind::Sobol {
+            self.independent_from = self.dimension;
         }
     }
 
@@ -288,6 +314,7 @@ impl Sampler {
         self.sample_index = sample_index;
         self.reversed_index = sample_index.reverse_bits();
         self.dimension = 0;
+        self.independent_from = u32::MAX;
     }
 
     /// The dimension the next request will use (for replaying a sample).
@@ -481,6 +508,48 @@ mod tests {
                 "{index:#x}"
             );
         }
+    }
+
+    #[test]
+    fn sobol_paths_turn_independent_at_their_deep_vertices() {
+        // The numbers a path draws at vertex v, with the vertex announced.
+        let draw = |kind: SamplerKind, vertex: u32| {
+            let mut s = Sampler::new(kind, 3, 64);
+            s.start(77, 5);
+            s.reserve(2);
+            for v in 0..=vertex {
+                s.enter_path_vertex(v);
+                s.reserve(5);
+            }
+            let dim = s.dimension() - 5;
+            (
+                s.get_2d_for(dim + 1, Domain::Light),
+                s.get_1d_for(dim + 4, Domain::Other),
+            )
+        };
+        for vertex in 0..5 {
+            let (sobol, independent) = (
+                draw(SamplerKind::Sobol, vertex),
+                draw(SamplerKind::Independent, vertex),
+            );
+            assert_eq!(
+                sobol == independent,
+                vertex >= SOBOL_PATH_VERTICES,
+                "{vertex}"
+            );
+            // Other samplers keep stratifying every vertex.
+            assert_ne!(draw(SamplerKind::Stratified, vertex), independent);
+        }
+        // A new sample starts on the sequence again.
+        let mut s = Sampler::new(SamplerKind::Sobol, 3, 64);
+        s.start(77, 5);
+        s.enter_path_vertex(SOBOL_PATH_VERTICES);
+        s.start(77, 6);
+        assert_ne!(s.get_2d_for(0, Domain::Pixel), {
+            let mut i = Sampler::new(SamplerKind::Independent, 3, 64);
+            i.start(77, 6);
+            i.get_2d_for(0, Domain::Pixel)
+        });
     }
 
     #[test]
