@@ -246,44 +246,38 @@ impl SlabAxes {
             let t0 = (boxes.planes[self.near[axis]] - self.origin[axis]) * self.inv_direction[axis];
             let t1 =
                 (boxes.planes[self.far[axis]] - self.origin[axis]) * self.inv_direction_far[axis];
-            t_near = max_unless_nan(t0, t_near);
-            t_far = min_unless_nan(t1, t_far);
+            t_near = bound_unless_nan::<true>(t0, t_near);
+            t_far = bound_unless_nan::<false>(t1, t_far);
         }
         let reached = t_near.simd_le(t_far).to_bitmask() & boxes.lanes;
         (reached, t_near.to_array())
     }
 }
 
-/// max(a, b) per lane, b where a is NaN. x86's max instruction has exactly
-/// these semantics (it returns its second operand when either is NaN);
-/// elsewhere an ordered comparison does it. A check of the NaN per node
-/// instead cost the traversal a compare and branch per axis.
+/// Per lane max(a, b) (`MAX`) or min(a, b), and b where a is NaN. x86's
+/// max and min instructions have exactly these semantics (they return
+/// their second operand when either is NaN); elsewhere an ordered
+/// comparison does it. A check of the NaN per node instead cost the
+/// traversal a compare and branch per axis.
 #[inline(always)]
-fn max_unless_nan(a: f32x8, b: f32x8) -> f32x8 {
+fn bound_unless_nan<const MAX: bool>(a: f32x8, b: f32x8) -> f32x8 {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
     {
-        use std::arch::x86_64::_mm256_max_ps;
+        use std::arch::x86_64::{_mm256_max_ps, _mm256_min_ps};
+        let (a, b) = (a.into(), b.into());
         // SAFETY: the build enables AVX (the cfg above).
-        f32x8::from(unsafe { _mm256_max_ps(a.into(), b.into()) })
+        f32x8::from(unsafe {
+            if MAX {
+                _mm256_max_ps(a, b)
+            } else {
+                _mm256_min_ps(a, b)
+            }
+        })
     }
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
     {
-        a.simd_gt(b).select(a, b)
-    }
-}
-
-/// min(a, b) per lane, b where a is NaN (as [`max_unless_nan`]).
-#[inline(always)]
-fn min_unless_nan(a: f32x8, b: f32x8) -> f32x8 {
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-    {
-        use std::arch::x86_64::_mm256_min_ps;
-        // SAFETY: the build enables AVX (the cfg above).
-        f32x8::from(unsafe { _mm256_min_ps(a.into(), b.into()) })
-    }
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
-    {
-        a.simd_lt(b).select(a, b)
+        let keep_a = if MAX { a.simd_gt(b) } else { a.simd_lt(b) };
+        keep_a.select(a, b)
     }
 }
 
@@ -372,8 +366,8 @@ mod tests {
         let nan = f32::NAN;
         let a = f32x8::new([nan, 1.0, -2.0, 5.0, nan, 0.0, -0.0, f32::INFINITY]);
         let b = f32x8::new([3.0, 2.0, -1.0, 4.0, -7.0, -0.0, 0.0, 1.0]);
-        let max = max_unless_nan(a, b).to_array();
-        let min = min_unless_nan(a, b).to_array();
+        let max = bound_unless_nan::<true>(a, b).to_array();
+        let min = bound_unless_nan::<false>(a, b).to_array();
         assert_eq!(max[..5], [3.0, 2.0, -1.0, 5.0, -7.0]);
         assert_eq!(min[..5], [3.0, 1.0, -2.0, 4.0, -7.0]);
         assert_eq!((max[7], min[7]), (f32::INFINITY, 1.0));
