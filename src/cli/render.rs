@@ -51,7 +51,8 @@ enum SamplerArg {
     Stratified,
     /// Correlated multi-jittered: jittered and Latin hypercube in every pair.
     Multijitter,
-    /// Owen-scrambled Sobol, shuffled per dimension pair.
+    /// Owen-scrambled Sobol, shuffled per dimension pair (path tracing:
+    /// for the camera sample and the first two vertices, then independent).
     Sobol,
 }
 

@@ -29,6 +29,7 @@ pub enum SamplerKind {
     /// Sobol (0,2)-sequence, Owen-scrambled with Laine-Karras hashing and
     /// shuffled per dimension pair (Burley 2020, pbrt-v4's padded Sobol):
     /// every power-of-two prefix is a stratified (0,m,2)-net in each pair.
+    /// Path tracing draws from it up to [`SOBOL_PATH_VERTICES`] vertices.
     Sobol,
 }
 
