@@ -234,8 +234,8 @@ impl SlabAxes {
     ///
     /// A slab giving 0 x inf = NaN (a direction component of zero and the
     /// origin on a face's plane) does not constrain t: the ray runs inside
-    /// that plane, which counts as inside: a NaN distance keeps the running
-    /// bound.
+    /// that plane, which counts as inside, so a NaN distance keeps the
+    /// running bound.
     #[inline(always)]
     pub fn reaches(&self, boxes: &Boxes8, t_max: f32) -> (u32, [f32; LANES]) {
         let mut t_near = f32x8::splat(0.0);

@@ -186,7 +186,7 @@ pub struct Sampler {
 /// bounces, already averaged over the earlier vertices' directions, gain
 /// next to nothing from stratification. Cornell box, path tracing spread by
 /// noise, seeds 1 and 2, 2 threads: RMSE at 64 spp +0.4% (0.00492 ->
-/// 0.00494), render time -7% (1.11 -> 1.04 s), error x time -6%; with one
+/// 0.00494), render time -7% (1.11 -> 1.04 s), MSE x time -6%; with one
 /// vertex +1% RMSE for -8% time; with all vertices (pbrt-v4's padded Sobol)
 /// the slowest.
 pub const SOBOL_PATH_VERTICES: u32 = 2;
