@@ -248,6 +248,9 @@ impl Session {
                     let mut sampler =
                         Sampler::new(settings.sampler, settings.seed, settings.planned_spp)
                             .with_domains(settings.domains);
+                    // The next sample's, whose camera ray is made while this
+                    // sample's path is traced (below).
+                    let mut ahead = sampler.clone();
                     let mut counts = RayCounts::default();
                     let mut non_finite = 0u64;
                     let mut skipped = 0u64;
@@ -269,9 +272,25 @@ impl Session {
                             }
                             _ => (first, spp),
                         };
-                        for s in begin..begin + count {
-                            sampler.start(pixel_index, s);
-                            let ray = camera_ray(scene, &mut sampler, x, y, deterministic, general);
+                        if count == 0 {
+                            continue;
+                        }
+                        // A camera sample is a long chain of dependent hashes
+                        // and a division. Made one sample ahead, by a second
+                        // sampler, it runs beside the path before it instead
+                        // of holding up its own.
+                        let end = begin + count;
+                        ahead.start(pixel_index, begin);
+                        let mut ray_ahead =
+                            camera_ray(scene, &mut ahead, x, y, deterministic, general);
+                        for s in begin..end {
+                            std::mem::swap(&mut sampler, &mut ahead);
+                            let ray = ray_ahead;
+                            if s + 1 < end {
+                                ahead.start(pixel_index, s + 1);
+                                ray_ahead =
+                                    camera_ray(scene, &mut ahead, x, y, deterministic, general);
+                            }
                             counts.camera += 1;
                             let mut value =
                                 settings
