@@ -227,6 +227,7 @@ impl Session {
         let deterministic = settings.integrator.is_deterministic();
         let general = settings.integrator.is_general();
         let width = self.film.width();
+        let primary = scene.primary_candidates();
         self.pool.install(|| {
             self.film
                 .tiles()
@@ -280,6 +281,7 @@ impl Session {
                         // sampler, it runs beside the path before it instead
                         // of holding up its own.
                         let end = begin + count;
+                        let candidates = primary.and_then(|p| p.of_pixel(pixel_index));
                         ahead.start(pixel_index, begin);
                         let mut ray_ahead =
                             camera_ray(scene, &mut ahead, x, y, deterministic, general);
@@ -292,10 +294,13 @@ impl Session {
                                     camera_ray(scene, &mut ahead, x, y, deterministic, general);
                             }
                             counts.camera += 1;
-                            let mut value =
-                                settings
-                                    .integrator
-                                    .radiance(scene, ray, &mut sampler, &mut counts);
+                            let mut value = settings.integrator.radiance(
+                                scene,
+                                ray,
+                                candidates,
+                                &mut sampler,
+                                &mut counts,
+                            );
                             non_finite += u64::from(!value.is_finite());
                             extreme += u64::from(pixel.flag(value, s));
                             if let Some(limit) = settings.clamp {

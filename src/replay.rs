@@ -128,9 +128,15 @@ pub fn replay_sample(
             ray.time
         )],
     };
+    // The camera ray tests what the render's does.
+    let candidates = scene
+        .primary_candidates()
+        .filter(|_| !tracer.general)
+        .and_then(|p| p.of_pixel(y * scene.camera.width + x));
     let value = tracer.radiance_observed(
         scene,
         ray,
+        candidates,
         &mut sampler,
         &mut RayCounts::default(),
         &mut log,

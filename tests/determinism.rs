@@ -46,3 +46,33 @@ fn same_seed_gives_a_bit_identical_film_with_one_and_two_threads() {
         );
     }
 }
+
+/// Camera rays tested against their pixel's candidate triangles only
+/// (`PrimaryCandidates`) find the hits the whole soup gives them: the film
+/// is bit-identical with and without the lists.
+#[test]
+fn camera_ray_candidate_lists_change_no_pixel() {
+    let mut scene = cornell_box();
+    scene.set_resolution(48, 40);
+    let lists = scene
+        .primary_candidates()
+        .expect("the Cornell box gets lists");
+    let (mean, full) = lists.summary();
+    assert!(
+        mean < 4.0 && full == 0,
+        "{mean} candidates per pixel, {full} full"
+    );
+    let render = |scene| {
+        let integrator = Integrator::Path(PathTracer::default());
+        let (snapshot, _) = render_with(scene, integrator, SamplerKind::Sobol, 16, 3, 2, 16);
+        snapshot
+            .image
+            .pixels
+            .iter()
+            .flat_map(|p| p.map(f32::to_bits))
+            .collect::<Vec<_>>()
+    };
+    let mut without = scene.clone();
+    without.primary = None;
+    assert_eq!(render(scene), render(without));
+}

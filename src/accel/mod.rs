@@ -8,12 +8,14 @@
 //! are contiguous in memory and a hit's index addresses them directly.
 
 mod block;
+mod primary;
 mod soup;
 mod sphere;
 mod triangle;
 mod wide_bvh;
 
 use crate::math::{OffsetMode, Ray, gamma};
+use crate::scene::camera::Camera;
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
@@ -22,8 +24,10 @@ use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
 use obvhs::ploc::PlocBuilder;
+pub use primary::PrimaryCandidates;
 use soup::TriangleSoup;
 use sphere::intersect_sphere;
+use triangle::ShearedRay;
 use wide_bvh::WideBvh;
 
 /// Marks a primitive that is not a light.
@@ -550,11 +554,25 @@ impl Geometry {
             return None;
         }
         let i = best_tri as usize;
-        let [p0, p1, p2] = vertices.unwrap_or_else(|| self.tri_vertices[i]);
-        let shading = self.tri_shading[i];
+        let vertices = vertices.unwrap_or_else(|| self.tri_vertices[i]);
+        Some(self.triangle_hit(ray, best_tri, vertices, best_t, best_b1, best_b2))
+    }
+
+    /// The hit record of triangle `index` at (t, b1, b2).
+    #[inline(always)]
+    fn triangle_hit(
+        &self,
+        ray: &Ray,
+        index: u32,
+        [p0, p1, p2]: [Vec3A; 3],
+        best_t: f32,
+        best_b1: f32,
+        best_b2: f32,
+    ) -> SurfaceHit {
+        let shading = self.tri_shading[index as usize];
         let b0 = 1.0 - best_b1 - best_b2;
         let point = b0 * p0 + best_b1 * p1 + best_b2 * p2;
-        Some(SurfaceHit {
+        SurfaceHit {
             t: best_t,
             point,
             // Barycentric interpolation (pbrt-v4 6.8.4).
@@ -563,8 +581,49 @@ impl Geometry {
             material: shading.material,
             light: shading.light,
             time: ray.time,
-            primitive: best_tri,
-        })
+            primitive: index,
+        }
+    }
+
+    /// True when camera rays may be tested against per-pixel candidates
+    /// ([`PrimaryCandidates`]): triangles only, in a soup (whose hits the
+    /// candidates' one-by-one test reproduces exactly), none moving.
+    pub fn allows_primary_candidates(&self) -> bool {
+        matches!(self.tri_index, TriangleIndex::Soup(_))
+            && self.spheres.is_empty()
+            && self.moving.is_empty()
+    }
+
+    /// Candidate lists of `camera`'s pixels for these triangles (see
+    /// [`PrimaryCandidates`]), where they apply.
+    pub fn primary_candidates(&self, camera: &Camera) -> Option<PrimaryCandidates> {
+        if !self.allows_primary_candidates() {
+            return None;
+        }
+        PrimaryCandidates::build(camera, &self.tri_vertices)
+    }
+
+    /// [`Geometry::intersect`] for a ray that can only hit the triangles
+    /// `candidates` (in storage order): the same hit, by the same
+    /// watertight test, without testing the rest.
+    #[inline(always)]
+    pub fn intersect_among(&self, ray: &Ray, candidates: &[u32]) -> Option<SurfaceHit> {
+        let sheared = ShearedRay::new(ray);
+        let mut best: Option<(u32, f32, f32, f32)> = None;
+        let mut best_t = ray.t_max;
+        for &index in candidates {
+            if let Some((t, b1, b2)) = sheared.intersect(&self.tri_vertices[index as usize], best_t)
+            {
+                best_t = t;
+                best = Some((index, t, b1, b2));
+            }
+        }
+        let (index, t, b1, b2) = best?;
+        let mut hit = self.triangle_hit(ray, index, self.tri_vertices[index as usize], t, b1, b2);
+        if let OffsetMode::Fixed(_) = self.offset {
+            hit.error = self.offset.spawn_error(hit.error, hit.normal);
+        }
+        Some(hit)
     }
 
     /// True when anything blocks `ray` in (0, ray.t_max) at `ray.time`

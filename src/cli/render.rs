@@ -552,6 +552,15 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
             eprintln!("specialised for this scene: skipped {}", skipped.join(", "));
         }
     }
+    if let (tracelab::integrator::Integrator::Path(p), Some(lists)) =
+        (&settings.integrator, session.scene().primary_candidates())
+        && !p.general
+    {
+        let (mean, full) = lists.summary();
+        eprintln!(
+            "camera rays test their pixel's candidate triangles only: {mean:.2} per pixel ({full} pixels test all)"
+        );
+    }
     match settings.adaptive {
         Some(Adaptive::Stop { threshold, min_spp }) => {
             let planned = stats.samples + stats.skipped;

@@ -79,19 +79,21 @@ pub enum Integrator {
 
 impl Integrator {
     /// One radiance sample along the camera ray `ray`. Counts the rays it
-    /// casts after the camera ray into `counts`.
+    /// casts after the camera ray into `counts`. `candidates`: the only
+    /// triangles `ray` can hit, where known (the path tracer uses them).
     #[inline]
     pub fn radiance(
         &self,
         scene: &Scene,
         ray: Ray,
+        candidates: Option<&[u32]>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
         match self {
             Integrator::Whitted(w) => w.radiance(scene, ray, counts),
             Integrator::Mcrt(m) => m.radiance(scene, ray, sampler, counts),
-            Integrator::Path(p) => p.radiance(scene, ray, sampler, counts),
+            Integrator::Path(p) => p.radiance(scene, ray, candidates, sampler, counts),
             // Light tracing splats instead; the session never calls this for it.
             Integrator::Light(_) => Rgb::ZERO,
         }

@@ -132,16 +132,20 @@ impl PathTracer {
     }
 
     /// One radiance sample along `ray`, by the loop specialised for what
-    /// the scene uses (see [`crate::scene::Features`]).
+    /// the scene uses (see [`crate::scene::Features`]). `candidates`: the
+    /// only triangles the camera ray can hit, when they are known
+    /// ([`crate::accel::PrimaryCandidates`]).
     #[inline]
     pub fn radiance(
         &self,
         scene: &Scene,
         ray: Ray,
+        candidates: Option<&[u32]>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
-        self.radiance_observed(scene, ray, sampler, counts, &mut NoObserver)
+        let candidates = candidates.filter(|_| !self.general);
+        self.radiance_observed(scene, ray, candidates, sampler, counts, &mut NoObserver)
     }
 
     /// [`PathTracer::radiance`], telling `observer` about every vertex.
@@ -150,17 +154,19 @@ impl PathTracer {
         &self,
         scene: &Scene,
         ray: Ray,
+        candidates: Option<&[u32]>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
         observer: &mut O,
     ) -> Rgb {
         let f = scene.features;
+        let c = candidates;
         if self.general || f.specular() {
-            self.trace::<true, false, O>(scene, ray, sampler, counts, observer)
+            self.trace::<true, false, O>(scene, ray, c, sampler, counts, observer)
         } else if f.diffuse_only() {
-            self.trace::<false, true, O>(scene, ray, sampler, counts, observer)
+            self.trace::<false, true, O>(scene, ray, c, sampler, counts, observer)
         } else {
-            self.trace::<false, false, O>(scene, ray, sampler, counts, observer)
+            self.trace::<false, false, O>(scene, ray, c, sampler, counts, observer)
         }
     }
 
@@ -170,6 +176,7 @@ impl PathTracer {
         &self,
         scene: &Scene,
         mut ray: Ray,
+        mut candidates: Option<&[u32]>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
         observer: &mut O,
@@ -200,7 +207,12 @@ impl PathTracer {
             };
             let u_light = sampler.get_2d_for(vertex_dim + 1, Domain::Light);
             let u_bsdf = sampler.get_2d_for(vertex_dim + 3, Domain::Bsdf);
-            let Some(hit) = scene.geometry.intersect(&ray) else {
+            // The camera ray tests only its pixel's candidates, if known.
+            let hit = match candidates.take() {
+                Some(among) => scene.geometry.intersect_among(&ray, among),
+                None => scene.geometry.intersect(&ray),
+            };
+            let Some(hit) = hit else {
                 observer.escaped();
                 break;
             };

@@ -9,7 +9,7 @@ pub mod load;
 pub mod material;
 pub mod obj;
 
-use crate::accel::{Geometry, Sphere, TriangleInput};
+use crate::accel::{Geometry, PrimaryCandidates, Sphere, TriangleInput};
 use crate::error::{Error, Result};
 use crate::math::OffsetMode;
 use camera::Camera;
@@ -203,6 +203,9 @@ pub struct Scene {
     pub features: Features,
     /// Things the user should know that did not stop loading (dropped triangles, ...).
     pub warnings: Vec<String>,
+    /// Each pixel's candidate triangles for camera rays, where the camera and
+    /// geometry allow them (made for `camera`: see [`Scene::set_camera`]).
+    pub primary: Option<Arc<PrimaryCandidates>>,
 }
 
 impl Scene {
@@ -343,6 +346,7 @@ impl Scene {
             warnings.push("the scene has no light source: the image will be black".into());
         }
         let features = Features::detect(&input.materials, &geometry, &lights, &input.camera);
+        let primary = geometry.primary_candidates(&input.camera).map(Arc::new);
         Ok(Scene {
             camera: input.camera,
             features,
@@ -350,6 +354,7 @@ impl Scene {
             materials: input.materials,
             lights,
             warnings,
+            primary,
         })
     }
 
@@ -369,7 +374,24 @@ impl Scene {
 
     /// Overrides the image size (keeping the field of view).
     pub fn set_resolution(&mut self, width: u32, height: u32) {
-        self.camera.width = width;
-        self.camera.height = height;
+        let mut camera = self.camera;
+        camera.width = width;
+        camera.height = height;
+        self.set_camera(camera);
+    }
+
+    /// Replaces the camera, and the camera rays' candidate lists with it.
+    pub fn set_camera(&mut self, camera: Camera) {
+        if camera != self.camera {
+            self.camera = camera;
+            self.primary = self.geometry.primary_candidates(&camera).map(Arc::new);
+        }
+    }
+
+    /// The camera rays' candidate lists, when they were made for the
+    /// current camera (a caller may have set `camera` directly).
+    #[inline(always)]
+    pub fn primary_candidates(&self) -> Option<&PrimaryCandidates> {
+        self.primary.as_deref().filter(|p| p.is_for(&self.camera))
     }
 }

@@ -338,7 +338,7 @@ impl ViewerApp {
 
         let mut scene = (*scene).clone();
         if let Some(camera) = self.camera {
-            scene.camera = camera;
+            scene.set_camera(camera);
         }
         if let Some((w, h)) = self.settings.resolution {
             scene.set_resolution(w, h);
