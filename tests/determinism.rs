@@ -48,10 +48,12 @@ fn same_seed_gives_a_bit_identical_film_with_one_and_two_threads() {
 }
 
 /// Camera rays tested against their pixel's candidate triangles only
-/// (`PrimaryCandidates`) find the hits the whole soup gives them: the film
-/// is bit-identical with and without the lists.
+/// (`PrimaryCandidates`) find the hits the whole soup gives them, and shadow
+/// rays answered by the light's clear voxels (`ClearVoxels`) get the answer
+/// the traversal would give: the film is bit-identical with and without
+/// either.
 #[test]
-fn camera_ray_candidate_lists_change_no_pixel() {
+fn camera_ray_candidates_and_clear_voxels_change_no_pixel() {
     let mut scene = cornell_box();
     scene.set_resolution(48, 40);
     let lists = scene
@@ -62,6 +64,10 @@ fn camera_ray_candidate_lists_change_no_pixel() {
         mean < 4.0 && full == 0,
         "{mean} candidates per pixel, {full} full"
     );
+    let clear = scene.clearance[0]
+        .as_ref()
+        .expect("its light gets clear voxels");
+    assert!(clear.clear_fraction() > 0.3, "{}", clear.clear_fraction());
     let render = |scene| {
         let integrator = Integrator::Path(PathTracer::default());
         let (snapshot, _) = render_with(scene, integrator, SamplerKind::Sobol, 16, 3, 2, 16);
@@ -72,7 +78,11 @@ fn camera_ray_candidate_lists_change_no_pixel() {
             .flat_map(|p| p.map(f32::to_bits))
             .collect::<Vec<_>>()
     };
-    let mut without = scene.clone();
-    without.primary = None;
-    assert_eq!(render(scene), render(without));
+    let with_both = render(scene.clone());
+    let mut without_lists = scene.clone();
+    without_lists.primary = None;
+    assert_eq!(with_both, render(without_lists));
+    let mut without_voxels = scene;
+    without_voxels.clearance = vec![None].into();
+    assert_eq!(with_both, render(without_voxels));
 }

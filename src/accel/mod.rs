@@ -8,6 +8,7 @@
 //! are contiguous in memory and a hit's index addresses them directly.
 
 mod block;
+mod clearance;
 mod primary;
 mod soup;
 mod sphere;
@@ -16,6 +17,7 @@ mod wide_bvh;
 
 use crate::math::{OffsetMode, Ray, gamma};
 use crate::scene::camera::Camera;
+pub use clearance::ClearVoxels;
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
@@ -601,6 +603,42 @@ impl Geometry {
             return None;
         }
         PrimaryCandidates::build(camera, &self.tri_vertices)
+    }
+
+    /// Voxels from which shadow rays to the flat light `light` (its corners,
+    /// in order; its own triangles are the light's id `light_id`) cannot be
+    /// blocked, for soups without spheres or motion (see [`ClearVoxels`]).
+    pub fn clear_voxels(&self, light_id: u32, light: &[Vec3A]) -> Option<ClearVoxels> {
+        let TriangleIndex::Soup(soup) = &self.tri_index else {
+            return None;
+        };
+        if !self.spheres.is_empty() || !self.moving.is_empty() {
+            return None;
+        }
+        // Shadow rays end just before the light's surface, off its own
+        // triangles by the light sample's error bound.
+        let occluders: Vec<[Vec3A; 3]> = (0..soup.inner_triangles())
+            .filter(|&i| self.tri_shading[i].light != light_id)
+            .map(|i| self.tri_vertices[i])
+            .collect();
+        let (lo, hi) = soup.bounds();
+        let margin = (hi - lo).max_element() * 1e-4;
+        Some(ClearVoxels::build(lo, hi, light, &occluders, margin))
+    }
+
+    /// [`Geometry::occluded`] for a shadow ray that ends on the light of
+    /// `clear` (built by [`Geometry::clear_voxels`]): from a clear voxel,
+    /// with both ends inside the box (so that the walls cannot block it,
+    /// as the soup's own test reasons), the answer is known without a test.
+    #[inline(always)]
+    pub fn occluded_towards(&self, ray: &Ray, clear: &ClearVoxels) -> bool {
+        if let TriangleIndex::Soup(soup) = &self.tri_index
+            && clear.is_clear(ray.origin)
+            && soup.segment_inside(ray, ray.t_max)
+        {
+            return false;
+        }
+        self.occluded(ray)
     }
 
     /// [`Geometry::intersect`] for a ray that can only hit the triangles

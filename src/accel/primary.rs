@@ -55,9 +55,7 @@ impl PrimaryCandidates {
             if depths.iter().all(|&z| z <= 0.0) {
                 continue;
             }
-            let Some(projected) = project_triangle(camera, triangle) else {
-                return None;
-            };
+            let projected = project_triangle(camera, triangle)?;
             let lo = projected.iter().fold(DVec2::INFINITY, |a, &p| a.min(p)) - MARGIN;
             let hi = projected.iter().fold(DVec2::NEG_INFINITY, |a, &p| a.max(p)) + MARGIN;
             if hi.x < 0.0 || hi.y < 0.0 || lo.x > width as f64 || lo.y > height as f64 {

@@ -24,6 +24,9 @@ pub struct TriangleSoup {
     /// Blocks from the first that hold a triangle off the bounding box's
     /// faces; the rest hold only face triangles.
     inner_blocks: usize,
+    /// Triangles from the first off the bounding box's faces (the rest lie
+    /// in a face).
+    inner_triangles: usize,
     /// The triangles' bounding box.
     lo: Vec3A,
     hi: Vec3A,
@@ -76,6 +79,7 @@ impl TriangleSoup {
         let extent = lo.abs().max(hi.abs());
         TriangleSoup {
             inner_blocks: last_inner.div_ceil(LANES),
+            inner_triangles: last_inner,
             blocks,
             lo,
             hi,
@@ -87,13 +91,24 @@ impl TriangleSoup {
     /// lies inside it by more than the margin on every axis: the segment
     /// then meets no face plane except at the origin.
     #[inline(always)]
-    fn segment_inside(&self, ray: &Ray, t_max: f32) -> bool {
+    pub fn segment_inside(&self, ray: &Ray, t_max: f32) -> bool {
         let end = ray.origin + ray.direction * t_max;
         let slack = self.margin + (ray.direction * t_max).abs() * (4.0 * f32::EPSILON);
         ray.origin.cmpge(self.lo).all()
             && ray.origin.cmple(self.hi).all()
             && end.cmpgt(self.lo + slack).all()
             && end.cmplt(self.hi - slack).all()
+    }
+
+    /// Triangles (the first ones stored) that can block a shadow ray for
+    /// which [`TriangleSoup::segment_inside`] holds: those off the faces.
+    pub fn inner_triangles(&self) -> usize {
+        self.inner_triangles
+    }
+
+    /// The triangles' bounding box.
+    pub fn bounds(&self) -> (Vec3A, Vec3A) {
+        (self.lo, self.hi)
     }
 
     /// Bytes of the blocks.

@@ -552,6 +552,19 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
             eprintln!("specialised for this scene: skipped {}", skipped.join(", "));
         }
     }
+    if matches!(
+        settings.integrator,
+        tracelab::integrator::Integrator::Path(_)
+    ) {
+        for (light, clear) in session.scene().clearance.iter().enumerate() {
+            if let Some(clear) = clear {
+                eprintln!(
+                    "shadow rays to light {light} need no test from {:.0}% of the scene's voxels (the light is seen whole there)",
+                    100.0 * clear.clear_fraction()
+                );
+            }
+        }
+    }
     if let (tracelab::integrator::Integrator::Path(p), Some(lists)) =
         (&settings.integrator, session.scene().primary_candidates())
         && !p.general

@@ -63,14 +63,22 @@ impl PathObserver for NoObserver {
 struct PendingShadow {
     ray: Ray,
     added: Rgb,
+    /// The light the ray ends on.
+    light: u32,
 }
 
 impl PendingShadow {
-    /// Traces the shadow ray: whether the light is visible.
+    /// Traces the shadow ray: whether the light is visible. Where the scene
+    /// knows the light to be seen whole from the ray's origin
+    /// ([`crate::accel::ClearVoxels`]) the answer needs no traversal; the
+    /// ray still counts, as the estimator cast it.
     #[inline(always)]
     fn visible(&self, scene: &Scene, counts: &mut RayCounts) -> bool {
         counts.shadow += 1;
-        !scene.geometry.occluded(&self.ray)
+        match scene.clearance.get(self.light as usize) {
+            Some(Some(clear)) => !scene.geometry.occluded_towards(&self.ray, clear),
+            _ => !scene.geometry.occluded(&self.ray),
+        }
     }
 
     /// What a deferred light sample adds, if there is one.
@@ -270,6 +278,7 @@ impl PathTracer {
                         let shadow = PendingShadow {
                             ray: shadow_ray(&hit, &ls),
                             added: beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf),
+                            light: ls.light,
                         };
                         // An observer hears of the light sample before the
                         // bounce; the image is the same either way.

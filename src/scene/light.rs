@@ -132,6 +132,7 @@ impl PlanarEmitter {
             radiance: self.radiance,
             pdf,
             delta: false,
+            light: 0,
         })
     }
 }
@@ -157,6 +158,8 @@ pub struct LightSample {
     pub pdf: f32,
     /// True for point lights (no MIS: BSDF sampling cannot hit them).
     pub delta: bool,
+    /// Which light ([`Lights::sample`] sets it).
+    pub light: u32,
 }
 
 impl Light {
@@ -261,6 +264,7 @@ impl Light {
                         radiance,
                         pdf,
                         delta: false,
+                        light: 0,
                     })
                 } else {
                     let normal = square_to_uniform_sphere(u);
@@ -286,6 +290,7 @@ impl Light {
                     radiance: intensity / dist2,
                     pdf: 1.0,
                     delta: true,
+                    light: 0,
                 })
             }
         }
@@ -398,6 +403,7 @@ fn area_sample(
         radiance,
         pdf,
         delta: false,
+        light: 0,
     })
 }
 
@@ -609,6 +615,7 @@ impl Lights {
         };
         let mut s = self.lights[index].sample(reference, u)?;
         s.pdf *= pmf;
+        s.light = index as u32;
         s.error = self.offset.spawn_error(s.error, s.normal);
         (s.pdf > 0.0 && s.pdf.is_finite() && s.distance > 0.0).then_some(s)
     }

@@ -9,7 +9,7 @@ pub mod load;
 pub mod material;
 pub mod obj;
 
-use crate::accel::{Geometry, PrimaryCandidates, Sphere, TriangleInput};
+use crate::accel::{ClearVoxels, Geometry, PrimaryCandidates, Sphere, TriangleInput};
 use crate::error::{Error, Result};
 use crate::math::OffsetMode;
 use camera::Camera;
@@ -206,6 +206,34 @@ pub struct Scene {
     /// Each pixel's candidate triangles for camera rays, where the camera and
     /// geometry allow them (made for `camera`: see [`Scene::set_camera`]).
     pub primary: Option<Arc<PrimaryCandidates>>,
+    /// Per light, the voxels from which shadow rays to it cannot be blocked
+    /// (flat lights in soups; see [`ClearVoxels`]).
+    pub clearance: Arc<[Option<ClearVoxels>]>,
+}
+
+/// Lights up to this many get [`ClearVoxels`] (each costs a build at load).
+const MAX_CLEARANCE_LIGHTS: usize = 8;
+
+/// Each flat light's [`ClearVoxels`], where the geometry allows them.
+fn light_clearance(geometry: &Geometry, lights: &Lights) -> Arc<[Option<ClearVoxels>]> {
+    let lights = lights.as_slice();
+    if lights.len() > MAX_CLEARANCE_LIGHTS {
+        return Arc::from(vec![None; lights.len()]);
+    }
+    lights
+        .iter()
+        .enumerate()
+        .map(|(id, light)| match light {
+            Light::Triangle(p) => {
+                geometry.clear_voxels(id as u32, &[p.p0, p.p0 + p.e1, p.p0 + p.e2])
+            }
+            Light::Parallelogram(p) => geometry.clear_voxels(
+                id as u32,
+                &[p.p0, p.p0 + p.e1, p.p0 + p.e1 + p.e2, p.p0 + p.e2],
+            ),
+            _ => None,
+        })
+        .collect()
 }
 
 impl Scene {
@@ -347,6 +375,7 @@ impl Scene {
         }
         let features = Features::detect(&input.materials, &geometry, &lights, &input.camera);
         let primary = geometry.primary_candidates(&input.camera).map(Arc::new);
+        let clearance = light_clearance(&geometry, &lights);
         Ok(Scene {
             camera: input.camera,
             features,
@@ -355,6 +384,7 @@ impl Scene {
             lights,
             warnings,
             primary,
+            clearance,
         })
     }
 
