@@ -49,11 +49,11 @@ fn same_seed_gives_a_bit_identical_film_with_one_and_two_threads() {
 
 /// Camera rays tested against their pixel's candidate triangles only
 /// (`PrimaryCandidates`) find the hits the whole soup gives them, and shadow
-/// rays answered by the light's clear voxels (`ClearVoxels`) get the answer
+/// rays tested against their voxel's occluders only (`ShadowVoxels`) get the answer
 /// the traversal would give: the film is bit-identical with and without
 /// either.
 #[test]
-fn camera_ray_candidates_and_clear_voxels_change_no_pixel() {
+fn camera_ray_candidates_and_shadow_voxels_change_no_pixel() {
     let mut scene = cornell_box();
     scene.set_resolution(48, 40);
     let lists = scene
@@ -64,10 +64,14 @@ fn camera_ray_candidates_and_clear_voxels_change_no_pixel() {
         mean < 4.0 && full == 0,
         "{mean} candidates per pixel, {full} full"
     );
-    let clear = scene.clearance[0]
+    let voxels = scene.clearance[0]
         .as_ref()
-        .expect("its light gets clear voxels");
-    assert!(clear.clear_fraction() > 0.3, "{}", clear.clear_fraction());
+        .expect("its light gets shadow voxels");
+    let (clear, listed) = voxels.summary();
+    assert!(
+        clear > 0.3 && listed > 0.1,
+        "{clear} clear, {listed} listed"
+    );
     let render = |scene| {
         let integrator = Integrator::Path(PathTracer::default());
         let (snapshot, _) = render_with(scene, integrator, SamplerKind::Sobol, 16, 3, 2, 16);

@@ -17,7 +17,7 @@ mod wide_bvh;
 
 use crate::math::{OffsetMode, Ray, gamma};
 use crate::scene::camera::Camera;
-pub use clearance::ClearVoxels;
+pub use clearance::ShadowVoxels;
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
@@ -605,10 +605,10 @@ impl Geometry {
         PrimaryCandidates::build(camera, &self.tri_vertices)
     }
 
-    /// Voxels from which shadow rays to the flat light `light` (its corners,
-    /// in order; its own triangles are the light's id `light_id`) cannot be
-    /// blocked, for soups without spheres or motion (see [`ClearVoxels`]).
-    pub fn clear_voxels(&self, light_id: u32, light: &[Vec3A]) -> Option<ClearVoxels> {
+    /// Per voxel, the triangles that may block shadow rays to the flat light
+    /// `light` (its corners, in order; its own triangles carry the light id
+    /// `light_id`), for soups without spheres or motion (see [`ShadowVoxels`]).
+    pub fn shadow_voxels(&self, light_id: u32, light: &[Vec3A]) -> Option<ShadowVoxels> {
         let TriangleIndex::Soup(soup) = &self.tri_index else {
             return None;
         };
@@ -616,27 +616,37 @@ impl Geometry {
             return None;
         }
         // Shadow rays end just before the light's surface, off its own
-        // triangles by the light sample's error bound.
-        let occluders: Vec<[Vec3A; 3]> = (0..soup.inner_triangles())
+        // triangles by the light sample's error bound; the soup's face
+        // triangles cannot block a segment inside its box.
+        let occluders: Vec<(u32, [Vec3A; 3])> = (0..soup.inner_triangles())
             .filter(|&i| self.tri_shading[i].light != light_id)
-            .map(|i| self.tri_vertices[i])
+            .map(|i| (i as u32, self.tri_vertices[i]))
             .collect();
         let (lo, hi) = soup.bounds();
         let margin = (hi - lo).max_element() * 1e-4;
-        Some(ClearVoxels::build(lo, hi, light, &occluders, margin))
+        Some(ShadowVoxels::build(lo, hi, light, &occluders, margin))
     }
 
     /// [`Geometry::occluded`] for a shadow ray that ends on the light of
-    /// `clear` (built by [`Geometry::clear_voxels`]): from a clear voxel,
-    /// with both ends inside the box (so that the walls cannot block it,
-    /// as the soup's own test reasons), the answer is known without a test.
+    /// `voxels` (built by [`Geometry::shadow_voxels`]): with both ends inside
+    /// the box (so that its faces cannot block it, as the soup reasons),
+    /// only the origin voxel's occluders are tested, by the same watertight
+    /// test, so the answer is the whole test's.
     #[inline(always)]
-    pub fn occluded_towards(&self, ray: &Ray, clear: &ClearVoxels) -> bool {
+    pub fn occluded_towards(&self, ray: &Ray, voxels: &ShadowVoxels) -> bool {
         if let TriangleIndex::Soup(soup) = &self.tri_index
-            && clear.is_clear(ray.origin)
+            && let Some(occluders) = voxels.occluders_from(ray.origin)
             && soup.segment_inside(ray, ray.t_max)
         {
-            return false;
+            if occluders.is_empty() {
+                return false;
+            }
+            let sheared = ShearedRay::new(ray);
+            return occluders.iter().any(|&i| {
+                sheared
+                    .intersect(&self.tri_vertices[i as usize], ray.t_max)
+                    .is_some()
+            });
         }
         self.occluded(ray)
     }

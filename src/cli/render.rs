@@ -556,11 +556,13 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         settings.integrator,
         tracelab::integrator::Integrator::Path(_)
     ) {
-        for (light, clear) in session.scene().clearance.iter().enumerate() {
-            if let Some(clear) = clear {
+        for (light, voxels) in session.scene().clearance.iter().enumerate() {
+            if let Some(voxels) = voxels {
+                let (clear, listed) = voxels.summary();
                 eprintln!(
-                    "shadow rays to light {light} need no test from {:.0}% of the scene's voxels (the light is seen whole there)",
-                    100.0 * clear.clear_fraction()
+                    "shadow rays to light {light}: no test from {:.0}% of the scene's voxels (the light is seen whole), a short list of occluders from {:.0}%",
+                    100.0 * clear,
+                    100.0 * listed
                 );
             }
         }

@@ -69,14 +69,14 @@ struct PendingShadow {
 
 impl PendingShadow {
     /// Traces the shadow ray: whether the light is visible. Where the scene
-    /// knows the light to be seen whole from the ray's origin
-    /// ([`crate::accel::ClearVoxels`]) the answer needs no traversal; the
-    /// ray still counts, as the estimator cast it.
+    /// knows which triangles can block rays from the origin's voxel to the
+    /// light ([`crate::accel::ShadowVoxels`]) only those are tested, and none
+    /// where the light is seen whole; the ray counts either way.
     #[inline(always)]
     fn visible(&self, scene: &Scene, counts: &mut RayCounts) -> bool {
         counts.shadow += 1;
         match scene.clearance.get(self.light as usize) {
-            Some(Some(clear)) => !scene.geometry.occluded_towards(&self.ray, clear),
+            Some(Some(voxels)) => !scene.geometry.occluded_towards(&self.ray, voxels),
             _ => !scene.geometry.occluded(&self.ray),
         }
     }

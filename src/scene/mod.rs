@@ -9,7 +9,7 @@ pub mod load;
 pub mod material;
 pub mod obj;
 
-use crate::accel::{ClearVoxels, Geometry, PrimaryCandidates, Sphere, TriangleInput};
+use crate::accel::{Geometry, PrimaryCandidates, ShadowVoxels, Sphere, TriangleInput};
 use crate::error::{Error, Result};
 use crate::math::OffsetMode;
 use camera::Camera;
@@ -206,16 +206,16 @@ pub struct Scene {
     /// Each pixel's candidate triangles for camera rays, where the camera and
     /// geometry allow them (made for `camera`: see [`Scene::set_camera`]).
     pub primary: Option<Arc<PrimaryCandidates>>,
-    /// Per light, the voxels from which shadow rays to it cannot be blocked
-    /// (flat lights in soups; see [`ClearVoxels`]).
-    pub clearance: Arc<[Option<ClearVoxels>]>,
+    /// Per light, which triangles may block shadow rays to it from each
+    /// voxel of the scene (flat lights in soups; see [`ShadowVoxels`]).
+    pub clearance: Arc<[Option<ShadowVoxels>]>,
 }
 
-/// Lights up to this many get [`ClearVoxels`] (each costs a build at load).
+/// Lights up to this many get [`ShadowVoxels`] (each costs a build at load).
 const MAX_CLEARANCE_LIGHTS: usize = 8;
 
-/// Each flat light's [`ClearVoxels`], where the geometry allows them.
-fn light_clearance(geometry: &Geometry, lights: &Lights) -> Arc<[Option<ClearVoxels>]> {
+/// Each flat light's [`ShadowVoxels`], where the geometry allows them.
+fn light_clearance(geometry: &Geometry, lights: &Lights) -> Arc<[Option<ShadowVoxels>]> {
     let lights = lights.as_slice();
     if lights.len() > MAX_CLEARANCE_LIGHTS {
         return Arc::from(vec![None; lights.len()]);
@@ -225,9 +225,9 @@ fn light_clearance(geometry: &Geometry, lights: &Lights) -> Arc<[Option<ClearVox
         .enumerate()
         .map(|(id, light)| match light {
             Light::Triangle(p) => {
-                geometry.clear_voxels(id as u32, &[p.p0, p.p0 + p.e1, p.p0 + p.e2])
+                geometry.shadow_voxels(id as u32, &[p.p0, p.p0 + p.e1, p.p0 + p.e2])
             }
-            Light::Parallelogram(p) => geometry.clear_voxels(
+            Light::Parallelogram(p) => geometry.shadow_voxels(
                 id as u32,
                 &[p.p0, p.p0 + p.e1, p.p0 + p.e1 + p.e2, p.p0 + p.e2],
             ),
