@@ -54,10 +54,13 @@ impl Geometry {
     /// `voxels` (built by [`Geometry::shadow_voxels`]): with both ends inside
     /// the box (so that its faces cannot block it, as the soup reasons),
     /// only the origin voxel's occluders are tested, by the same watertight
-    /// test, so the answer is the whole test's.
+    /// test, so the answer is the whole test's. A fixed-epsilon offset
+    /// (`--offset fixed:E`) may end the ray farther off the light than the
+    /// voxels' margin allows for: those rays take the whole test.
     #[inline(always)]
     pub fn occluded_towards(&self, ray: &Ray, voxels: &ShadowVoxels) -> bool {
         if let TriangleIndex::Soup(soup) = &self.tri_index
+            && self.offset == OffsetMode::Robust
             && let Some(occluders) = voxels.occluders_from(ray.origin)
             && soup.segment_inside(ray, ray.t_max)
         {
