@@ -202,21 +202,13 @@ impl EdgeTests {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::triangle::ShearedRay;
+    use crate::accel::triangle::closest_by_scalar_test;
     use crate::sampling::hash::{hash_combine, to_unit_float};
     use glam::Vec2;
 
-    /// The closest hit over all triangles by the scalar test, in storage order.
+    /// The closest hit over all triangles by the scalar test: (index, t).
     fn closest(ray: &crate::math::Ray, triangles: &[[Vec3A; 3]]) -> Option<(usize, f32)> {
-        let sheared = ShearedRay::new(ray);
-        let mut best: Option<(usize, f32)> = None;
-        for (i, tri) in triangles.iter().enumerate() {
-            let t_max = best.map_or(f32::INFINITY, |b| b.1);
-            if let Some((t, _, _)) = sheared.intersect(tri, t_max) {
-                best = Some((i, t));
-            }
-        }
-        best
+        closest_by_scalar_test(ray, triangles).map(|(k, t, _, _)| (k, t))
     }
 
     /// Random triangles in front of a camera, a room's floor and walls

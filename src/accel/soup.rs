@@ -175,7 +175,7 @@ impl TriangleSoup {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::triangle::ShearedRay;
+    use crate::accel::triangle::{ShearedRay, closest_by_scalar_test};
     use crate::sampling::hash::{hash_combine, to_unit_float};
 
     #[test]
@@ -192,14 +192,7 @@ mod tests {
             let origin = Vec3A::new(u(1, i), u(2, i), u(3, i)) * 4.0 - Vec3A::splat(2.0);
             let direction = (Vec3A::new(u(4, i), u(5, i), u(6, i)) * 2.0 - Vec3A::ONE).normalize();
             let ray = Ray::new(origin, direction);
-            let sheared = ShearedRay::new(&ray);
-            let mut expected: Option<TriangleHit> = None;
-            for (k, tri) in triangles.iter().enumerate() {
-                let t_max = expected.map_or(f32::INFINITY, |h| h.1);
-                if let Some((t, b1, b2)) = sheared.intersect(tri, t_max) {
-                    expected = Some((k, t, b1, b2));
-                }
-            }
+            let expected = closest_by_scalar_test(&ray, &triangles);
             assert_eq!(
                 soup.closest(&ray, f32::INFINITY, &triangles),
                 expected,
@@ -264,18 +257,13 @@ mod tests {
             assert_eq!(soup.any(&ray, t_max, &stored), expected, "ray {i}");
             // Closest hits, which skip the faces once an inner hit is nearer
             // than the box's exit, agree too.
-            let mut closest: Option<TriangleHit> = None;
-            for (k, tri) in stored.iter().enumerate() {
-                let t_max = closest.map_or(f32::INFINITY, |h| h.1);
-                if let Some((t, b1, b2)) = sheared.intersect(tri, t_max) {
-                    closest = Some((k, t, b1, b2));
-                }
-            }
+            let closest = closest_by_scalar_test(&ray, &stored);
             assert_eq!(
                 soup.closest(&ray, f32::INFINITY, &stored),
                 closest,
                 "ray {i}"
             );
+            // The 13 inner triangles are stored first.
             face_skips += usize::from(
                 closest.is_some_and(|h| h.0 < 13) && soup.exit_distance(&ray) > closest.unwrap().1,
             );

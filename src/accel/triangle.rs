@@ -120,6 +120,24 @@ impl ShearedRay {
     }
 }
 
+/// The closest hit among all `triangles` by the scalar test, in storage
+/// order (index, t, b1, b2): what every faster query must reproduce.
+#[cfg(test)]
+pub fn closest_by_scalar_test(
+    ray: &Ray,
+    triangles: &[[Vec3A; 3]],
+) -> Option<(usize, f32, f32, f32)> {
+    let sheared = ShearedRay::new(ray);
+    let mut best: Option<(usize, f32, f32, f32)> = None;
+    for (k, tri) in triangles.iter().enumerate() {
+        let t_max = best.map_or(f32::INFINITY, |h| h.1);
+        if let Some((t, b1, b2)) = sheared.intersect(tri, t_max) {
+            best = Some((k, t, b1, b2));
+        }
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
