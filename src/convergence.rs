@@ -71,6 +71,13 @@ impl BenchConfig {
                 "max-depth" => integrator.max_depth = number()?,
                 "rr-depth" => integrator.rr_depth = number()?,
                 "rr" => integrator.russian_roulette = value != "off",
+                "seen-emitters" => {
+                    integrator.exact_seen_emitters = match value {
+                        "exact" => true,
+                        "sampled" => false,
+                        _ => return Err(err(format!("seen-emitters `{value}` (exact, sampled)"))),
+                    }
+                }
                 "shadow-rays" => integrator.shadow_rays = number()?,
                 "glossy-rays" => integrator.glossy_rays = number()?,
                 "strategy" => {

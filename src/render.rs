@@ -281,7 +281,7 @@ impl Session {
                         // sampler, it runs beside the path before it instead
                         // of holding up its own.
                         let end = begin + count;
-                        let candidates = primary.and_then(|p| p.of_pixel(pixel_index));
+                        let known = primary.map(|p| p.pixel(pixel_index)).unwrap_or_default();
                         ahead.start(pixel_index, begin);
                         let mut ray_ahead =
                             camera_ray(scene, &mut ahead, x, y, deterministic, general);
@@ -297,7 +297,7 @@ impl Session {
                             let mut value = settings.integrator.radiance(
                                 scene,
                                 ray,
-                                candidates,
+                                known,
                                 &mut sampler,
                                 &mut counts,
                             );

@@ -129,14 +129,14 @@ pub fn replay_sample(
         )],
     };
     // The camera ray tests what the render's does.
-    let candidates = scene
+    let pixel = scene
         .primary_candidates()
-        .filter(|_| !tracer.general)
-        .and_then(|p| p.of_pixel(y * scene.camera.width + x));
+        .map(|p| p.pixel(y * scene.camera.width + x))
+        .unwrap_or_default();
     let value = tracer.radiance_observed(
         scene,
         ray,
-        candidates,
+        pixel,
         &mut sampler,
         &mut RayCounts::default(),
         &mut log,

@@ -73,7 +73,12 @@ fn camera_ray_candidates_and_shadow_voxels_change_no_pixel() {
         "{clear} clear, {listed} listed"
     );
     let render = |scene| {
-        let integrator = Integrator::Path(PathTracer::default());
+        // Seen emitters come with the lists: sampled here, so that only
+        // the lists differ.
+        let integrator = Integrator::Path(PathTracer {
+            exact_seen_emitters: false,
+            ..PathTracer::default()
+        });
         let (snapshot, _) = render_with(scene, integrator, SamplerKind::Sobol, 16, 3, 2, 16);
         snapshot
             .image

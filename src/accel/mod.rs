@@ -11,6 +11,7 @@ mod block;
 mod clearance;
 mod known_visibility;
 mod primary;
+mod seen_emitters;
 mod soup;
 mod sphere;
 mod triangle;
@@ -26,7 +27,7 @@ use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
 use obvhs::ploc::PlocBuilder;
-pub use primary::PrimaryCandidates;
+pub use primary::{PrimaryCandidates, PrimaryPixel};
 use soup::TriangleSoup;
 use sphere::intersect_sphere;
 use wide_bvh::WideBvh;
@@ -399,6 +400,16 @@ impl Geometry {
     /// Material of triangle `i` (BVH order).
     pub fn triangle_material(&self, i: usize) -> u32 {
         self.tri_shading[i].material
+    }
+
+    /// Light of triangle `i` (BVH order), or [`NO_LIGHT`].
+    pub fn triangle_light(&self, i: usize) -> u32 {
+        self.tri_shading[i].light
+    }
+
+    /// Unit geometric normal of triangle `i` (BVH order).
+    pub fn triangle_normal(&self, i: usize) -> Vec3A {
+        self.tri_shading[i].normal
     }
 
     /// Spheres in BVH order.

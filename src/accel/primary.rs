@@ -10,6 +10,8 @@
 //! Candidates are tested in storage order by the same watertight test, so
 //! the hit is the one the soup finds.
 
+use super::seen_emitters::integrate_seen_emitters;
+use crate::math::Rgb;
 use crate::scene::camera::Camera;
 use glam::{DVec2, DVec3, Vec3A};
 
@@ -31,7 +33,26 @@ pub struct PrimaryCandidates {
     ranges: Vec<[u32; 2]>,
     /// The lists, one after the other, each in storage order.
     triangles: Vec<u32>,
+    /// Per pixel, an index into `seen_values` or [`NOT_SEEN`]; empty when
+    /// no pixel sees an emitter (see [`PrimaryCandidates::with_seen_emitters`]).
+    seen_index: Vec<u32>,
+    /// Emission seen through a pixel, integrated over its square.
+    seen_values: Vec<Rgb>,
 }
+
+/// What a renderer knows in advance about the camera rays of one pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PrimaryPixel<'a> {
+    /// The only triangles they can hit, in storage order, where known.
+    pub candidates: Option<&'a [u32]>,
+    /// The emission they see directly, integrated exactly over the pixel
+    /// (`crate::accel::seen_emitters`); where it is known, a camera ray's
+    /// hit on an emitter adds no emission of its own.
+    pub seen_emission: Option<Rgb>,
+}
+
+/// Marks a pixel whose seen emission is not known.
+const NOT_SEEN: u32 = u32::MAX;
 
 /// Marks a pixel whose camera rays test the whole scene.
 const FULL_TEST: u32 = u32::MAX;
@@ -102,7 +123,60 @@ impl PrimaryCandidates {
             camera: *camera,
             ranges,
             triangles: lists,
+            seen_index: Vec::new(),
+            seen_values: Vec::new(),
         })
+    }
+
+    /// Adds each pixel's directly seen emission, integrated over the pixel,
+    /// where it can be known exactly (`crate::accel::seen_emitters`).
+    /// `seen_radiance(i)`: what triangle `i` (storage order) emits towards
+    /// the eye, None when it is not a light.
+    pub fn with_seen_emitters(
+        mut self,
+        triangles: &[[Vec3A; 3]],
+        seen_radiance: impl Fn(usize) -> Option<Rgb>,
+    ) -> Self {
+        let pixels = self.ranges.len() as u32;
+        let seen = integrate_seen_emitters(
+            &self.camera,
+            triangles,
+            (0..pixels).map(|p| self.of_pixel(p)),
+            seen_radiance,
+        );
+        self.seen_values.clear();
+        self.seen_index = seen
+            .iter()
+            .map(|value| match value {
+                Some(v) => {
+                    self.seen_values.push(*v);
+                    self.seen_values.len() as u32 - 1
+                }
+                None => NOT_SEEN,
+            })
+            .collect();
+        if self.seen_values.is_empty() {
+            self.seen_index = Vec::new();
+        }
+        self
+    }
+
+    /// What is known about `pixel`'s camera rays.
+    #[inline(always)]
+    pub fn pixel(&self, pixel: u32) -> PrimaryPixel<'_> {
+        let seen_emission = match self.seen_index.get(pixel as usize) {
+            Some(&i) if i != NOT_SEEN => Some(self.seen_values[i as usize]),
+            _ => None,
+        };
+        PrimaryPixel {
+            candidates: self.of_pixel(pixel),
+            seen_emission,
+        }
+    }
+
+    /// Pixels whose seen emission is integrated exactly.
+    pub fn pixels_with_seen_emission(&self) -> usize {
+        self.seen_values.len()
     }
 
     /// True when the lists were made for `camera`.
@@ -131,7 +205,7 @@ impl PrimaryCandidates {
 /// The triangle's vertices in pixel coordinates (x right, y down, as
 /// [`Camera::generate_ray`] reads its film position), or None when a vertex
 /// lies on or behind the eye's image plane.
-fn project_triangle(camera: &Camera, triangle: &[Vec3A; 3]) -> Option<[DVec2; 3]> {
+pub(super) fn project_triangle(camera: &Camera, triangle: &[Vec3A; 3]) -> Option<[DVec2; 3]> {
     let aspect = f64::from(camera.width) / f64::from(camera.height);
     let tan_y = f64::from(camera.tan_half_fov_y);
     let (right, up, forward) = (
@@ -160,15 +234,15 @@ fn project_triangle(camera: &Camera, triangle: &[Vec3A; 3]) -> Option<[DVec2; 3]
 
 /// The projected triangle's edge lines, oriented so that its inside is on
 /// their positive side.
-struct EdgeTests {
+pub(super) struct EdgeTests {
     /// (normal, offset): a point p is on the inner side when normal . p >= offset.
-    edges: [(DVec2, f64); 3],
+    pub(super) edges: [(DVec2, f64); 3],
     /// A triangle seen edge-on has no inside to test: its bounding box decides.
-    degenerate: bool,
+    pub(super) degenerate: bool,
 }
 
 impl EdgeTests {
-    fn new(p: &[DVec2; 3]) -> Self {
+    pub(super) fn new(p: &[DVec2; 3]) -> Self {
         let area2 = (p[1] - p[0]).perp_dot(p[2] - p[0]);
         let orientation = area2.signum();
         let edges = [0, 1, 2].map(|i| {

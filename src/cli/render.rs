@@ -43,6 +43,12 @@ enum GlassShadowsArg {
     Tinted,
 }
 
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum SeenEmittersArg {
+    Exact,
+    Sampled,
+}
+
 #[derive(ValueEnum, Clone, Copy, Debug)]
 enum SamplerArg {
     /// Independent uniform numbers.
@@ -120,6 +126,11 @@ pub struct RenderArgs {
     /// specialised for the scene's features (to measure what that saves).
     #[arg(long)]
     general: bool,
+    /// Path tracing: emitters seen directly through a pixel are integrated
+    /// exactly over it where nothing can hide them (`exact`), or sampled by
+    /// the camera rays like everything else (`sampled`).
+    #[arg(long, value_enum, default_value = "exact")]
+    seen_emitters: SeenEmittersArg,
     /// Whitted: constant ambient radiance times the diffuse albedo.
     #[arg(long, default_value_t = 0.0)]
     ambient: f32,
@@ -472,6 +483,7 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
             GlassShadowsArg::Tinted => GlassShadows::Tinted,
         },
         general: args.general,
+        exact_seen_emitters: args.seen_emitters == SeenEmittersArg::Exact,
     })
 }
 
@@ -574,6 +586,16 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         let (mean, full) = lists.summary();
         eprintln!(
             "camera rays test their pixel's candidate triangles only: {mean:.2} per pixel ({full} pixels test all)"
+        );
+    }
+    if let (tracelab::integrator::Integrator::Path(p), Some(lists)) =
+        (&settings.integrator, session.scene().primary_candidates())
+        && p.exact_seen_emitters
+        && lists.pixels_with_seen_emission() > 0
+    {
+        eprintln!(
+            "lights seen directly: integrated exactly over {} pixels (--seen-emitters sampled to sample them)",
+            lists.pixels_with_seen_emission()
         );
     }
     match settings.adaptive {

@@ -20,6 +20,7 @@ pub use options::{IntegratorKind, IntegratorOptions, Strategy};
 pub use path::PathTracer;
 pub use whitted::{GlassShadows, WhittedTracer};
 
+use crate::accel::PrimaryPixel;
 use crate::math::{Ray, Rgb};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
@@ -79,21 +80,21 @@ pub enum Integrator {
 
 impl Integrator {
     /// One radiance sample along the camera ray `ray`. Counts the rays it
-    /// casts after the camera ray into `counts`. `candidates`: the only
-    /// triangles `ray` can hit, where known (the path tracer uses them).
+    /// casts after the camera ray into `counts`. `pixel`: what is known in
+    /// advance about the ray's pixel (the path tracer uses it).
     #[inline]
     pub fn radiance(
         &self,
         scene: &Scene,
         ray: Ray,
-        candidates: Option<&[u32]>,
+        pixel: PrimaryPixel<'_>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
         match self {
             Integrator::Whitted(w) => w.radiance(scene, ray, counts),
             Integrator::Mcrt(m) => m.radiance(scene, ray, sampler, counts),
-            Integrator::Path(p) => p.radiance(scene, ray, candidates, sampler, counts),
+            Integrator::Path(p) => p.radiance(scene, ray, pixel, sampler, counts),
             // Light tracing splats instead; the session never calls this for it.
             Integrator::Light(_) => Rgb::ZERO,
         }

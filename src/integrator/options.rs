@@ -71,6 +71,10 @@ pub struct IntegratorOptions {
     /// Path tracing and Whitted: the general code even where a specialised
     /// one applies.
     pub general: bool,
+    /// Path tracing: emitters seen directly are integrated exactly over each
+    /// pixel where that is possible (`crate::accel::seen_emitters`); off,
+    /// camera rays sample them like everything else.
+    pub exact_seen_emitters: bool,
 }
 
 impl Default for IntegratorOptions {
@@ -87,6 +91,7 @@ impl Default for IntegratorOptions {
             ambient: 0.0,
             glass_shadows: GlassShadows::Opaque,
             general: false,
+            exact_seen_emitters: true,
         }
     }
 }
@@ -122,6 +127,7 @@ impl IntegratorOptions {
                     _ => mis,
                 },
                 general: self.general,
+                exact_seen_emitters: self.exact_seen_emitters,
             }),
             IntegratorKind::Light => Integrator::Light(LightTracer {
                 max_depth: self.max_depth,

@@ -9,7 +9,7 @@
 //! where beta_k is the product of f cos / p_bsdf (and 1/q of roulette) so far.
 
 use super::{MisHeuristic, RayCounts, survives_roulette};
-use crate::accel::{NO_LIGHT, SurfaceHit};
+use crate::accel::{NO_LIGHT, PrimaryPixel, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, ray_between};
 use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
@@ -108,6 +108,9 @@ pub struct PathTracer {
     /// Use the general loop even where the scene allows a specialised one
     /// (for measuring what specialisation saves).
     pub general: bool,
+    /// Emission seen directly is integrated exactly over the pixel where the
+    /// scene knows it ([`PrimaryPixel::seen_emission`]) instead of sampled.
+    pub exact_seen_emitters: bool,
 }
 
 impl Default for PathTracer {
@@ -119,6 +122,7 @@ impl Default for PathTracer {
             nee: true,
             mis: MisHeuristic::Power,
             general: false,
+            exact_seen_emitters: true,
         }
     }
 }
@@ -140,51 +144,66 @@ impl PathTracer {
     }
 
     /// One radiance sample along `ray`, by the loop specialised for what
-    /// the scene uses (see [`crate::scene::Features`]). `candidates`: the
-    /// only triangles the camera ray can hit, when they are known
-    /// ([`crate::accel::PrimaryCandidates`]).
+    /// the scene uses (see [`crate::scene::Features`]). `pixel`: what is
+    /// known of the camera ray's pixel ([`crate::accel::PrimaryCandidates`]).
     #[inline]
     pub fn radiance(
         &self,
         scene: &Scene,
         ray: Ray,
-        candidates: Option<&[u32]>,
+        pixel: PrimaryPixel<'_>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
-        let candidates = candidates.filter(|_| !self.general);
-        self.radiance_observed(scene, ray, candidates, sampler, counts, &mut NoObserver)
+        self.radiance_observed(scene, ray, pixel, sampler, counts, &mut NoObserver)
     }
 
     /// [`PathTracer::radiance`], telling `observer` about every vertex.
+    ///
+    /// Where the pixel's directly seen emission is known, integrated over
+    /// the pixel, every sample adds it and the camera ray's own hit on an
+    /// emitter adds nothing: the pixel's mean is unchanged, and what varied
+    /// with where in the pixel the ray went (an emitter's rim) does not.
     #[inline]
     pub fn radiance_observed<O: PathObserver>(
         &self,
         scene: &Scene,
         ray: Ray,
-        candidates: Option<&[u32]>,
+        pixel: PrimaryPixel<'_>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
         observer: &mut O,
     ) -> Rgb {
         let f = scene.features;
-        let c = candidates;
-        if self.general || f.specular() {
-            self.trace::<true, false, O>(scene, ray, c, sampler, counts, observer)
+        // The general loop tests everything, as a renderer without the
+        // lists would; it still integrates seen emitters, so that its image
+        // stays the specialised loop's.
+        let p = PrimaryPixel {
+            candidates: pixel.candidates.filter(|_| !self.general),
+            seen_emission: pixel.seen_emission.filter(|_| self.exact_seen_emitters),
+        };
+        let traced = if self.general || f.specular() {
+            self.trace::<true, false, O>(scene, ray, p, sampler, counts, observer)
         } else if f.diffuse_only() {
-            self.trace::<false, true, O>(scene, ray, c, sampler, counts, observer)
+            self.trace::<false, true, O>(scene, ray, p, sampler, counts, observer)
         } else {
-            self.trace::<false, false, O>(scene, ray, c, sampler, counts, observer)
+            self.trace::<false, false, O>(scene, ray, p, sampler, counts, observer)
+        };
+        match p.seen_emission {
+            Some(emission) => emission + traced,
+            None => traced,
         }
     }
 
     /// The path loop. `SPECULAR`: the scene may have mirror or glass
-    /// surfaces. `DIFFUSE_ONLY`: every BSDF is Lambertian.
+    /// surfaces. `DIFFUSE_ONLY`: every BSDF is Lambertian. `pixel`: the
+    /// camera ray's candidates, and whether its emission is accounted for
+    /// outside the loop.
     fn trace<const SPECULAR: bool, const DIFFUSE_ONLY: bool, O: PathObserver>(
         &self,
         scene: &Scene,
         mut ray: Ray,
-        mut candidates: Option<&[u32]>,
+        pixel: PrimaryPixel<'_>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
         observer: &mut O,
@@ -197,6 +216,8 @@ impl PathTracer {
         let mut prev_bsdf_pdf = 0.0;
         let mut prev_point = ray.origin;
         let mut bounces = 0;
+        let mut candidates = pixel.candidates;
+        let seen_known = pixel.seen_emission.is_some();
         loop {
             // Every vertex consumes the same five dimensions (light choice,
             // light point, lobe, BSDF direction, roulette), so stratified
@@ -228,7 +249,7 @@ impl PathTracer {
             let wo_world = -ray.direction;
             let material = &scene.materials[hit.material as usize];
 
-            if hit.light != NO_LIGHT {
+            if hit.light != NO_LIGHT && !(seen_known && bounces == 0) {
                 let emitted = material.emitted(hit.normal, wo_world);
                 if emitted.max_element() > 0.0 {
                     let weight = if specular_bounce || !self.nee {

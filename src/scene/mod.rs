@@ -9,7 +9,7 @@ pub mod load;
 pub mod material;
 pub mod obj;
 
-use crate::accel::{Geometry, PrimaryCandidates, ShadowVoxels, Sphere, TriangleInput};
+use crate::accel::{Geometry, NO_LIGHT, PrimaryCandidates, ShadowVoxels, Sphere, TriangleInput};
 use crate::error::{Error, Result};
 use crate::math::OffsetMode;
 use camera::Camera;
@@ -211,6 +211,27 @@ pub struct Scene {
     pub clearance: Arc<[Option<ShadowVoxels>]>,
 }
 
+/// Camera rays' candidate lists for `camera`, with the emission each pixel
+/// sees directly, where the geometry allows them.
+fn primary_for(
+    geometry: &Geometry,
+    materials: &[Material],
+    camera: &Camera,
+) -> Option<Arc<PrimaryCandidates>> {
+    let triangles = geometry.triangles();
+    let candidates = geometry.primary_candidates(camera)?;
+    let with_seen = candidates.with_seen_emitters(triangles, |i| {
+        if geometry.triangle_light(i) == NO_LIGHT {
+            return None;
+        }
+        // One side of a flat emitter faces the eye everywhere on it.
+        let towards_eye = (camera.eye - triangles[i][0]).normalize_or_zero();
+        let material = &materials[geometry.triangle_material(i) as usize];
+        Some(material.emitted(geometry.triangle_normal(i), towards_eye))
+    });
+    Some(Arc::new(with_seen))
+}
+
 /// Lights up to this many get [`ShadowVoxels`] (each costs a build at load).
 const MAX_CLEARANCE_LIGHTS: usize = 8;
 
@@ -374,7 +395,7 @@ impl Scene {
             warnings.push("the scene has no light source: the image will be black".into());
         }
         let features = Features::detect(&input.materials, &geometry, &lights, &input.camera);
-        let primary = geometry.primary_candidates(&input.camera).map(Arc::new);
+        let primary = primary_for(&geometry, &input.materials, &input.camera);
         let clearance = light_clearance(&geometry, &lights);
         Ok(Scene {
             camera: input.camera,
@@ -414,7 +435,7 @@ impl Scene {
     pub fn set_camera(&mut self, camera: Camera) {
         if camera != self.camera {
             self.camera = camera;
-            self.primary = self.geometry.primary_candidates(&camera).map(Arc::new);
+            self.primary = primary_for(&self.geometry, &self.materials, &camera);
         }
     }
 

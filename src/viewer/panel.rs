@@ -168,6 +168,14 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                 mis_heuristic(ui, &mut options.mis);
             }
             roulette(ui, &mut options.russian_roulette, &mut options.rr_depth);
+            ui.checkbox(
+                &mut options.exact_seen_emitters,
+                "Lights seen directly: exact per pixel",
+            )
+            .on_hover_text(
+                "A light seen through a pixel adds its exact share of the pixel's area \
+                 instead of being hit or missed by each camera ray: no noise on its rim",
+            );
         }
         IntegratorKind::Light => roulette(ui, &mut options.russian_roulette, &mut options.rr_depth),
     }
