@@ -66,10 +66,12 @@ intensity = [1.0, 1.0, 1.0]
 "#;
 
 #[test]
-fn mc_ray_tracing_casts_186_rays_per_pixel_with_depth_2_and_5_by_5_branching() {
+fn mc_ray_tracing_casts_186_rays_per_pixel_with_two_branching_levels_and_5_by_5_branching() {
+    // Cook's tree with D = 2 levels of branching gathers light of three
+    // bounces: --max-depth counts bounces, so it is max_depth 3.
     let options = IntegratorOptions {
         kind: IntegratorKind::Mcrt,
-        max_depth: 2,
+        max_depth: 3,
         shadow_rays: 5,
         glossy_rays: 5,
         ..Default::default()

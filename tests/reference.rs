@@ -124,17 +124,24 @@ fn path_tracing_with_bsdf_or_light_sampling_alone_matches_mitsuba() {
     }
 }
 
+/// Also at depth 1, where a bounce too many (as MC ray tracing had until
+/// session 12: light samples at its last level too) is 14-16% of the image.
 #[test]
 fn mc_ray_tracing_without_branching_matches_mitsuba() {
-    check_against_reference(
-        IntegratorOptions {
-            shadow_rays: 1,
-            glossy_rays: 1,
-            ..options(IntegratorKind::Mcrt, 8)
-        },
-        "cornell_box_path_ref.exr",
-        "cornell_box_path_ref_var.exr",
-    );
+    for (depth, reference, variance) in [
+        (8, "cornell_box_path_ref.exr", "cornell_box_path_ref_var.exr"),
+        (1, "cornell_box_direct_ref.exr", "cornell_box_direct_ref_var.exr"),
+    ] {
+        check_against_reference(
+            IntegratorOptions {
+                shadow_rays: 1,
+                glossy_rays: 1,
+                ..options(IntegratorKind::Mcrt, depth)
+            },
+            reference,
+            variance,
+        );
+    }
 }
 
 #[test]
@@ -205,15 +212,19 @@ fn path_tracing_with_exact_seen_emitters_matches_mitsuba_with_less_error() {
     assert!(may_see_light > 400, "{may_see_light} pixels");
     assert_eq!(lists.pixels_with_seen_emission(), may_see_light);
 
-    let exact = check_against_reference_rmse(options(IntegratorKind::Path, 8));
-    let sampled = check_against_reference_rmse(IntegratorOptions {
-        exact_seen_emitters: false,
-        ..options(IntegratorKind::Path, 8)
-    });
-    assert!(
-        exact * 2.0 < sampled,
-        "RMSE with seen emitters exact {exact:.5}, sampled {sampled:.5}"
-    );
+    // MC ray tracing without branching is the path tracer's estimator, so
+    // the same margin holds for it.
+    for kind in [IntegratorKind::Path, IntegratorKind::Mcrt] {
+        let exact = check_against_reference_rmse(options(kind, 8));
+        let sampled = check_against_reference_rmse(IntegratorOptions {
+            exact_seen_emitters: false,
+            ..options(kind, 8)
+        });
+        assert!(
+            exact * 2.0 < sampled,
+            "{kind:?}: RMSE with seen emitters exact {exact:.5}, sampled {sampled:.5}"
+        );
+    }
 }
 
 fn check_against_reference_rmse(options: IntegratorOptions) -> f64 {

@@ -126,7 +126,7 @@ pub struct RenderArgs {
     /// specialised for the scene's features (to measure what that saves).
     #[arg(long)]
     general: bool,
-    /// Path tracing: emitters seen directly through a pixel are integrated
+    /// Path and MC ray tracing: emitters seen directly through a pixel are integrated
     /// exactly over it where nothing can hide them (`exact`), or sampled by
     /// the camera rays like everything else (`sampled`).
     #[arg(long, value_enum, default_value = "exact")]
@@ -173,7 +173,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1 << 24)]
     max_spp: u32,
     /// Largest number of rays one MC ray tracing sample may branch into
-    /// (M glossy rays per hit to depth D cast about M^D rays).
+    /// (M glossy rays per hit to depth D cast about M^(D-1) rays).
     #[arg(long, default_value_t = 1_000_000)]
     max_branch_rays: u64,
     /// Scale down samples whose largest component exceeds this value
@@ -588,9 +588,13 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
             "camera rays test their pixel's candidate triangles only: {mean:.2} per pixel ({full} pixels test all)"
         );
     }
-    if let (tracelab::integrator::Integrator::Path(p), Some(lists)) =
-        (&settings.integrator, session.scene().primary_candidates())
-        && p.exact_seen_emitters
+    let exact_seen_emitters = match &settings.integrator {
+        tracelab::integrator::Integrator::Path(p) => p.exact_seen_emitters,
+        tracelab::integrator::Integrator::Mcrt(m) => m.exact_seen_emitters,
+        _ => false,
+    };
+    if let Some(lists) = session.scene().primary_candidates()
+        && exact_seen_emitters
         && lists.pixels_with_seen_emission() > 0
     {
         eprintln!(

@@ -7,8 +7,12 @@
 //! (balance or power heuristic with sample counts): with densities p_l, p_b,
 //!   L(x) = (1/N) sum_i w_l f Le cos / p_l  +  (1/M) sum_j f cos / p_b [w_b Le(y_j) + L(y_j)]
 //!   w_l = (N p_l)^b / ((N p_l)^b + (M p_b)^b),   w_b likewise.
-//! At the last level no BSDF rays are cast (M = 0), so light samples carry
-//! all of the direct light there.
+//! `max_depth` counts bounces, as in the other estimators: the hits of
+//! levels 0..D-1 take light samples (light of 1..D bounces), and BSDF rays
+//! leave all but the last level. There none are cast (M = 0), so light
+//! samples carry all of the last bounce's light (BSDF rays remain where no
+//! light sample can be taken: specular surfaces, or N = 0). Cook's tree of
+//! two branching levels (the classic 186-ray example) is D = 3.
 
 use super::{MisHeuristic, RayCounts};
 use crate::accel::{NO_LIGHT, SurfaceHit};
@@ -28,6 +32,9 @@ pub struct McRayTracer {
     /// BSDF samples (secondary rays) per hit, each recursing.
     pub glossy_rays: u32,
     pub mis: MisHeuristic,
+    /// Emission seen directly is integrated exactly over the pixel where the
+    /// scene knows it (as the path tracer does), instead of sampled.
+    pub exact_seen_emitters: bool,
 }
 
 impl Default for McRayTracer {
@@ -37,6 +44,7 @@ impl Default for McRayTracer {
             shadow_rays: 5,
             glossy_rays: 5,
             mis: MisHeuristic::Power,
+            exact_seen_emitters: true,
         }
     }
 }
@@ -60,57 +68,64 @@ impl McRayTracer {
     }
 
     /// Expected rays per camera sample in a closed scene where every ray hits
-    /// a scattering surface: 1 + sum_{d=0..D} M^d N + sum_{d=1..D} M^d
-    /// (saturating at `u64::MAX`).
+    /// a non-specular scattering surface, with N > 0:
+    /// 1 + sum_{d=0..D-1} M^d N + sum_{d=1..D-1} M^d (saturating at `u64::MAX`).
     pub fn rays_per_sample_closed(&self) -> u64 {
         let (m, n) = (self.glossy_rays as u64, self.shadow_rays as u64);
         let mut total = 1;
         let mut width = 1u64;
-        for depth in 0..=self.max_depth {
+        for level in 0..self.max_depth {
             total = width.saturating_mul(n).saturating_add(total);
-            if depth < self.max_depth {
+            if level + 1 < self.max_depth {
                 width = width.saturating_mul(m);
                 total = total.saturating_add(width);
             }
-            if total == u64::MAX || (m == 0 && depth > 0) {
+            if total == u64::MAX || m == 0 {
                 break;
             }
         }
         total
     }
 
-    /// One radiance sample along the camera ray.
+    /// One radiance sample along the camera ray. `seen_emission`: the
+    /// emission its pixel sees directly, integrated over the pixel, where
+    /// known ([`crate::accel::PrimaryPixel`]); it then replaces the camera
+    /// hit's own emission, as in the path tracer.
     pub fn radiance(
         &self,
         scene: &Scene,
         ray: Ray,
+        seen_emission: Option<Rgb>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
+        let seen_emission = seen_emission.filter(|_| self.exact_seen_emitters);
         let Some(hit) = scene.geometry.intersect(&ray) else {
-            return Rgb::ZERO;
+            return seen_emission.unwrap_or(Rgb::ZERO);
         };
         let material = &scene.materials[hit.material as usize];
-        let emitted = if hit.light != NO_LIGHT {
-            material.emitted(hit.normal, -ray.direction)
-        } else {
-            Rgb::ZERO
+        let emitted = match seen_emission {
+            Some(emission) => emission,
+            None if hit.light != NO_LIGHT => material.emitted(hit.normal, -ray.direction),
+            None => Rgb::ZERO,
         };
         emitted + self.scattered(scene, &hit, -ray.direction, 0, sampler, counts)
     }
 
-    /// Light scattered at `hit` towards `wo_world`, excluding its emission.
+    /// Light scattered at `hit` (a vertex of level `level`, 0 at the camera
+    /// ray's hit) towards `wo_world`, excluding its emission: light of
+    /// bounces `level + 1 ..= max_depth`.
     fn scattered(
         &self,
         scene: &Scene,
         hit: &SurfaceHit,
         wo_world: glam::Vec3A,
-        depth: u32,
+        level: u32,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
         let bsdf = scene.materials[hit.material as usize].bsdf;
-        if bsdf.is_black() {
+        if level >= self.max_depth || bsdf.is_black() {
             return Rgb::ZERO;
         }
         let frame = Frame::from_normal(hit.normal);
@@ -120,10 +135,11 @@ impl McRayTracer {
         } else {
             self.shadow_rays
         };
-        let n_bsdf = if depth < self.max_depth {
-            self.glossy_rays
-        } else {
+        let last_level = level + 1 == self.max_depth;
+        let n_bsdf = if last_level && n_light > 0 {
             0
+        } else {
+            self.glossy_rays
         };
         let mut radiance = Rgb::ZERO;
 
@@ -180,7 +196,10 @@ impl McRayTracer {
                     radiance += beta * emitted * weight;
                 }
             }
-            radiance += beta * self.scattered(scene, &next, -wi_world, depth + 1, sampler, counts);
+            if !last_level {
+                radiance +=
+                    beta * self.scattered(scene, &next, -wi_world, level + 1, sampler, counts);
+            }
         }
         radiance
     }

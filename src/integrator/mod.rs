@@ -81,7 +81,7 @@ pub enum Integrator {
 impl Integrator {
     /// One radiance sample along the camera ray `ray`. Counts the rays it
     /// casts after the camera ray into `counts`. `pixel`: what is known in
-    /// advance about the ray's pixel (the path tracer uses it).
+    /// advance about the ray's pixel (path and MC ray tracing use it).
     #[inline]
     pub fn radiance(
         &self,
@@ -93,7 +93,7 @@ impl Integrator {
     ) -> Rgb {
         match self {
             Integrator::Whitted(w) => w.radiance(scene, ray, counts),
-            Integrator::Mcrt(m) => m.radiance(scene, ray, sampler, counts),
+            Integrator::Mcrt(m) => m.radiance(scene, ray, pixel.seen_emission, sampler, counts),
             Integrator::Path(p) => p.radiance(scene, ray, pixel, sampler, counts),
             // Light tracing splats instead; the session never calls this for it.
             Integrator::Light(_) => Rgb::ZERO,

@@ -71,8 +71,8 @@ pub struct IntegratorOptions {
     /// Path tracing and Whitted: the general code even where a specialised
     /// one applies.
     pub general: bool,
-    /// Path tracing: emitters seen directly are integrated exactly over each
-    /// pixel where that is possible (`crate::accel::seen_emitters`); off,
+    /// Path and MC ray tracing: emitters seen directly are integrated
+    /// exactly over each pixel where that is possible (`crate::accel::seen_emitters`); off,
     /// camera rays sample them like everything else.
     pub exact_seen_emitters: bool,
 }
@@ -116,6 +116,7 @@ impl IntegratorOptions {
                 shadow_rays: self.shadow_rays,
                 glossy_rays: self.glossy_rays,
                 mis,
+                exact_seen_emitters: self.exact_seen_emitters,
             }),
             IntegratorKind::Path => Integrator::Path(PathTracer {
                 max_depth: self.max_depth,

@@ -122,6 +122,14 @@ fn compare_section(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing
     });
 }
 
+fn seen_emitters(ui: &mut egui::Ui, exact: &mut bool) {
+    ui.checkbox(exact, "Lights seen directly: exact per pixel")
+        .on_hover_text(
+            "A light seen through a pixel adds its exact share of the pixel's area \
+             instead of being hit or missed by each camera ray: no noise on its rim",
+        );
+}
+
 fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
     ui.heading("Estimator");
     let options = &mut config.integrator;
@@ -149,10 +157,11 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                 options.shadow_rays = 1;
             }
             mis_heuristic(ui, &mut options.mis);
-            let rays = u64::from(options.glossy_rays).pow(options.max_depth.min(16));
+            seen_emitters(ui, &mut options.exact_seen_emitters);
+            let rays = u64::from(options.glossy_rays).pow(options.max_depth.clamp(1, 17) - 1);
             if rays > 100_000 {
                 ui.label(
-                    RichText::new(format!("M^D = {rays} rays per sample: slow"))
+                    RichText::new(format!("M^(D-1) = {rays} rays per sample: slow"))
                         .color(egui::Color32::YELLOW),
                 );
             }
@@ -168,14 +177,7 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                 mis_heuristic(ui, &mut options.mis);
             }
             roulette(ui, &mut options.russian_roulette, &mut options.rr_depth);
-            ui.checkbox(
-                &mut options.exact_seen_emitters,
-                "Lights seen directly: exact per pixel",
-            )
-            .on_hover_text(
-                "A light seen through a pixel adds its exact share of the pixel's area \
-                 instead of being hit or missed by each camera ray: no noise on its rim",
-            );
+            seen_emitters(ui, &mut options.exact_seen_emitters);
         }
         IntegratorKind::Light => roulette(ui, &mut options.russian_roulette, &mut options.rr_depth),
     }
