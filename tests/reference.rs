@@ -129,8 +129,16 @@ fn path_tracing_with_bsdf_or_light_sampling_alone_matches_mitsuba() {
 #[test]
 fn mc_ray_tracing_without_branching_matches_mitsuba() {
     for (depth, reference, variance) in [
-        (8, "cornell_box_path_ref.exr", "cornell_box_path_ref_var.exr"),
-        (1, "cornell_box_direct_ref.exr", "cornell_box_direct_ref_var.exr"),
+        (
+            8,
+            "cornell_box_path_ref.exr",
+            "cornell_box_path_ref_var.exr",
+        ),
+        (
+            1,
+            "cornell_box_direct_ref.exr",
+            "cornell_box_direct_ref_var.exr",
+        ),
     ] {
         check_against_reference(
             IntegratorOptions {
