@@ -34,10 +34,10 @@ pub struct BenchArgs {
     #[arg(long, default_value = "path:sobol")]
     reference_config: String,
     /// A configuration `integrator:sampler[:key=value...]`, e.g. `path:sobol`,
-    /// `path:stratified:max-depth=1`, `mcrt:independent:shadow-rays=5:glossy-rays=5:max-depth=2`,
-    /// `light:independent`; keys: max-depth, rr-depth, rr=off, seen-emitters=sampled, shadow-rays, glossy-rays,
-    /// strategy=bsdf|light|mis, light-sampling=area|solid-angle, domains=pixel+light,
-    /// distribute=N (adaptive sampling by noise after N spp). Repeatable.
+    /// `path:stratified:max-depth=1`, `mcrt:independent:shadow-rays=5:glossy-rays=5:max-depth=3`,
+    /// `light:independent`; keys: max-depth, rr-depth, rr=off, seen-emitters=sampled,
+    /// shadow-rays, glossy-rays, strategy=bsdf|light|mis, light-sampling=area|solid-angle,
+    /// domains=pixel+light, distribute=N (adaptive sampling by noise after N spp). Repeatable.
     #[arg(long = "config", required = true)]
     configs: Vec<String>,
     /// Largest sample count measured (powers of two from 1).
