@@ -1,6 +1,7 @@
 //! Different estimators of the same integral must agree: next-event
 //! estimation on and off, MIS with the balance heuristic, the power heuristic
-//! or none, Russian roulette on and off, all on the Cornell box.
+//! or none, Russian roulette on and off, all on the Cornell box; and lights
+//! seen directly integrated over the pixel or sampled, behind an occluder.
 //!
 //! Tolerance: the image is cut into 8x8 blocks of 8x8 pixels; each block mean
 //! has a standard error sqrt(sum se_i^2) / 64 from the per-pixel standard
@@ -9,16 +10,21 @@
 //! within 4.5 (Bonferroni at 1% would be 3.9; the margin covers the heavy
 //! tail of BSDF-only sampling, whose standard error is itself noisy).
 
-use crate::common::{cornell_box, render};
+use crate::common::{cornell_box, render, temp_dir};
+use tracelab::accel::NO_LIGHT;
 use tracelab::film::FilmSnapshot;
 use tracelab::integrator::{Integrator, MisHeuristic, PathTracer};
 use tracelab::sampling::SamplerKind;
+use tracelab::scene::Scene;
 
 const SIZE: u32 = 64;
 const BLOCK: u32 = 8;
 
 fn render_small(tracer: PathTracer, spp: u32, seed: u64) -> FilmSnapshot {
-    let mut scene = cornell_box();
+    render_scene(cornell_box(), tracer, spp, seed)
+}
+
+fn render_scene(mut scene: Scene, tracer: PathTracer, spp: u32, seed: u64) -> FilmSnapshot {
     scene.set_resolution(SIZE, SIZE);
     let (snapshot, stats) = render(
         scene,
@@ -105,6 +111,90 @@ fn nee_and_mis_variants_converge_to_the_same_image() {
         let image = render_small(tracer, spp, 10 + k as u64);
         assert_agree(name, &reference, &image);
     }
+}
+
+/// A tilted light facing the camera, a wall behind it, and a quad in front
+/// hiding part of it.
+const HIDDEN_LIGHT: &str = r#"
+[camera]
+eye = [0.0, 0.0, -5.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 40.0
+width = 64
+height = 64
+
+[materials.grey]
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+
+[materials.lamp]
+type = "diffuse"
+albedo = [0.3, 0.3, 0.3]
+emission = [8.0, 8.0, 8.0]
+
+[[quad]]
+corner = [-2.0, -2.0, 1.0]
+u = [4.0, 0.0, 0.0]
+v = [0.0, 4.0, 0.0]
+material = "grey"
+
+[[quad]]
+corner = [-0.8, -0.6, 0.0]
+u = [0.0, 1.2, 0.0]
+v = [1.6, 0.0, 0.3]
+material = "lamp"
+
+[[quad]]
+corner = [-1.0, -1.0, -1.0]
+u = [0.0, 2.0, 0.0]
+v = [1.2, 0.0, 0.0]
+material = "grey"
+"#;
+
+#[test]
+fn lights_seen_directly_agree_integrated_or_sampled_behind_an_occluder() {
+    let load = || {
+        let path = temp_dir("hidden-light").join("scene.toml");
+        std::fs::write(&path, HIDDEN_LIGHT).unwrap();
+        Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    };
+    // Both kinds of pixel occur: the light integrated exactly, and the light
+    // left to sampling where the quad in front may hide it.
+    let scene = load();
+    let lists = scene
+        .primary_candidates()
+        .expect("a pinhole soup gets lists");
+    let (mut exact, mut fell_back) = (0, 0);
+    for p in 0..SIZE * SIZE {
+        let pixel = lists.pixel(p);
+        let sees_light = pixel
+            .candidates
+            .unwrap_or_default()
+            .iter()
+            .any(|&i| scene.geometry.triangle_light(i as usize) != NO_LIGHT);
+        match (sees_light, pixel.seen_emission) {
+            (true, Some(_)) => exact += 1,
+            (true, None) => fell_back += 1,
+            _ => {}
+        }
+    }
+    assert!(
+        exact > 50 && fell_back > 20,
+        "{exact} exact, {fell_back} sampled"
+    );
+
+    let base = PathTracer::default();
+    let integrated = render_scene(load(), base, 256, 1);
+    let sampled = PathTracer {
+        exact_seen_emitters: false,
+        ..base
+    };
+    let sampled = render_scene(load(), sampled, 256, 2);
+    assert_agree(
+        "lights seen directly, integrated / sampled",
+        &integrated,
+        &sampled,
+    );
 }
 
 #[test]
