@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use tracelab::film::FilmSnapshot;
 use tracelab::image::Image;
 use tracelab::integrator::Integrator;
@@ -17,6 +18,17 @@ pub fn repo_path(relative: &str) -> PathBuf {
 /// The default Cornell box.
 pub fn cornell_box() -> Scene {
     Scene::load(&repo_path("scenes/cornell_box.toml")).expect("default scene loads")
+}
+
+/// A scene from TOML text, written to a fresh directory named after `name`
+/// and numbered per call: tests run in parallel, and two loading under the
+/// same name would empty each other's directory.
+pub fn load_scene_text(name: &str, text: &str) -> Scene {
+    static CALLS: AtomicUsize = AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, Ordering::Relaxed);
+    let path = temp_dir(&format!("{name}-{call}")).join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// A reference image from tests/data.

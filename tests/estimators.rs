@@ -3,17 +3,10 @@
 //! single pixels, computed here from the geometry with pencil-and-paper
 //! formulas (Lambert, inverse square law, Fresnel at normal incidence).
 
-use crate::common::{render_with, temp_dir};
+use crate::common::{load_scene_text as load, render_with};
 use std::f32::consts::PI;
 use tracelab::integrator::{GlassShadows, IntegratorKind, IntegratorOptions};
 use tracelab::sampling::SamplerKind;
-use tracelab::scene::Scene;
-
-fn load(name: &str, text: &str) -> Scene {
-    let path = temp_dir(name).join("scene.toml");
-    std::fs::write(&path, text).unwrap();
-    Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
-}
 
 /// Six inward-facing diffuse walls around a point light: every ray hits a
 /// scattering surface and every light sample is in front of it.

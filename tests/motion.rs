@@ -11,7 +11,7 @@
 //! 4 of them. Rendering without a time dimension (the sphere at its shutter
 //! opening position) gives 1.0, which the test rejects by 48 of them.
 
-use crate::common::{render, temp_dir};
+use crate::common::{load_scene_text, render, temp_dir};
 use tracelab::integrator::{Integrator, PathTracer, WhittedTracer};
 use tracelab::sampling::SamplerKind;
 use tracelab::scene::Scene;
@@ -19,8 +19,6 @@ use tracelab::scene::Scene;
 const WIDTH: u32 = 9;
 
 fn crossing_scene(shutter: [f32; 2]) -> Scene {
-    let dir = temp_dir(&format!("motion-{}-{}", shutter[0], shutter[1]));
-    let path = dir.join("crossing.toml");
     let text = format!(
         r#"
 [camera]
@@ -55,8 +53,7 @@ material = "black"
 "#,
         shutter[0], shutter[1]
     );
-    std::fs::write(&path, text).unwrap();
-    Scene::load(&path).expect("motion scene loads")
+    load_scene_text("motion", &text)
 }
 
 /// Mean of the middle row's red channel.

@@ -10,7 +10,7 @@
 //! within 4.5 (Bonferroni at 1% would be 3.9; the margin covers the heavy
 //! tail of BSDF-only sampling, whose standard error is itself noisy).
 
-use crate::common::{cornell_box, render, temp_dir};
+use crate::common::{cornell_box, load_scene_text, render};
 use tracelab::accel::NO_LIGHT;
 use tracelab::film::FilmSnapshot;
 use tracelab::integrator::{Integrator, MisHeuristic, PathTracer};
@@ -153,11 +153,7 @@ material = "grey"
 
 #[test]
 fn lights_seen_directly_agree_integrated_or_sampled_behind_an_occluder() {
-    let load = || {
-        let path = temp_dir("hidden-light").join("scene.toml");
-        std::fs::write(&path, HIDDEN_LIGHT).unwrap();
-        Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
-    };
+    let load = || load_scene_text("hidden-light", HIDDEN_LIGHT);
     // Both kinds of pixel occur: the light integrated exactly, and the light
     // left to sampling where the quad in front may hide it.
     let scene = load();
