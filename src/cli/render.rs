@@ -588,13 +588,8 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
             "camera rays test their pixel's candidate triangles only: {mean:.2} per pixel ({full} pixels test all)"
         );
     }
-    let exact_seen_emitters = match &settings.integrator {
-        tracelab::integrator::Integrator::Path(p) => p.exact_seen_emitters,
-        tracelab::integrator::Integrator::Mcrt(m) => m.exact_seen_emitters,
-        _ => false,
-    };
     if let Some(lists) = session.scene().primary_candidates()
-        && exact_seen_emitters
+        && settings.integrator.integrates_seen_emitters()
         && lists.pixels_with_seen_emission() > 0
     {
         eprintln!(

@@ -120,6 +120,16 @@ impl Integrator {
         }
     }
 
+    /// True when the estimator adds [`PrimaryPixel::seen_emission`] where it
+    /// is known instead of sampling the emission camera rays hit.
+    pub fn integrates_seen_emitters(&self) -> bool {
+        match self {
+            Integrator::Mcrt(m) => m.exact_seen_emitters,
+            Integrator::Path(p) => p.exact_seen_emitters,
+            Integrator::Whitted(_) | Integrator::Light(_) => false,
+        }
+    }
+
     /// True when every sample of a pixel gives the same value (Whitted: one
     /// ray through the pixel centre), so one sample per pixel is the image.
     pub fn is_deterministic(&self) -> bool {
