@@ -46,7 +46,7 @@ fn path_runs(threads: usize, general: bool) -> Vec<f64> {
     let runs = (0..5)
         .map(|seed| {
             let settings = RenderSettings {
-                integrator: Integrator::Path(PathTracer {
+                integrator: Integrator::from(PathTracer {
                     general,
                     ..PathTracer::default()
                 }),

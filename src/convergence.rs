@@ -31,16 +31,14 @@ impl BenchConfig {
         let err = |m: String| Error::new(format!("--config `{text}`: {m}"));
         let mut parts = text.split(':');
         let mut integrator = IntegratorOptions {
-            kind: match parts.next().unwrap_or("") {
-                "whitted" => IntegratorKind::Whitted,
-                "mcrt" => IntegratorKind::Mcrt,
-                "path" => IntegratorKind::Path,
-                "light" => IntegratorKind::Light,
-                other => {
-                    return Err(err(format!(
-                        "unknown integrator `{other}` (whitted, mcrt, path, light)"
-                    )));
-                }
+            kind: {
+                let name = parts.next().unwrap_or("");
+                IntegratorKind::from_name(name).ok_or_else(|| {
+                    err(format!(
+                        "unknown integrator `{name}` ({})",
+                        IntegratorKind::names()
+                    ))
+                })?
             },
             ..Default::default()
         };

@@ -200,6 +200,33 @@ pub struct FilmSnapshot {
     pub non_finite: u64,
 }
 
+impl FilmSnapshot {
+    /// The RMSE the film expects against the truth: sqrt of the mean over
+    /// pixels and channels of the squared standard error. Each s^2 / n is
+    /// an unbiased estimate of its pixel's squared error, so the mean is
+    /// unbiased at any sample count (a mean of per-pixel *relative* errors
+    /// is not: ratios and square roots of few samples are biased low). It
+    /// assumes independent samples, so it overstates the error of
+    /// stratified and Sobol sampling. NaN while no pixel has two samples.
+    pub fn estimated_rmse(&self) -> f64 {
+        let mut sum = 0.0f64;
+        let mut n = 0usize;
+        for se in &self.standard_error.pixels {
+            for &v in se {
+                if v.is_finite() {
+                    sum += f64::from(v) * f64::from(v);
+                    n += 1;
+                }
+            }
+        }
+        if n == 0 {
+            f64::NAN
+        } else {
+            (sum / n as f64).sqrt()
+        }
+    }
+}
+
 impl Film {
     /// An empty film of `width` x `height` pixels.
     pub fn new(width: u32, height: u32) -> Self {
@@ -229,6 +256,14 @@ impl Film {
 
     pub fn height(&self) -> u32 {
         self.height
+    }
+
+    /// Empties every pixel (a solver's new image replaces the old one).
+    pub fn clear(&self) {
+        for tile in &self.tiles {
+            let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
+            tile.pixels.fill(PixelSums::default());
+        }
     }
 
     /// The tiles, for passes to fill in parallel.

@@ -12,6 +12,7 @@
 use crate::error::Result;
 use crate::film::FilmSnapshot;
 use crate::image::Image;
+use crate::integrator::{ErrorEstimate, Integrator};
 use crate::render::{RenderSettings, RenderStats, Session, thread_pool};
 use crate::scene::Scene;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
@@ -45,9 +46,12 @@ pub struct LiveConfig {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ErrorPoint {
     pub spp: u32,
+    /// Units of progress ([`RenderStats::progress`]): spp, or solver steps.
+    pub progress: u64,
     pub seconds: f64,
-    /// RMSE expected from the film's own variance ([`estimated_rmse`]).
-    pub noise: f64,
+    /// What the session can say of its error without a reference
+    /// ([`Session::error_estimate`]).
+    pub estimate: ErrorEstimate,
     /// RMSE against the reference, when one is set and matches the image size.
     pub rmse: Option<f64>,
 }
@@ -62,8 +66,11 @@ pub struct LiveView {
     pub snapshot: Arc<FilmSnapshot>,
     pub stats: RenderStats,
     pub history: Vec<ErrorPoint>,
-    /// Whether the target sample count is reached.
+    /// Whether the target sample count is reached, the solver converged,
+    /// or the technique failed.
     pub done: bool,
+    /// Why the technique could not run, if it could not.
+    pub failure: Option<String>,
 }
 
 /// Everything published after a pass.
@@ -266,6 +273,7 @@ fn render_loop(shared: &Shared, commands: &Receiver<Command>, pool: &Arc<rayon::
                         stats: s.stats(),
                         history: Vec::new(),
                         done: false,
+                        failure: None,
                     })
                     .collect();
                 job = Some(Job {
@@ -299,17 +307,20 @@ fn render_loop(shared: &Shared, commands: &Receiver<Command>, pool: &Arc<rayon::
             k = k.min(target.saturating_sub(stats.spp)).max(1);
         }
         let start = Instant::now();
-        if stats.spp == 0 {
+        if stats.passes == 0 {
             // The first pass of new settings comes in parts spread over the
             // image, each published, so the change shows at once.
             let parts = match session.settings().integrator {
-                crate::integrator::Integrator::Light(_) => 1,
-                _ => FIRST_PASS_PARTS,
+                Integrator::Camera(_) => FIRST_PASS_PARTS,
+                _ => 1,
             };
             let mut ok = true;
             for part in 0..parts {
                 ok = session.render_pass_part(1, part, parts);
                 if !ok {
+                    if session.failure().is_some() {
+                        job.publish(next, shared);
+                    }
                     break;
                 }
                 job.publish(next, shared);
@@ -320,6 +331,9 @@ fn render_loop(shared: &Shared, commands: &Receiver<Command>, pool: &Arc<rayon::
             continue;
         }
         if !session.render_pass(k) {
+            if session.failure().is_some() {
+                job.publish(next, shared);
+            }
             continue;
         }
         // Grow or shrink passes towards the target duration.
@@ -362,8 +376,9 @@ impl Job {
         let stats = session.stats();
         let point = ErrorPoint {
             spp: stats.spp,
+            progress: stats.progress,
             seconds: stats.render_time.as_secs_f64(),
-            noise: estimated_rmse(&snapshot),
+            estimate: session.error_estimate(&snapshot),
             rmse: self
                 .reference
                 .as_ref()
@@ -371,7 +386,12 @@ impl Job {
                 .map(|m| m.rmse),
         };
         let view = &mut self.frame.views[index];
-        if stats.spp > 0 && view.history.last().is_none_or(|p| p.spp < stats.spp) {
+        if stats.passes > 0
+            && view
+                .history
+                .last()
+                .is_none_or(|p| p.progress < stats.progress)
+        {
             view.history.push(point);
         }
         if view.history.len() > HISTORY_LIMIT {
@@ -385,36 +405,14 @@ impl Job {
         }
         view.snapshot = Arc::new(snapshot);
         view.stats = stats;
-        view.done = self.targets[index].is_some_and(|t| stats.spp >= t);
+        view.failure = session.failure().map(|e| e.to_string());
+        view.done = self.targets[index].is_some_and(|t| stats.spp >= t)
+            || stats.solver.is_some_and(|s| s.converged)
+            || view.failure.is_some();
         if self.frame.first_image_latency.is_none() {
             self.frame.first_image_latency = Some(self.requested.elapsed());
         }
         *lock(&shared.latest) = Arc::new(self.frame.clone());
-    }
-}
-
-/// The RMSE the film expects against the truth: sqrt of the mean over
-/// pixels and channels of the squared standard error. Each s^2 / n is an
-/// unbiased estimate of its pixel's squared error, so the mean is unbiased at
-/// any sample count (a mean of per-pixel *relative* errors is not: ratios and
-/// square roots of few samples are biased low). It assumes independent
-/// samples, so it overstates the error of stratified and Sobol sampling;
-/// with a reference loaded the true RMSE is shown as well.
-pub fn estimated_rmse(snapshot: &FilmSnapshot) -> f64 {
-    let mut sum = 0.0f64;
-    let mut n = 0usize;
-    for se in &snapshot.standard_error.pixels {
-        for &v in se {
-            if v.is_finite() {
-                sum += f64::from(v) * f64::from(v);
-                n += 1;
-            }
-        }
-    }
-    if n == 0 {
-        f64::NAN
-    } else {
-        (sum / n as f64).sqrt()
     }
 }
 
@@ -468,7 +466,10 @@ mod tests {
         let frame = wait_done(&live);
         assert_eq!(frame.generation, 1);
         assert_eq!(frame.views[0].stats.spp, 16);
-        assert!(frame.views[0].history.last().unwrap().noise > 0.0);
+        assert!(matches!(
+            frame.views[0].history.last().unwrap().estimate,
+            ErrorEstimate::Sampling(rmse) if rmse > 0.0
+        ));
 
         live.restart(
             vec![config(&scene, 4), config(&scene, 8)],

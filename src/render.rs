@@ -1,15 +1,24 @@
-//! A render session: the one API every front end drives (CLI, tests, and the
-//! viewer later). A session owns a film and a thread pool; each call to
-//! [`Session::render_pass`] adds k samples to every pixel, in parallel over
-//! tiles. Between passes, callers take snapshots, read statistics or cancel.
+//! A render session: the one API every front end drives (the CLI, the tests
+//! and, through [`crate::live`], the viewer). A session owns a film and a
+//! thread pool; its unit of progress is a pass ([`Session::render_pass`]),
+//! whatever the kind of technique ([`crate::integrator::TechniqueKind`]):
+//! k samples more for every pixel (camera estimators), k particles per pixel
+//! splatted anywhere (splatting estimators), k iterations of a pre-pass and
+//! one sample per pixel (multi-pass estimators), or k solve steps and a new
+//! image of the solution (solvers). Between passes, callers take snapshots,
+//! read statistics and the error estimate, or cancel.
 //!
 //! Sample `s` of pixel `p` is a pure function of (seed, p, s), and each pixel's
 //! samples are summed in sample order, so the film is bit-identical whatever
 //! the thread count or tile schedule.
 
+use crate::accel::PrimaryPixel;
 use crate::error::{Error, Result};
 use crate::film::{Film, FilmSnapshot};
-use crate::integrator::{Integrator, LightTracer, RayCounts, sample_time};
+use crate::integrator::{
+    ErrorEstimate, Integrator, MultiPassEstimator, MultiPassVisitor, RayCounts, Solver,
+    SolverProgress, SolverVisitor, SplattingIntegrator, sample_time,
+};
 use crate::math::{Ray, Rgb};
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Domains, Sampler, SamplerKind};
@@ -62,7 +71,14 @@ pub enum Adaptive {
 pub struct RenderStats {
     /// Samples per pixel completed (every pixel has this many; with
     /// [`Adaptive`] sampling, the mean over pixels of what passes planned).
+    /// For a solver, the samples per pixel of the image of its solution.
     pub spp: u32,
+    /// Passes completed.
+    pub passes: u64,
+    /// Units of progress completed: samples per pixel, or a solver's steps.
+    pub progress: u64,
+    /// A solver's progress after its last pass.
+    pub solver: Option<SolverProgress>,
     /// Camera samples taken (= camera paths).
     pub samples: u64,
     pub rays: RayCounts,
@@ -85,6 +101,8 @@ pub struct Session {
     film: Film,
     pool: Arc<rayon::ThreadPool>,
     spp: AtomicU32,
+    passes: AtomicU64,
+    progress: AtomicU64,
     samples: AtomicU64,
     camera_rays: AtomicU64,
     shadow_rays: AtomicU64,
@@ -98,6 +116,12 @@ pub struct Session {
     /// Samples per pixel of the pass in progress under
     /// [`Adaptive::Distribute`], made by its part 0 for all its parts.
     pass_plan: Mutex<Option<Arc<Vec<u32>>>>,
+    /// A solver's state between passes, typed by the solver
+    /// ([`Solver::State`]); `None` until the first pass.
+    solver_state: Mutex<Option<Box<dyn std::any::Any + Send + Sync>>>,
+    solver_progress: Mutex<Option<SolverProgress>>,
+    /// Why the technique could not run (a solver's set-up failed).
+    failure: Mutex<Option<Error>>,
 }
 
 impl Session {
@@ -114,6 +138,10 @@ impl Session {
         settings: RenderSettings,
         pool: Arc<rayon::ThreadPool>,
     ) -> Session {
+        let settings = RenderSettings {
+            integrator: settings.integrator.for_scene(&scene),
+            ..settings
+        };
         let film = Film::new(scene.camera.width, scene.camera.height);
         Session {
             scene,
@@ -121,6 +149,8 @@ impl Session {
             film,
             pool,
             spp: AtomicU32::new(0),
+            passes: AtomicU64::new(0),
+            progress: AtomicU64::new(0),
             samples: AtomicU64::new(0),
             camera_rays: AtomicU64::new(0),
             shadow_rays: AtomicU64::new(0),
@@ -132,6 +162,9 @@ impl Session {
             render_nanos: AtomicU64::new(0),
             cancelled: AtomicBool::new(false),
             pass_plan: Mutex::new(None),
+            solver_state: Mutex::new(None),
+            solver_progress: Mutex::new(None),
+            failure: Mutex::new(None),
         }
     }
 
@@ -153,43 +186,91 @@ impl Session {
         self.cancelled.store(true, Ordering::Relaxed);
     }
 
-    /// Adds `spp` samples to every pixel. Returns false (and leaves the film
-    /// with a partial pass that [`RenderStats::spp`] does not count) when cancelled.
-    pub fn render_pass(&self, spp: u32) -> bool {
-        self.render_pass_part(spp, 0, 1)
+    /// Renders one pass of size `k` (see the module documentation).
+    /// Returns false (and leaves the film with a partial pass that
+    /// [`RenderStats::spp`] does not count) when cancelled or failed.
+    pub fn render_pass(&self, k: u32) -> bool {
+        self.render_pass_part(k, 0, 1)
     }
 
-    /// Renders part `part` of `parts` of a pass of `spp` samples: the tiles
-    /// whose index is `part` modulo `parts`, spread over the image. The pass
-    /// counts (in [`RenderStats::spp`]) once its last part is done; the film
-    /// is the same as after one whole pass. A live view uses parts to show
-    /// the first pass of new settings sooner. Light tracing splats anywhere,
-    /// so it renders its whole pass with part 0 and skips the others.
-    pub fn render_pass_part(&self, spp: u32, part: u32, parts: u32) -> bool {
+    /// Renders part `part` of `parts` of a pass of size `k`. Camera
+    /// estimators render the tiles whose index is `part` modulo `parts`,
+    /// spread over the image, and the film is the same as after one whole
+    /// pass; a live view uses parts to show the first pass of new settings
+    /// sooner. The other kinds need the whole film at once (splats land
+    /// anywhere, a pre-pass or a solve step serves every pixel), so they
+    /// render the whole pass with part 0 and skip the others. The pass
+    /// counts (in [`RenderStats`]) once complete.
+    pub fn render_pass_part(&self, k: u32, part: u32, parts: u32) -> bool {
         let start = Instant::now();
         let first = self.spp.load(Ordering::Relaxed);
         let parts = parts.max(1);
-        if let Integrator::Light(tracer) = self.settings.integrator {
-            if part == 0 {
-                self.light_pass(&tracer, first, spp);
-            }
-        } else {
-            let plan = self.pass_plan(first, spp, part);
-            self.camera_pass(first, spp, plan.as_deref().map(Vec::as_slice), part, parts);
+        let whole_film = !matches!(self.settings.integrator, Integrator::Camera(_));
+        if whole_film && part != 0 {
+            return !self.cancelled.load(Ordering::Relaxed);
         }
+        let (spp, progress) = match self.settings.integrator {
+            Integrator::Camera(estimator) => {
+                let plan = self.pass_plan(first, k, part);
+                let pixel_plan = plan.as_deref().map(Vec::as_slice);
+                let deterministic = estimator.is_deterministic();
+                self.camera_pass(
+                    first,
+                    k,
+                    pixel_plan,
+                    part,
+                    parts,
+                    deterministic,
+                    |s, r, p, sa, c| estimator.radiance(s, r, p, sa, c),
+                );
+                (first + k, u64::from(k))
+            }
+            Integrator::Splatting(estimator) => {
+                self.splat_pass(&estimator, first, k);
+                (first + k, u64::from(k))
+            }
+            Integrator::MultiPass(estimator) => estimator.visit(MultiPass {
+                session: self,
+                first,
+                k,
+            }),
+            Integrator::Solver(solver) => solver.visit(SolverPass { session: self, k }),
+        };
         self.render_nanos
             .fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
-        if self.cancelled.load(Ordering::Relaxed) {
+        if self.cancelled.load(Ordering::Relaxed) || self.failure().is_some() {
             return false;
         }
-        let complete = match self.settings.integrator {
-            Integrator::Light(_) => part == 0,
-            _ => part + 1 == parts,
-        };
-        if complete {
-            self.spp.store(first + spp, Ordering::Relaxed);
+        if whole_film || part + 1 == parts {
+            self.spp.store(spp, Ordering::Relaxed);
+            self.passes.fetch_add(1, Ordering::Relaxed);
+            self.progress.fetch_add(progress, Ordering::Relaxed);
         }
         true
+    }
+
+    /// Why the technique could not run, if it could not.
+    pub fn failure(&self) -> Option<Error> {
+        lock(&self.failure).clone()
+    }
+
+    /// What the session can say about its error without a reference:
+    /// the RMS of the pixels' standard errors (`snapshot` from
+    /// [`Session::snapshot`]), nothing for a deterministic estimator, a
+    /// solver's residual.
+    pub fn error_estimate(&self, snapshot: &FilmSnapshot) -> ErrorEstimate {
+        if let Some(progress) = *lock(&self.solver_progress) {
+            return ErrorEstimate::Residual(progress.residual);
+        }
+        if self.settings.integrator.is_deterministic() {
+            return ErrorEstimate::Deterministic;
+        }
+        let rmse = snapshot.estimated_rmse();
+        if rmse.is_finite() {
+            ErrorEstimate::Sampling(rmse)
+        } else {
+            ErrorEstimate::Unknown
+        }
     }
 
     /// Per-pixel sample counts for the pass of `spp` that starts at `first`
@@ -217,15 +298,26 @@ impl Session {
         shared.clone()
     }
 
-    /// Camera-driven estimators: `spp` samples (or `plan`'s count) more for
-    /// every pixel of the tiles in part `part` of `parts`. Samples are
-    /// numbered from `first`, or under [`Adaptive::Distribute`] from the
-    /// pixel's own count.
-    fn camera_pass(&self, first: u32, spp: u32, plan: Option<&[u32]>, part: u32, parts: u32) {
+    /// Camera samples: `spp` samples (or `plan`'s count) more for every
+    /// pixel of the tiles in part `part` of `parts`, each `estimate`d along
+    /// its camera ray. Samples are numbered from `first`, or under
+    /// [`Adaptive::Distribute`] from the pixel's own count.
+    #[allow(clippy::too_many_arguments)]
+    fn camera_pass<E>(
+        &self,
+        first: u32,
+        spp: u32,
+        plan: Option<&[u32]>,
+        part: u32,
+        parts: u32,
+        deterministic: bool,
+        estimate: E,
+    ) where
+        E: Fn(&Scene, Ray, PrimaryPixel<'_>, &mut Sampler, &mut RayCounts) -> Rgb + Sync,
+    {
         let scene = &*self.scene;
         let settings = &self.settings;
-        let deterministic = settings.integrator.is_deterministic();
-        let general = settings.integrator.is_general();
+        let general = matches!(settings.integrator, Integrator::Camera(e) if e.is_general());
         let width = self.film.width();
         let primary = scene.primary_candidates();
         self.pool.install(|| {
@@ -294,13 +386,7 @@ impl Session {
                                     camera_ray(scene, &mut ahead, x, y, deterministic, general);
                             }
                             counts.camera += 1;
-                            let mut value = settings.integrator.radiance(
-                                scene,
-                                ray,
-                                known,
-                                &mut sampler,
-                                &mut counts,
-                            );
+                            let mut value = estimate(scene, ray, known, &mut sampler, &mut counts);
                             non_finite += u64::from(!value.is_finite());
                             extreme += u64::from(pixel.flag(value, s));
                             if let Some(limit) = settings.clamp {
@@ -318,13 +404,13 @@ impl Session {
         });
     }
 
-    /// Light tracing: `spp` particles per pixel (the same total as a camera
-    /// pass), seeded by (pixel, index) so the result does not depend on the
-    /// schedule. Splats go to a fixed-point buffer whose integer sums do not
+    /// Splatting estimators (light tracing): `spp` paths per pixel (the
+    /// same total as a camera pass), seeded by (pixel, index) so the result
+    /// does not depend on the schedule. Splats go to a fixed-point buffer whose integer sums do not
     /// depend on their order either; the pass's estimate then enters the film
     /// as `spp` samples of equal value, so the film's mean is exact and its
     /// standard error is estimated across passes (exact for 1-spp passes).
-    fn light_pass(&self, tracer: &LightTracer, first: u32, spp: u32) {
+    fn splat_pass(&self, estimator: &SplattingIntegrator, first: u32, spp: u32) {
         let scene = &*self.scene;
         let settings = &self.settings;
         let (width, height) = (self.film.width(), self.film.height());
@@ -351,7 +437,7 @@ impl Session {
                         let (x, y) = (x0 + i % tile_width, y0 + i / tile_width);
                         for s in first..first + spp {
                             sampler.start(y * width + x, s);
-                            tracer.trace_particle(scene, &mut sampler, &mut counts, |splat| {
+                            estimator.trace(scene, &mut sampler, &mut counts, |splat| {
                                 if !splats.add(splat.film, splat.value) {
                                     non_finite += 1;
                                 }
@@ -402,6 +488,9 @@ impl Session {
     pub fn stats(&self) -> RenderStats {
         RenderStats {
             spp: self.spp.load(Ordering::Relaxed),
+            passes: self.passes.load(Ordering::Relaxed),
+            progress: self.progress.load(Ordering::Relaxed),
+            solver: *lock(&self.solver_progress),
             samples: self.samples.load(Ordering::Relaxed),
             rays: RayCounts {
                 camera: self.camera_rays.load(Ordering::Relaxed),
@@ -415,6 +504,91 @@ impl Session {
             render_time: Duration::from_nanos(self.render_nanos.load(Ordering::Relaxed)),
         }
     }
+}
+
+/// A multi-pass estimator's pass: `k` iterations, each a pre-pass (numbered
+/// by the session's passes so far) and one sample per pixel reading it.
+struct MultiPass<'a> {
+    session: &'a Session,
+    first: u32,
+    k: u32,
+}
+
+impl MultiPassVisitor for MultiPass<'_> {
+    type Output = (u32, u64);
+
+    fn visit<E: MultiPassEstimator>(self, estimator: &E) -> (u32, u64) {
+        let session = self.session;
+        let settings = &session.settings;
+        for i in 0..self.k {
+            if session.cancelled.load(Ordering::Relaxed) {
+                break;
+            }
+            let iteration = self.first + i;
+            let mut counts = RayCounts::default();
+            let pass = session.pool.install(|| {
+                estimator.prepare(&session.scene, iteration, settings.seed, &mut counts)
+            });
+            session.add_counts(0, &counts, 0);
+            session.camera_pass(
+                iteration,
+                1,
+                None,
+                0,
+                1,
+                false,
+                |scene, ray, _, sampler, c| estimator.radiance(scene, &pass, ray, sampler, c),
+            );
+        }
+        (self.first + self.k, u64::from(self.k))
+    }
+}
+
+/// A solver's pass: `k` solve steps, then a new image of the solution (the
+/// film restarts: the solution it showed is gone).
+struct SolverPass<'a> {
+    session: &'a Session,
+    k: u32,
+}
+
+impl SolverVisitor for SolverPass<'_> {
+    type Output = (u32, u64);
+
+    fn visit<S: Solver>(self, solver: &S) -> (u32, u64) {
+        let session = self.session;
+        let scene = &*session.scene;
+        let mut state = lock(&session.solver_state);
+        if state.is_none() {
+            match session.pool.install(|| solver.init(scene)) {
+                Ok(initial) => *state = Some(Box::new(initial)),
+                Err(e) => {
+                    *lock(&session.failure) = Some(e);
+                    return (0, 0);
+                }
+            }
+        }
+        let Some(typed) = state.as_mut().and_then(|s| s.downcast_mut::<S::State>()) else {
+            unreachable!("a session's solver state has its solver's type");
+        };
+        let mut counts = RayCounts::default();
+        let progress = session
+            .pool
+            .install(|| solver.step(scene, typed, self.k, &mut counts));
+        session.add_counts(0, &counts, 0);
+        *lock(&session.solver_progress) = Some(progress);
+        session.film.clear();
+        let spp = solver.display_spp().max(1);
+        let typed = &*typed;
+        session.camera_pass(0, spp, None, 0, 1, spp == 1, |scene, ray, _, sampler, c| {
+            solver.radiance(scene, typed, ray, sampler, c)
+        });
+        (spp, u64::from(self.k))
+    }
+}
+
+/// A poisoned lock only means a pass panicked; the data is still whole.
+fn lock<T: ?Sized>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// The camera ray of the sample the sampler was started at, for pixel
@@ -517,5 +691,178 @@ impl SplatBuffer {
     fn get(&self, index: u32) -> [f64; 3] {
         let sums = &self.sums[index as usize];
         [0, 1, 2].map(|c| sums[c].load(Ordering::Relaxed) as f64 / SPLAT_SCALE)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The drivers of the kinds no shipped technique uses yet, run with
+    //! small techniques whose answers are known exactly.
+    use super::*;
+    use crate::integrator::{IntegratorOptions, Technique};
+
+    fn session() -> Session {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml");
+        let mut scene = Scene::load(&path).unwrap();
+        scene.set_resolution(8, 6);
+        let settings = RenderSettings {
+            integrator: IntegratorOptions::default().build(),
+            sampler: SamplerKind::Independent,
+            seed: 7,
+            planned_spp: 0,
+            threads: 2,
+            adaptive: None,
+            domains: Default::default(),
+            clamp: None,
+        };
+        Session::new(Arc::new(scene), settings).unwrap()
+    }
+
+    /// Each pre-pass builds its own number; every sample reads it.
+    struct PassNumber;
+
+    impl Technique for PassNumber {
+        const SUMMARY: &'static str = "test";
+        fn from_options(_: &IntegratorOptions) -> Self {
+            PassNumber
+        }
+        fn describe(&self) -> String {
+            "pass number".into()
+        }
+    }
+
+    impl MultiPassEstimator for PassNumber {
+        type Pass = f32;
+        fn prepare(&self, _: &Scene, pass: u32, _: u64, counts: &mut RayCounts) -> f32 {
+            counts.bounce += 10;
+            pass as f32
+        }
+        fn radiance(
+            &self,
+            _: &Scene,
+            pass: &f32,
+            _: Ray,
+            _: &mut Sampler,
+            _: &mut RayCounts,
+        ) -> Rgb {
+            Rgb::splat(*pass)
+        }
+    }
+
+    #[test]
+    fn a_multi_pass_estimator_prepares_once_per_iteration() {
+        let session = session();
+        let (spp, progress) = MultiPass {
+            session: &session,
+            first: 0,
+            k: 4,
+        }
+        .visit(&PassNumber);
+        assert_eq!((spp, progress), (4, 4));
+        let snapshot = session.snapshot();
+        // Passes 0..4 each add one sample of their number: mean 1.5.
+        assert!(snapshot.image.pixels.iter().all(|p| *p == [1.5; 3]));
+        assert!(snapshot.samples.iter().all(|&n| n == 4));
+        assert_eq!(session.stats().rays.bounce, 40);
+    }
+
+    /// x <- (x + 1) / 2 from 0: the residual 1 - x halves every step.
+    struct Halving {
+        fail: bool,
+    }
+
+    impl Technique for Halving {
+        const SUMMARY: &'static str = "test";
+        fn from_options(_: &IntegratorOptions) -> Self {
+            Halving { fail: false }
+        }
+        fn describe(&self) -> String {
+            "halving".into()
+        }
+    }
+
+    impl Solver for Halving {
+        type State = f64;
+        fn init(&self, _: &Scene) -> crate::Result<f64> {
+            if self.fail {
+                Err(Error::new("no patches"))
+            } else {
+                Ok(0.0)
+            }
+        }
+        fn step(&self, _: &Scene, x: &mut f64, steps: u32, _: &mut RayCounts) -> SolverProgress {
+            for _ in 0..steps {
+                *x = (*x + 1.0) / 2.0;
+            }
+            SolverProgress {
+                steps: u64::from(steps),
+                residual: 1.0 - *x,
+                converged: *x == 1.0,
+            }
+        }
+        fn radiance(&self, _: &Scene, x: &f64, _: Ray, _: &mut Sampler, _: &mut RayCounts) -> Rgb {
+            Rgb::splat(*x as f32)
+        }
+        fn display_spp(&self) -> u32 {
+            2
+        }
+    }
+
+    #[test]
+    fn a_solver_shows_only_its_latest_solution() {
+        let session = session();
+        let solver = Halving { fail: false };
+        assert_eq!(
+            SolverPass {
+                session: &session,
+                k: 1
+            }
+            .visit(&solver),
+            (2, 1)
+        );
+        assert_eq!(
+            SolverPass {
+                session: &session,
+                k: 2
+            }
+            .visit(&solver),
+            (2, 2)
+        );
+        // Three steps: x = 7/8, and the film holds only its image.
+        let snapshot = session.snapshot();
+        assert!(snapshot.image.pixels.iter().all(|p| *p == [0.875; 3]));
+        assert!(snapshot.samples.iter().all(|&n| n == 2));
+        assert_eq!(
+            session.error_estimate(&snapshot),
+            ErrorEstimate::Residual(0.125)
+        );
+    }
+
+    #[test]
+    fn a_solver_that_cannot_start_says_why() {
+        let session = session();
+        SolverPass {
+            session: &session,
+            k: 1,
+        }
+        .visit(&Halving { fail: true });
+        assert_eq!(session.failure().unwrap().message(), "no patches");
+    }
+
+    #[test]
+    fn a_deterministic_estimator_has_no_sampling_error() {
+        let mut session = session();
+        session.settings.integrator = IntegratorOptions {
+            kind: crate::integrator::IntegratorKind::Whitted,
+            ..Default::default()
+        }
+        .build();
+        assert!(session.render_pass(1));
+        let snapshot = session.snapshot();
+        assert_eq!(
+            session.error_estimate(&snapshot),
+            ErrorEstimate::Deterministic
+        );
+        assert_eq!(session.stats().passes, 1);
     }
 }

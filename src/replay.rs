@@ -6,7 +6,7 @@
 use crate::accel::SurfaceHit;
 use crate::error::{Error, Result};
 use crate::integrator::path::PathObserver;
-use crate::integrator::{Integrator, RayCounts};
+use crate::integrator::{CameraIntegrator, Integrator, RayCounts};
 use crate::math::Rgb;
 use crate::render::{RenderSettings, camera_ray};
 use crate::sampling::Sampler;
@@ -99,7 +99,7 @@ pub fn replay_sample(
     y: u32,
     index: u32,
 ) -> Result<(Rgb, Vec<String>)> {
-    let Integrator::Path(tracer) = settings.integrator else {
+    let Integrator::Camera(CameraIntegrator::Path(tracer)) = settings.integrator else {
         return Err(Error::new(
             "--debug-sample replays path tracing samples (--integrator path)",
         ));

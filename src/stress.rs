@@ -11,7 +11,7 @@ use crate::accel::{SurfaceHit, TriangleInput};
 use crate::error::{Error, Result};
 use crate::image::Image;
 use crate::integrator::path::shadow_ray;
-use crate::integrator::{Integrator, PathTracer};
+use crate::integrator::{CameraIntegrator, Integrator, PathTracer};
 use crate::math::{Frame, OffsetMode};
 use crate::render::{RenderSettings, Session};
 use crate::sampling::warp::square_to_cosine_hemisphere;
@@ -290,7 +290,7 @@ impl StressSuite {
 /// Renders `scene` with the suite's path tracer and seed.
 pub fn render(scene: &Scene, spp: u32, seed: u64) -> Result<(Image, u64)> {
     let settings = RenderSettings {
-        integrator: Integrator::Path(PathTracer::default()),
+        integrator: Integrator::Camera(CameraIntegrator::Path(PathTracer::default())),
         sampler: SamplerKind::Independent,
         seed,
         planned_spp: spp,

@@ -10,7 +10,7 @@ fn film(sampler: SamplerKind, threads: usize, pass: u32, seed: u64) -> Vec<[f32;
     scene.set_resolution(48, 40);
     let (snapshot, _) = render_with(
         scene,
-        Integrator::Path(PathTracer::default()),
+        Integrator::from(PathTracer::default()),
         sampler,
         16,
         seed,
@@ -75,7 +75,7 @@ fn camera_ray_candidates_and_shadow_voxels_change_no_pixel() {
     let render = |scene| {
         // Seen emitters come with the lists: sampled here, so that only
         // the lists differ.
-        let integrator = Integrator::Path(PathTracer {
+        let integrator = Integrator::from(PathTracer {
             exact_seen_emitters: false,
             ..PathTracer::default()
         });

@@ -14,7 +14,7 @@ use tracelab::scene::Scene;
 
 fn settings(sampler: SamplerKind, spp: u32, clamp: Option<f32>) -> RenderSettings {
     RenderSettings {
-        integrator: Integrator::Path(PathTracer::default()),
+        integrator: Integrator::from(PathTracer::default()),
         sampler,
         seed: 11,
         planned_spp: spp,

@@ -69,7 +69,10 @@ fn mc_ray_tracing_casts_186_rays_per_pixel_with_two_branching_levels_and_5_by_5_
         glossy_rays: 5,
         ..Default::default()
     };
-    let tracelab::integrator::Integrator::Mcrt(mcrt) = options.build() else {
+    let tracelab::integrator::Integrator::Camera(tracelab::integrator::CameraIntegrator::Mcrt(
+        mcrt,
+    )) = options.build()
+    else {
         unreachable!()
     };
     assert_eq!(mcrt.rays_per_sample_closed(), 186);

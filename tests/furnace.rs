@@ -105,7 +105,7 @@ fn cube_furnace() -> Scene {
 }
 
 fn check_furnace(scene: Scene, nee: bool, mis: MisHeuristic) {
-    let integrator = Integrator::Path(PathTracer {
+    let integrator = Integrator::from(PathTracer {
         max_depth: u32::MAX,
         nee,
         mis,
@@ -166,7 +166,7 @@ fn cube_furnace_without_nee() {
 fn truncated_furnace_sums_the_geometric_series() {
     // Without roulette and with at most 2 bounces, L = Le (1 + a + a^2) exactly
     // in expectation; this checks the bounce count against its definition.
-    let integrator = Integrator::Path(PathTracer {
+    let integrator = Integrator::from(PathTracer {
         max_depth: 2,
         russian_roulette: false,
         ..Default::default()

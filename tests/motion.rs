@@ -72,7 +72,7 @@ fn moving_sphere_blocks_the_light_for_its_share_of_the_exposure() {
         assert!(scene.features.motion);
         let (film, _) = render(
             scene,
-            Integrator::Path(PathTracer::default()),
+            Integrator::from(PathTracer::default()),
             sampler,
             spp,
             7,
@@ -93,7 +93,7 @@ fn shutter_interval_sets_the_time_range() {
     let scene = crossing_scene([2.0, 3.0]);
     let (film, _) = render(
         scene,
-        Integrator::Path(PathTracer::default()),
+        Integrator::from(PathTracer::default()),
         SamplerKind::Independent,
         64,
         7,
@@ -114,7 +114,7 @@ fn instantaneous_shutter_has_no_time_dimension() {
     // At time 0 the sphere is 5 units off the axis: nothing is blocked.
     let (film, _) = render(
         scene,
-        Integrator::Path(PathTracer::default()),
+        Integrator::from(PathTracer::default()),
         SamplerKind::Independent,
         64,
         7,
@@ -127,7 +127,7 @@ fn whitted_sees_the_middle_of_the_exposure() {
     // At time 0.5 the sphere is centred on the axis and covers the row.
     let (film, _) = render(
         crossing_scene([0.0, 1.0]),
-        Integrator::Whitted(WhittedTracer::default()),
+        Integrator::from(WhittedTracer::default()),
         SamplerKind::Independent,
         1,
         7,

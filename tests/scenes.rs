@@ -29,7 +29,7 @@ fn every_shipped_scene_renders_cleanly() {
             };
             let (snapshot, stats) = render(
                 scene.clone(),
-                Integrator::Path(tracer),
+                Integrator::from(tracer),
                 SamplerKind::Stratified,
                 16,
                 1,

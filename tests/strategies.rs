@@ -28,7 +28,7 @@ fn render_scene(mut scene: Scene, tracer: PathTracer, spp: u32, seed: u64) -> Fi
     scene.set_resolution(SIZE, SIZE);
     let (snapshot, stats) = render(
         scene,
-        Integrator::Path(tracer),
+        Integrator::from(tracer),
         SamplerKind::Independent,
         spp,
         seed,

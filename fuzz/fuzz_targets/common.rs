@@ -22,7 +22,7 @@ pub fn build_and_render(input: SceneInput) {
     };
     scene.set_resolution(4, 4);
     let settings = RenderSettings {
-        integrator: Integrator::Path(PathTracer {
+        integrator: Integrator::from(PathTracer {
             max_depth: 4,
             ..PathTracer::default()
         }),

@@ -41,16 +41,25 @@ enum Command {
     },
 }
 
-#[derive(ValueEnum, Clone, Copy, Debug)]
-enum IntegratorArg {
-    /// Whitted ray tracing: point-light direct light, hard shadows, mirror and glass recursion.
-    Whitted,
-    /// Monte Carlo (distribution) ray tracing: N shadow rays and M branching BSDF rays per hit.
-    Mcrt,
-    /// Path tracing with next-event estimation, MIS and Russian roulette.
-    Path,
-    /// Light (particle) tracing: paths from the lights, every vertex connected to the camera.
-    Light,
+/// A technique, by the name it is registered under
+/// ([`tracelab::integrator::IntegratorKind`]).
+#[derive(Clone, Copy, Debug)]
+struct IntegratorArg(IntegratorKind);
+
+impl ValueEnum for IntegratorArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        static VARIANTS: std::sync::LazyLock<Vec<IntegratorArg>> = std::sync::LazyLock::new(|| {
+            IntegratorKind::ALL
+                .iter()
+                .map(|&k| IntegratorArg(k))
+                .collect()
+        });
+        &VARIANTS
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.0.name()).help(self.0.summary()))
+    }
 }
 
 #[cfg(feature = "viewer")]
@@ -178,12 +187,7 @@ enum ShowArg {
 }
 
 fn integrator_kind(arg: IntegratorArg) -> IntegratorKind {
-    match arg {
-        IntegratorArg::Whitted => IntegratorKind::Whitted,
-        IntegratorArg::Mcrt => IntegratorKind::Mcrt,
-        IntegratorArg::Path => IntegratorKind::Path,
-        IntegratorArg::Light => IntegratorKind::Light,
-    }
+    arg.0
 }
 
 #[cfg_attr(feature = "viewer", allow(dead_code))]

@@ -10,7 +10,10 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tracelab::film::{EXTREME_LUMINANCE, FilmSnapshot, NOT_FLAGGED};
 use tracelab::image::check_writable;
-use tracelab::integrator::{GlassShadows, Integrator, IntegratorOptions, MisHeuristic, Strategy};
+use tracelab::integrator::{
+    CameraIntegrator, GlassShadows, Integrator, IntegratorKind, IntegratorOptions, MisHeuristic,
+    Strategy,
+};
 use tracelab::math::OffsetMode;
 use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
 use tracelab::replay::replay_sample;
@@ -320,7 +323,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         domains: args.domains.unwrap_or_default(),
         clamp: args.clamp,
     };
-    if let Integrator::Mcrt(m) = settings.integrator
+    if let Integrator::Camera(CameraIntegrator::Mcrt(m)) = settings.integrator
         && m.rays_per_sample_closed() > args.max_branch_rays
     {
         return Err(Error::new(format!(
@@ -460,7 +463,9 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
         }
         _ => Strategy::Mis,
     };
-    if matches!(args.integrator, IntegratorArg::Mcrt) && args.shadow_rays + args.glossy_rays == 0 {
+    if integrator_kind(args.integrator) == IntegratorKind::Mcrt
+        && args.shadow_rays + args.glossy_rays == 0
+    {
         return Err(Error::new(
             "--shadow-rays and --glossy-rays cannot both be 0",
         ));
@@ -555,10 +560,10 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
     );
     if matches!(
         settings.integrator,
-        tracelab::integrator::Integrator::Path(_) | tracelab::integrator::Integrator::Whitted(_)
+        Integrator::Camera(CameraIntegrator::Path(_) | CameraIntegrator::Whitted(_))
     ) {
         let skipped = session.scene().features.skipped();
-        if settings.integrator.is_general() {
+        if matches!(settings.integrator, Integrator::Camera(e) if e.is_general()) {
             eprintln!("general code (--general): nothing skipped");
         } else {
             eprintln!("specialised for this scene: skipped {}", skipped.join(", "));
@@ -566,7 +571,7 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
     }
     if matches!(
         settings.integrator,
-        tracelab::integrator::Integrator::Path(_)
+        Integrator::Camera(CameraIntegrator::Path(_))
     ) {
         for (light, voxels) in session.scene().clearance.iter().enumerate() {
             if let Some(voxels) = voxels {
@@ -579,7 +584,7 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
             }
         }
     }
-    if let (tracelab::integrator::Integrator::Path(p), Some(lists)) =
+    if let (Integrator::Camera(CameraIntegrator::Path(p)), Some(lists)) =
         (&settings.integrator, session.scene().primary_candidates())
         && !p.general
     {

@@ -16,7 +16,7 @@
 //! radiance scaling at refraction does not apply to particles (Veach's
 //! thesis, 5.2).
 
-use super::{RayCounts, survives_roulette};
+use super::{IntegratorOptions, RayCounts, SplattingEstimator, Technique, survives_roulette};
 use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
@@ -51,8 +51,19 @@ pub struct Splat {
     pub value: Rgb,
 }
 
-impl LightTracer {
-    pub fn describe(&self) -> String {
+impl Technique for LightTracer {
+    const SUMMARY: &'static str =
+        "Light (particle) tracing: paths from the lights, every vertex connected to the camera.";
+
+    fn from_options(options: &IntegratorOptions) -> Self {
+        LightTracer {
+            max_depth: options.max_depth,
+            rr_depth: options.rr_depth,
+            russian_roulette: options.russian_roulette,
+        }
+    }
+
+    fn describe(&self) -> String {
         format!(
             "light tracing (max depth {}, rr {})",
             self.max_depth,
@@ -63,9 +74,11 @@ impl LightTracer {
             }
         )
     }
+}
 
+impl SplattingEstimator for LightTracer {
     /// Traces one particle and hands each camera connection to `splat`.
-    pub fn trace_particle(
+    fn trace(
         &self,
         scene: &Scene,
         sampler: &mut Sampler,

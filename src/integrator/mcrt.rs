@@ -14,8 +14,8 @@
 //! light sample can be taken: specular surfaces, or N = 0). Cook's tree of
 //! two branching levels (the classic 186-ray example) is D = 3.
 
-use super::{MisHeuristic, RayCounts};
-use crate::accel::{NO_LIGHT, SurfaceHit};
+use super::{CameraEstimator, IntegratorOptions, MisHeuristic, RayCounts, Technique};
+use crate::accel::{NO_LIGHT, PrimaryPixel, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
@@ -59,14 +59,29 @@ fn multi_sample_weight(heuristic: MisHeuristic, n_a: u32, pdf_a: f32, n_b: u32, 
     heuristic.weight(n_a as f32 * pdf_a, n_b as f32 * pdf_b)
 }
 
-impl McRayTracer {
-    pub fn describe(&self) -> String {
+impl Technique for McRayTracer {
+    const SUMMARY: &'static str =
+        "Monte Carlo (distribution) ray tracing: N shadow rays and M branching BSDF rays per hit.";
+
+    fn from_options(options: &IntegratorOptions) -> Self {
+        McRayTracer {
+            max_depth: options.max_depth,
+            shadow_rays: options.shadow_rays,
+            glossy_rays: options.glossy_rays,
+            mis: options.combining_heuristic(),
+            exact_seen_emitters: options.exact_seen_emitters,
+        }
+    }
+
+    fn describe(&self) -> String {
         format!(
             "mcrt (max depth {}, shadow rays {}, glossy rays {}, mis {:?})",
             self.max_depth, self.shadow_rays, self.glossy_rays, self.mis
         )
     }
+}
 
+impl McRayTracer {
     /// Expected rays per camera sample in a closed scene where every ray hits
     /// a non-specular scattering surface, with N > 0:
     /// 1 + sum_{d=0..D-1} M^d N + sum_{d=1..D-1} M^d (saturating at `u64::MAX`).
@@ -86,20 +101,22 @@ impl McRayTracer {
         }
         total
     }
+}
 
-    /// One radiance sample along the camera ray. `seen_emission`: the
-    /// emission its pixel sees directly, integrated over the pixel, where
-    /// known ([`crate::accel::PrimaryPixel`]); it then replaces the camera
-    /// hit's own emission, as in the path tracer.
-    pub fn radiance(
+impl CameraEstimator for McRayTracer {
+    /// One radiance sample along the camera ray. The emission its pixel sees
+    /// directly, integrated over the pixel where known
+    /// ([`PrimaryPixel::seen_emission`]), replaces the camera hit's own
+    /// emission, as in the path tracer.
+    fn radiance(
         &self,
         scene: &Scene,
         ray: Ray,
-        seen_emission: Option<Rgb>,
+        pixel: PrimaryPixel<'_>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
-        let seen_emission = seen_emission.filter(|_| self.exact_seen_emitters);
+        let seen_emission = pixel.seen_emission.filter(|_| self.exact_seen_emitters);
         let Some(hit) = scene.geometry.intersect(&ray) else {
             return seen_emission.unwrap_or(Rgb::ZERO);
         };
@@ -112,6 +129,12 @@ impl McRayTracer {
         emitted + self.scattered(scene, &hit, -ray.direction, 0, sampler, counts)
     }
 
+    fn integrates_seen_emitters(&self) -> bool {
+        self.exact_seen_emitters
+    }
+}
+
+impl McRayTracer {
     /// Light scattered at `hit` (a vertex of level `level`, 0 at the camera
     /// ray's hit) towards `wo_world`, excluding its emission: light of
     /// bounces `level + 1 ..= max_depth`.

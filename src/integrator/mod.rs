@@ -1,10 +1,21 @@
-//! Estimators of the rendering equation, one file each, behind one interface:
-//! given a camera ray and a sampler, return a radiance sample. The enum is
-//! dispatched once per camera sample, never inside the bounce loop.
+//! Techniques that solve the rendering equation, one file each, behind one
+//! interface. A technique is one of four kinds, each driven by the render
+//! session ([`crate::render::Session`]) through the same pass API:
 //!
-//! Light tracing runs the other way (particles from the lights splat onto
-//! the film), so it has its own entry point, [`LightTracer::trace_particle`],
-//! which the render session calls instead of [`Integrator::radiance`].
+//! - a **camera estimator** ([`CameraEstimator`]) returns a radiance value
+//!   per camera sample (Whitted, MC ray tracing, path tracing, ambient
+//!   occlusion);
+//! - a **splatting estimator** ([`SplattingEstimator`]) traces paths whose
+//!   contributions land anywhere on the film (light tracing);
+//! - a **multi-pass estimator** ([`MultiPassEstimator`]) builds shared data
+//!   once per pass (a photon map), then estimates per camera sample from it;
+//! - a **solver** ([`Solver`]) runs solve steps and shows an image of its
+//!   solution (radiosity).
+//!
+//! Each kind is a closed enum generated from the registration list at the
+//! bottom of this file, dispatched once per sample (never inside a bounce
+//! loop) and never by a virtual call. Adding a technique is its own file,
+//! one line in that list and its controls; `docs/design.md` lists the files.
 
 pub mod light;
 pub mod mcrt;
@@ -13,10 +24,10 @@ pub mod options;
 pub mod path;
 pub mod whitted;
 
-pub use light::LightTracer;
+pub use light::{LightTracer, Splat};
 pub use mcrt::McRayTracer;
 pub use mis::MisHeuristic;
-pub use options::{IntegratorKind, IntegratorOptions, Strategy};
+pub use options::{IntegratorOptions, Strategy};
 pub use path::PathTracer;
 pub use whitted::{GlassShadows, WhittedTracer};
 
@@ -69,80 +80,487 @@ pub fn sample_time(scene: &Scene, sampler: &mut Sampler, always: bool) -> f32 {
     }
 }
 
-/// A configured estimator.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Integrator {
-    Whitted(WhittedTracer),
-    Mcrt(McRayTracer),
-    Path(PathTracer),
-    Light(LightTracer),
+/// What every technique has, whatever its kind.
+pub trait Technique: Sized + Send + Sync {
+    /// One sentence for the command line's help: what the technique does.
+    const SUMMARY: &'static str;
+    /// The technique's settings, read from the options the CLI and the
+    /// viewer both fill in.
+    fn from_options(options: &IntegratorOptions) -> Self;
+    /// Short description with the settings, for summaries and metadata.
+    fn describe(&self) -> String;
+    /// The settings resolved for `scene` (pbrt's preprocess): a distance
+    /// given as a fraction of the scene's size becomes one in its units, so
+    /// that no result depends on them. The session calls it once.
+    fn for_scene(self, _scene: &Scene) -> Self {
+        self
+    }
 }
 
-impl Integrator {
-    /// One radiance sample along the camera ray `ray`. Counts the rays it
+/// An estimator of the radiance arriving along a camera ray.
+pub trait CameraEstimator: Technique {
+    /// One radiance sample along the camera ray `ray`; counts the rays it
     /// casts after the camera ray into `counts`. `pixel`: what is known in
-    /// advance about the ray's pixel (path and MC ray tracing use it).
-    #[inline]
-    pub fn radiance(
+    /// advance about the ray's pixel ([`crate::accel::PrimaryCandidates`]).
+    fn radiance(
         &self,
         scene: &Scene,
         ray: Ray,
         pixel: PrimaryPixel<'_>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
-    ) -> Rgb {
+    ) -> Rgb;
+
+    /// True when every sample of a pixel gives the same value (one ray
+    /// through the pixel centre), so one sample per pixel is the image.
+    fn is_deterministic(&self) -> bool {
+        false
+    }
+
+    /// True when the estimator adds [`PrimaryPixel::seen_emission`] where it
+    /// is known instead of sampling the emission camera rays hit.
+    fn integrates_seen_emitters(&self) -> bool {
+        false
+    }
+
+    /// True when the estimator runs its general code even where the scene
+    /// allows a specialised one (for measuring what specialisation saves):
+    /// camera rays then draw a time even in a static scene.
+    fn is_general(&self) -> bool {
+        false
+    }
+}
+
+/// An estimator whose paths start at the lights and whose contributions
+/// land anywhere on the film.
+pub trait SplattingEstimator: Technique {
+    /// Traces one path and hands each contribution that reaches the film to
+    /// `splat`, not yet divided by the number of paths of the pass.
+    fn trace(
+        &self,
+        scene: &Scene,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+        splat: impl FnMut(Splat),
+    );
+}
+
+/// An estimator that builds data shared by all pixels once per pass (a
+/// photon map), then estimates radiance per camera sample from it.
+pub trait MultiPassEstimator: Technique {
+    /// What a pre-pass builds and the pass's camera samples read.
+    type Pass: Send + Sync;
+    /// Runs the pre-pass of pass number `pass` (0, 1, ...); may use rayon,
+    /// as it runs on the session's threads. Randomness must come from
+    /// (`seed`, `pass`) alone so images stay independent of the schedule.
+    fn prepare(&self, scene: &Scene, pass: u32, seed: u64, counts: &mut RayCounts) -> Self::Pass;
+    /// One radiance sample along a camera ray, reading this pass's data.
+    fn radiance(
+        &self,
+        scene: &Scene,
+        pass: &Self::Pass,
+        ray: Ray,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb;
+}
+
+/// A solver: improves a solution by steps, and shows it through camera rays.
+pub trait Solver: Technique {
+    /// The solution and whatever the steps need between calls.
+    type State: Send + Sync + 'static;
+    /// The initial state (meshing, form factors); errors name what failed.
+    fn init(&self, scene: &Scene) -> crate::Result<Self::State>;
+    /// Runs up to `steps` solve steps; may use rayon.
+    fn step(
+        &self,
+        scene: &Scene,
+        state: &mut Self::State,
+        steps: u32,
+        counts: &mut RayCounts,
+    ) -> SolverProgress;
+    /// One radiance sample of the current solution along a camera ray.
+    fn radiance(
+        &self,
+        scene: &Scene,
+        state: &Self::State,
+        ray: Ray,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb;
+    /// Samples per pixel of one image of the solution (ray-cast display
+    /// with antialiasing, say); 1 for a deterministic display.
+    fn display_spp(&self) -> u32;
+}
+
+/// Where a solver stands after a batch of steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolverProgress {
+    /// Steps run so far.
+    pub steps: u64,
+    /// The solver's own error estimate (a residual, or the unshot power
+    /// over the emitted power), comparable between steps.
+    pub residual: f64,
+    /// No further step changes the solution.
+    pub converged: bool,
+}
+
+/// What a session can say about a technique's error without a reference.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ErrorEstimate {
+    /// Root mean square standard error of the pixel means.
+    Sampling(f64),
+    /// A deterministic estimator: no sampling noise to estimate.
+    Deterministic,
+    /// A solver's residual ([`SolverProgress::residual`]).
+    Residual(f64),
+    /// Not yet known (fewer than two samples).
+    Unknown,
+}
+
+/// The four kinds of technique.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TechniqueKind {
+    Camera,
+    Splatting,
+    MultiPass,
+    Solver,
+}
+
+/// Generates, from one list of techniques by kind: [`IntegratorKind`] (the
+/// names the CLI and the viewer offer), one enum per kind that dispatches
+/// statically to the techniques' trait methods, and
+/// [`IntegratorOptions::build`].
+macro_rules! register_techniques {
+    (
+        camera { $($cv:ident($ct:ty) = $cname:literal, $clabel:literal;)* }
+        splatting { $($sv:ident($st:ty) = $sname:literal, $slabel:literal;)* }
+        multi_pass { $($mv:ident($mt:ty) = $mname:literal, $mlabel:literal;)* }
+        solver { $($xv:ident($xt:ty) = $xname:literal, $xlabel:literal;)* }
+    ) => {
+        /// Which technique, by name.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+        pub enum IntegratorKind {
+            $(#[serde(rename = $cname)] $cv,)*
+            $(#[serde(rename = $sname)] $sv,)*
+            $(#[serde(rename = $mname)] $mv,)*
+            $(#[serde(rename = $xname)] $xv,)*
+        }
+
+        impl IntegratorKind {
+            /// Every registered technique, in registration order.
+            pub const ALL: &'static [IntegratorKind] = &[
+                $(IntegratorKind::$cv,)* $(IntegratorKind::$sv,)*
+                $(IntegratorKind::$mv,)* $(IntegratorKind::$xv,)*
+            ];
+
+            /// Short name, as the command line spells it.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(IntegratorKind::$cv => $cname,)* $(IntegratorKind::$sv => $sname,)*
+                    $(IntegratorKind::$mv => $mname,)* $(IntegratorKind::$xv => $xname,)*
+                }
+            }
+
+            /// Name for menus.
+            pub fn label(self) -> &'static str {
+                match self {
+                    $(IntegratorKind::$cv => $clabel,)* $(IntegratorKind::$sv => $slabel,)*
+                    $(IntegratorKind::$mv => $mlabel,)* $(IntegratorKind::$xv => $xlabel,)*
+                }
+            }
+
+            /// One sentence on what the technique does ([`Technique::SUMMARY`]).
+            pub fn summary(self) -> &'static str {
+                match self {
+                    $(IntegratorKind::$cv => <$ct as Technique>::SUMMARY,)*
+                    $(IntegratorKind::$sv => <$st as Technique>::SUMMARY,)*
+                    $(IntegratorKind::$mv => <$mt as Technique>::SUMMARY,)*
+                    $(IntegratorKind::$xv => <$xt as Technique>::SUMMARY,)*
+                }
+            }
+
+            /// Which kind of technique it is.
+            pub fn technique(self) -> TechniqueKind {
+                match self {
+                    $(IntegratorKind::$cv => TechniqueKind::Camera,)*
+                    $(IntegratorKind::$sv => TechniqueKind::Splatting,)*
+                    $(IntegratorKind::$mv => TechniqueKind::MultiPass,)*
+                    $(IntegratorKind::$xv => TechniqueKind::Solver,)*
+                }
+            }
+        }
+
+        impl IntegratorOptions {
+            /// The configured technique.
+            pub fn build(&self) -> Integrator {
+                match self.kind {
+                    $(IntegratorKind::$cv =>
+                        Integrator::Camera(CameraIntegrator::$cv(<$ct>::from_options(self))),)*
+                    $(IntegratorKind::$sv =>
+                        Integrator::Splatting(SplattingIntegrator::$sv(<$st>::from_options(self))),)*
+                    $(IntegratorKind::$mv =>
+                        Integrator::MultiPass(MultiPassIntegrator::$mv(<$mt>::from_options(self))),)*
+                    $(IntegratorKind::$xv =>
+                        Integrator::Solver(SolverIntegrator::$xv(<$xt>::from_options(self))),)*
+                }
+            }
+        }
+
+        /// A configured camera estimator.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub enum CameraIntegrator { $($cv($ct),)* }
+
+        $(impl From<$ct> for Integrator {
+            fn from(estimator: $ct) -> Integrator {
+                Integrator::Camera(CameraIntegrator::$cv(estimator))
+            }
+        })*
+
+        $(impl From<$st> for Integrator {
+            fn from(estimator: $st) -> Integrator {
+                Integrator::Splatting(SplattingIntegrator::$sv(estimator))
+            }
+        })*
+
+        impl CameraIntegrator {
+            /// [`CameraEstimator::radiance`] of the configured estimator.
+            #[inline]
+            pub fn radiance(
+                &self,
+                scene: &Scene,
+                ray: Ray,
+                pixel: PrimaryPixel<'_>,
+                sampler: &mut Sampler,
+                counts: &mut RayCounts,
+            ) -> Rgb {
+                match self { $(CameraIntegrator::$cv(e) => e.radiance(scene, ray, pixel, sampler, counts),)* }
+            }
+
+            fn kind(&self) -> IntegratorKind {
+                match self { $(CameraIntegrator::$cv(_) => IntegratorKind::$cv,)* }
+            }
+
+            fn describe(&self) -> String {
+                match self { $(CameraIntegrator::$cv(e) => e.describe(),)* }
+            }
+
+            fn for_scene(self, scene: &Scene) -> Self {
+                match self { $(CameraIntegrator::$cv(e) => CameraIntegrator::$cv(e.for_scene(scene)),)* }
+            }
+
+            /// [`CameraEstimator::is_deterministic`].
+            pub fn is_deterministic(&self) -> bool {
+                match self { $(CameraIntegrator::$cv(e) => e.is_deterministic(),)* }
+            }
+
+            /// [`CameraEstimator::is_general`].
+            pub fn is_general(&self) -> bool {
+                match self { $(CameraIntegrator::$cv(e) => e.is_general(),)* }
+            }
+
+            /// [`CameraEstimator::integrates_seen_emitters`].
+            pub fn integrates_seen_emitters(&self) -> bool {
+                match self { $(CameraIntegrator::$cv(e) => e.integrates_seen_emitters(),)* }
+            }
+        }
+
+        /// A configured splatting estimator.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub enum SplattingIntegrator { $($sv($st),)* }
+
+        impl SplattingIntegrator {
+            /// [`SplattingEstimator::trace`] of the configured estimator.
+            #[inline]
+            pub fn trace(
+                &self,
+                scene: &Scene,
+                sampler: &mut Sampler,
+                counts: &mut RayCounts,
+                splat: impl FnMut(Splat),
+            ) {
+                match self { $(SplattingIntegrator::$sv(e) => e.trace(scene, sampler, counts, splat),)* }
+            }
+
+            fn kind(&self) -> IntegratorKind {
+                match self { $(SplattingIntegrator::$sv(_) => IntegratorKind::$sv,)* }
+            }
+
+            fn describe(&self) -> String {
+                match self { $(SplattingIntegrator::$sv(e) => e.describe(),)* }
+            }
+
+            fn for_scene(self, scene: &Scene) -> Self {
+                match self { $(SplattingIntegrator::$sv(e) => SplattingIntegrator::$sv(e.for_scene(scene)),)* }
+            }
+        }
+
+        /// A configured multi-pass estimator (photon mapping registers here).
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub enum MultiPassIntegrator { $($mv($mt),)* }
+
+        // While a kind has no technique its enum is empty and these are unreachable.
+        #[allow(unused_variables, unreachable_code)]
+        impl MultiPassIntegrator {
+            /// Calls `visit` with the configured estimator's concrete type,
+            /// so the session's pass loop is compiled for it.
+            pub fn visit<V: MultiPassVisitor>(&self, visit: V) -> V::Output {
+                match *self { $(MultiPassIntegrator::$mv(ref e) => visit.visit(e),)* }
+            }
+
+            fn kind(&self) -> IntegratorKind {
+                match *self { $(MultiPassIntegrator::$mv(_) => IntegratorKind::$mv,)* }
+            }
+
+            fn describe(&self) -> String {
+                match *self { $(MultiPassIntegrator::$mv(ref e) => e.describe(),)* }
+            }
+
+            fn for_scene(self, scene: &Scene) -> Self {
+                match self { $(MultiPassIntegrator::$mv(e) => MultiPassIntegrator::$mv(e.for_scene(scene)),)* }
+            }
+        }
+
+        /// A configured solver (radiosity registers here).
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub enum SolverIntegrator { $($xv($xt),)* }
+
+        #[allow(unused_variables, unreachable_code)]
+        impl SolverIntegrator {
+            /// Calls `visit` with the configured solver's concrete type.
+            pub fn visit<V: SolverVisitor>(&self, visit: V) -> V::Output {
+                match *self { $(SolverIntegrator::$xv(ref e) => visit.visit(e),)* }
+            }
+
+            fn kind(&self) -> IntegratorKind {
+                match *self { $(SolverIntegrator::$xv(_) => IntegratorKind::$xv,)* }
+            }
+
+            fn describe(&self) -> String {
+                match *self { $(SolverIntegrator::$xv(ref e) => e.describe(),)* }
+            }
+
+            fn for_scene(self, scene: &Scene) -> Self {
+                match self { $(SolverIntegrator::$xv(e) => SolverIntegrator::$xv(e.for_scene(scene)),)* }
+            }
+        }
+    };
+}
+
+/// Receives a multi-pass estimator as its concrete type.
+pub trait MultiPassVisitor {
+    type Output;
+    fn visit<E: MultiPassEstimator>(self, estimator: &E) -> Self::Output;
+}
+
+/// Receives a solver as its concrete type.
+pub trait SolverVisitor {
+    type Output;
+    fn visit<S: Solver>(self, solver: &S) -> Self::Output;
+}
+
+/// A configured technique of any kind.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Integrator {
+    Camera(CameraIntegrator),
+    Splatting(SplattingIntegrator),
+    MultiPass(MultiPassIntegrator),
+    Solver(SolverIntegrator),
+}
+
+// Arms of kinds without a registered technique are unreachable.
+#[allow(unreachable_code)]
+impl Integrator {
+    /// Which technique.
+    pub fn kind(&self) -> IntegratorKind {
         match self {
-            Integrator::Whitted(w) => w.radiance(scene, ray, counts),
-            Integrator::Mcrt(m) => m.radiance(scene, ray, pixel.seen_emission, sampler, counts),
-            Integrator::Path(p) => p.radiance(scene, ray, pixel, sampler, counts),
-            // Light tracing splats instead; the session never calls this for it.
-            Integrator::Light(_) => Rgb::ZERO,
+            Integrator::Camera(e) => e.kind(),
+            Integrator::Splatting(e) => e.kind(),
+            Integrator::MultiPass(e) => e.kind(),
+            Integrator::Solver(e) => e.kind(),
+        }
+    }
+
+    /// Which kind of technique.
+    pub fn technique(&self) -> TechniqueKind {
+        match self {
+            Integrator::Camera(_) => TechniqueKind::Camera,
+            Integrator::Splatting(_) => TechniqueKind::Splatting,
+            Integrator::MultiPass(_) => TechniqueKind::MultiPass,
+            Integrator::Solver(_) => TechniqueKind::Solver,
         }
     }
 
     /// Short description for summaries and file names.
     pub fn describe(&self) -> String {
         match self {
-            Integrator::Whitted(w) => w.describe(),
-            Integrator::Mcrt(m) => m.describe(),
-            Integrator::Path(p) => p.describe(),
-            Integrator::Light(l) => l.describe(),
+            Integrator::Camera(e) => e.describe(),
+            Integrator::Splatting(e) => e.describe(),
+            Integrator::MultiPass(e) => e.describe(),
+            Integrator::Solver(e) => e.describe(),
         }
     }
 
     /// Short name, as the command line spells it.
     pub fn name(&self) -> &'static str {
+        self.kind().name()
+    }
+
+    /// The settings resolved for `scene` ([`Technique::for_scene`]).
+    pub fn for_scene(self, scene: &Scene) -> Integrator {
         match self {
-            Integrator::Whitted(_) => "whitted",
-            Integrator::Mcrt(_) => "mcrt",
-            Integrator::Path(_) => "path",
-            Integrator::Light(_) => "light",
+            Integrator::Camera(e) => Integrator::Camera(e.for_scene(scene)),
+            Integrator::Splatting(e) => Integrator::Splatting(e.for_scene(scene)),
+            Integrator::MultiPass(e) => Integrator::MultiPass(e.for_scene(scene)),
+            Integrator::Solver(e) => Integrator::Solver(e.for_scene(scene)),
         }
     }
 
-    /// True when the estimator adds [`PrimaryPixel::seen_emission`] where it
-    /// is known instead of sampling the emission camera rays hit.
-    pub fn integrates_seen_emitters(&self) -> bool {
-        match self {
-            Integrator::Mcrt(m) => m.exact_seen_emitters,
-            Integrator::Path(p) => p.exact_seen_emitters,
-            Integrator::Whitted(_) | Integrator::Light(_) => false,
-        }
-    }
-
-    /// True when every sample of a pixel gives the same value (Whitted: one
-    /// ray through the pixel centre), so one sample per pixel is the image.
+    /// True when every sample of a pixel gives the same value, so one sample
+    /// per pixel is the image and there is no sampling noise.
     pub fn is_deterministic(&self) -> bool {
-        matches!(self, Integrator::Whitted(_))
+        matches!(self, Integrator::Camera(e) if e.is_deterministic())
     }
 
-    /// True when the estimator runs its general loop even where the scene
-    /// allows a specialised one (for measuring what specialisation saves).
-    pub fn is_general(&self) -> bool {
-        match self {
-            Integrator::Path(p) => p.general,
-            Integrator::Whitted(w) => w.general,
-            _ => false,
-        }
+    /// True when the estimator integrates emitters seen directly over each
+    /// pixel where that is known.
+    pub fn integrates_seen_emitters(&self) -> bool {
+        matches!(self, Integrator::Camera(e) if e.integrates_seen_emitters())
     }
+}
+
+impl Default for IntegratorKind {
+    fn default() -> Self {
+        IntegratorKind::Path
+    }
+}
+
+impl IntegratorKind {
+    /// The technique named `name` (as [`IntegratorKind::name`] spells it).
+    pub fn from_name(name: &str) -> Option<IntegratorKind> {
+        Self::ALL.iter().copied().find(|k| k.name() == name)
+    }
+
+    /// Every name, comma-separated, for error messages and help.
+    pub fn names() -> String {
+        Self::ALL
+            .iter()
+            .map(|k| k.name())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+// The registration list: one line per technique.
+register_techniques! {
+    camera {
+        Whitted(WhittedTracer) = "whitted", "Whitted ray tracing";
+        Mcrt(McRayTracer) = "mcrt", "Monte Carlo ray tracing";
+        Path(PathTracer) = "path", "Path tracing";
+    }
+    splatting {
+        Light(LightTracer) = "light", "Light tracing";
+    }
+    multi_pass {}
+    solver {}
 }

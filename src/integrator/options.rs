@@ -1,40 +1,8 @@
 //! Estimator settings as plain data, the one form that the CLI and the viewer
-//! both fill in; [`IntegratorOptions::build`] turns them into an [`Integrator`].
+//! both fill in; [`IntegratorOptions::build`] turns them into an
+//! [`super::Integrator`], each technique reading the fields it has.
 
-use super::{
-    GlassShadows, Integrator, LightTracer, McRayTracer, MisHeuristic, PathTracer, WhittedTracer,
-};
-use crate::math::Rgb;
-
-/// Which estimator.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum IntegratorKind {
-    Whitted,
-    Mcrt,
-    #[default]
-    Path,
-    Light,
-}
-
-impl IntegratorKind {
-    pub const ALL: [IntegratorKind; 4] = [
-        IntegratorKind::Whitted,
-        IntegratorKind::Mcrt,
-        IntegratorKind::Path,
-        IntegratorKind::Light,
-    ];
-
-    /// Name for menus.
-    pub fn label(self) -> &'static str {
-        match self {
-            IntegratorKind::Whitted => "Whitted ray tracing",
-            IntegratorKind::Mcrt => "Monte Carlo ray tracing",
-            IntegratorKind::Path => "Path tracing",
-            IntegratorKind::Light => "Light tracing",
-        }
-    }
-}
+use super::{GlassShadows, IntegratorKind, MisHeuristic};
 
 /// Which sampling strategies the path tracer uses for direct light.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
@@ -97,44 +65,13 @@ impl Default for IntegratorOptions {
 }
 
 impl IntegratorOptions {
-    /// The configured estimator.
-    pub fn build(&self) -> Integrator {
-        let mis = if self.mis == MisHeuristic::None {
+    /// The MIS heuristic of estimators that always combine strategies
+    /// (`None` is not one of them).
+    pub fn combining_heuristic(&self) -> MisHeuristic {
+        if self.mis == MisHeuristic::None {
             MisHeuristic::Power
         } else {
             self.mis
-        };
-        match self.kind {
-            IntegratorKind::Whitted => Integrator::Whitted(WhittedTracer {
-                max_depth: self.max_depth,
-                ambient: Rgb::splat(self.ambient.max(0.0)),
-                glass_shadows: self.glass_shadows,
-                general: self.general,
-            }),
-            IntegratorKind::Mcrt => Integrator::Mcrt(McRayTracer {
-                max_depth: self.max_depth,
-                shadow_rays: self.shadow_rays,
-                glossy_rays: self.glossy_rays,
-                mis,
-                exact_seen_emitters: self.exact_seen_emitters,
-            }),
-            IntegratorKind::Path => Integrator::Path(PathTracer {
-                max_depth: self.max_depth,
-                rr_depth: self.rr_depth,
-                russian_roulette: self.russian_roulette,
-                nee: self.strategy != Strategy::Bsdf,
-                mis: match self.strategy {
-                    Strategy::Light => MisHeuristic::None,
-                    _ => mis,
-                },
-                general: self.general,
-                exact_seen_emitters: self.exact_seen_emitters,
-            }),
-            IntegratorKind::Light => Integrator::Light(LightTracer {
-                max_depth: self.max_depth,
-                rr_depth: self.rr_depth,
-                russian_roulette: self.russian_roulette,
-            }),
         }
     }
 }

@@ -8,7 +8,10 @@
 //!                               + w_bsdf * Le(x_{k+1})          (BSDF ray hits a light) ]
 //! where beta_k is the product of f cos / p_bsdf (and 1/q of roulette) so far.
 
-use super::{MisHeuristic, RayCounts, survives_roulette};
+use super::{
+    CameraEstimator, IntegratorOptions, MisHeuristic, RayCounts, Strategy, Technique,
+    survives_roulette,
+};
 use crate::accel::{NO_LIGHT, PrimaryPixel, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, ray_between};
 use crate::sampling::warp::square_to_cosine_hemisphere;
@@ -127,9 +130,26 @@ impl Default for PathTracer {
     }
 }
 
-impl PathTracer {
-    /// Short description for summaries.
-    pub fn describe(&self) -> String {
+impl Technique for PathTracer {
+    const SUMMARY: &'static str =
+        "Path tracing with next-event estimation, MIS and Russian roulette.";
+
+    fn from_options(options: &IntegratorOptions) -> Self {
+        PathTracer {
+            max_depth: options.max_depth,
+            rr_depth: options.rr_depth,
+            russian_roulette: options.russian_roulette,
+            nee: options.strategy != Strategy::Bsdf,
+            mis: match options.strategy {
+                Strategy::Light => MisHeuristic::None,
+                _ => options.combining_heuristic(),
+            },
+            general: options.general,
+            exact_seen_emitters: options.exact_seen_emitters,
+        }
+    }
+
+    fn describe(&self) -> String {
         format!(
             "path (max depth {}, nee {}, mis {:?}, rr {})",
             self.max_depth,
@@ -142,12 +162,14 @@ impl PathTracer {
             }
         )
     }
+}
 
+impl CameraEstimator for PathTracer {
     /// One radiance sample along `ray`, by the loop specialised for what
     /// the scene uses (see [`crate::scene::Features`]). `pixel`: what is
     /// known of the camera ray's pixel ([`crate::accel::PrimaryCandidates`]).
     #[inline]
-    pub fn radiance(
+    fn radiance(
         &self,
         scene: &Scene,
         ray: Ray,
@@ -158,6 +180,16 @@ impl PathTracer {
         self.radiance_observed(scene, ray, pixel, sampler, counts, &mut NoObserver)
     }
 
+    fn integrates_seen_emitters(&self) -> bool {
+        self.exact_seen_emitters
+    }
+
+    fn is_general(&self) -> bool {
+        self.general
+    }
+}
+
+impl PathTracer {
     /// [`PathTracer::radiance`], telling `observer` about every vertex.
     ///
     /// Where the pixel's directly seen emission is known, integrated over

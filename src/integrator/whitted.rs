@@ -11,9 +11,10 @@
 //!   L(x, wo) = Le + sum_lights f(wo, wl) I cos / d^2 V + ka albedo
 //!            + R L(x, reflect(wo)) + (1 - R) T L(x, refract(wo))
 
-use super::RayCounts;
-use crate::accel::{NO_LIGHT, SurfaceHit};
+use super::{CameraEstimator, IntegratorOptions, RayCounts, Technique};
+use crate::accel::{NO_LIGHT, PrimaryPixel, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
+use crate::sampling::Sampler;
 use crate::scene::Scene;
 use crate::scene::light::{Light, PlanarEmitter};
 use crate::scene::material::{Bsdf, fresnel_dielectric};
@@ -58,8 +59,20 @@ impl Default for WhittedTracer {
 /// Most glass surfaces a tinted shadow ray passes before it gives up.
 const MAX_GLASS_CROSSINGS: u32 = 16;
 
-impl WhittedTracer {
-    pub fn describe(&self) -> String {
+impl Technique for WhittedTracer {
+    const SUMMARY: &'static str =
+        "Whitted ray tracing: point-light direct light, hard shadows, mirror and glass recursion.";
+
+    fn from_options(options: &IntegratorOptions) -> Self {
+        WhittedTracer {
+            max_depth: options.max_depth,
+            ambient: Rgb::splat(options.ambient.max(0.0)),
+            glass_shadows: options.glass_shadows,
+            general: options.general,
+        }
+    }
+
+    fn describe(&self) -> String {
         format!(
             "whitted (max depth {}, ambient {:?}, glass shadows {:?})",
             self.max_depth,
@@ -67,12 +80,31 @@ impl WhittedTracer {
             self.glass_shadows
         )
     }
+}
 
+impl CameraEstimator for WhittedTracer {
     /// Radiance along `ray`; deterministic, so one sample per pixel is enough.
-    pub fn radiance(&self, scene: &Scene, ray: Ray, counts: &mut RayCounts) -> Rgb {
+    fn radiance(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        _pixel: PrimaryPixel<'_>,
+        _sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
         self.trace(scene, ray, 0, counts)
     }
 
+    fn is_deterministic(&self) -> bool {
+        true
+    }
+
+    fn is_general(&self) -> bool {
+        self.general
+    }
+}
+
+impl WhittedTracer {
     fn trace(&self, scene: &Scene, ray: Ray, depth: u32, counts: &mut RayCounts) -> Rgb {
         let Some(hit) = scene.geometry.intersect(&ray) else {
             return Rgb::ZERO;

@@ -359,7 +359,7 @@ impl ViewerApp {
                         seed: c.seed,
                         planned_spp: target.unwrap_or(0),
                         threads: 0,
-                        adaptive: c.spread_by_noise.then_some(Adaptive::Distribute {
+                        adaptive: c.spreads_by_noise().then_some(Adaptive::Distribute {
                             warmup_spp: SPREAD_WARMUP_SPP,
                         }),
                         domains: c.domains,

@@ -133,8 +133,9 @@ fn seen_emitters(ui: &mut egui::Ui, exact: &mut bool) {
 fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
     ui.heading("Estimator");
     let options = &mut config.integrator;
-    for kind in IntegratorKind::ALL {
-        ui.radio_value(&mut options.kind, kind, kind.label());
+    for &kind in IntegratorKind::ALL {
+        ui.radio_value(&mut options.kind, kind, kind.label())
+            .on_hover_text(kind.summary());
     }
     let depth_label = match options.kind {
         IntegratorKind::Whitted => "Max specular depth",
@@ -211,10 +212,7 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
             ui.checkbox(&mut d.bsdf, "BSDF");
         });
     });
-    if !matches!(
-        options.kind,
-        IntegratorKind::Light | IntegratorKind::Whitted
-    ) {
+    if config.spreads_by_noise() || config.can_spread_by_noise() {
         ui.checkbox(
             &mut config.spread_by_noise,
             "Adaptive: spread samples by noise",

@@ -2,7 +2,7 @@
 //! persists between runs. Render settings (which restart accumulation) and
 //! display settings (which never do) are kept apart.
 
-use crate::integrator::{IntegratorKind, IntegratorOptions};
+use crate::integrator::{IntegratorKind, IntegratorOptions, TechniqueKind};
 use crate::live::Lock;
 use crate::math::OffsetMode;
 use crate::sampling::{Domains, SamplerKind};
@@ -35,6 +35,18 @@ impl Default for Config {
 }
 
 impl Config {
+    /// True when the technique takes samples per pixel that can be spread
+    /// by noise: a camera estimator with sampling noise.
+    pub fn can_spread_by_noise(&self) -> bool {
+        self.integrator.kind.technique() == TechniqueKind::Camera
+            && !self.integrator.build().is_deterministic()
+    }
+
+    /// True when samples are spread by noise.
+    pub fn spreads_by_noise(&self) -> bool {
+        self.spread_by_noise && self.can_spread_by_noise()
+    }
+
     /// A short name for labels, legends and file names.
     pub fn label(&self) -> String {
         let i = &self.integrator;
@@ -48,6 +60,9 @@ impl Config {
                 format!("path d{} {:?}", i.max_depth, i.strategy).to_lowercase()
             }
             IntegratorKind::Light => format!("light d{}", i.max_depth),
+            // Techniques without a label of their own.
+            #[allow(unreachable_patterns)]
+            other => other.name().to_string(),
         };
         let d = self.domains;
         let partial = if self.sampler != SamplerKind::Independent && d != Domains::ALL {
@@ -66,7 +81,7 @@ impl Config {
         } else {
             String::new()
         };
-        let adaptive = if self.spread_by_noise && self.integrator.kind != IntegratorKind::Light {
+        let adaptive = if self.spreads_by_noise() {
             " adaptive"
         } else {
             ""

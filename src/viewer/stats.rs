@@ -3,6 +3,7 @@
 //! configuration, past configurations kept).
 
 use super::app::ViewerApp;
+use crate::integrator::ErrorEstimate;
 use crate::live::{ErrorPoint, LiveView};
 use eframe::egui;
 use egui_plot::{Legend, Line, LineStyle, Plot, PlotPoints};
@@ -48,10 +49,15 @@ fn view_summary(name: &str, view: &LiveView, app: &ViewerApp) -> String {
     let pixels = view.snapshot.samples.len().max(1) as f64;
     let last = view.history.last();
     let mut text = format!(
-        "{name} {} spp | {:.2} s | est. RMSE {:.5}{} | {:.2} M samples/s | {:.1} M rays/s | rays/px {:.0} (cam {:.0}, shadow {:.0}, bounce {:.0})",
+        "{name} {} spp | {:.2} s | {}{} | {:.2} M samples/s | {:.1} M rays/s | rays/px {:.0} (cam {:.0}, shadow {:.0}, bounce {:.0})",
         s.spp,
         s.render_time.as_secs_f64(),
-        last.map_or(f64::NAN, |p| p.noise),
+        match last.map(|p| p.estimate) {
+            Some(ErrorEstimate::Sampling(rmse)) => format!("est. RMSE {rmse:.5}"),
+            Some(ErrorEstimate::Deterministic) => "deterministic: no sampling noise".into(),
+            Some(ErrorEstimate::Residual(r)) => format!("residual {r:.3e}"),
+            Some(ErrorEstimate::Unknown) | None => "est. RMSE n/a".into(),
+        },
         match last.and_then(|p| p.rmse) {
             Some(rmse) => format!(" | RMSE {rmse:.5}"),
             None if app.reference().is_some() => " | RMSE n/a (size differs)".into(),
@@ -67,6 +73,9 @@ fn view_summary(name: &str, view: &LiveView, app: &ViewerApp) -> String {
     if s.non_finite > 0 {
         text += &format!(" | non-finite {}", s.non_finite);
     }
+    if let Some(failure) = &view.failure {
+        text += &format!(" | failed: {failure}");
+    }
     text
 }
 
@@ -79,7 +88,15 @@ pub fn resident_memory_mib() -> Option<f64> {
 
 /// The metric plotted: RMSE when a reference is loaded, else the film's noise.
 fn metric(p: &ErrorPoint, use_rmse: bool) -> Option<f64> {
-    let v = if use_rmse { p.rmse? } else { p.noise };
+    let v = if use_rmse {
+        p.rmse?
+    } else {
+        match p.estimate {
+            ErrorEstimate::Sampling(v) | ErrorEstimate::Residual(v) => v,
+            // Nothing to plot: no noise, or not known yet.
+            ErrorEstimate::Deterministic | ErrorEstimate::Unknown => return None,
+        }
+    };
     (v.is_finite() && v > 0.0).then_some(v)
 }
 
