@@ -13,6 +13,8 @@ mod chi2;
 mod bsdf;
 // Whitted by hand, MC ray tracing's ray count.
 mod estimators;
+// Ambient occlusion of a plane and of a floor before a wall.
+mod ambient_occlusion;
 // NEE on/off and MIS variants converge to the same image.
 mod strategies;
 // Same seed, same film, whatever the thread count or pass split.

@@ -125,6 +125,10 @@ pub struct RenderArgs {
     /// MC ray tracing: BSDF samples (branching rays) per hit.
     #[arg(long, default_value_t = 1)]
     glossy_rays: u32,
+    /// Ambient occlusion: occluders count within this fraction of the
+    /// scene's bounding-box diagonal (0: no limit).
+    #[arg(long, default_value_t = 0.1)]
+    ao_distance: f32,
     /// Path tracing and Whitted: run the general code, not the code
     /// specialised for the scene's features (to measure what that saves).
     #[arg(long)]
@@ -463,6 +467,12 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
         }
         _ => Strategy::Mis,
     };
+    if !(args.ao_distance >= 0.0 && args.ao_distance.is_finite()) {
+        return Err(Error::new(format!(
+            "--ao-distance {} is not a fraction >= 0 of the scene's size",
+            args.ao_distance
+        )));
+    }
     if integrator_kind(args.integrator) == IntegratorKind::Mcrt
         && args.shadow_rays + args.glossy_rays == 0
     {
@@ -489,6 +499,7 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
         },
         general: args.general,
         exact_seen_emitters: args.seen_emitters == SeenEmittersArg::Exact,
+        ao_distance: args.ao_distance,
     })
 }
 

@@ -17,6 +17,7 @@
 //! loop) and never by a virtual call. Adding a technique is its own file,
 //! one line in that list and its controls; `docs/design.md` lists the files.
 
+pub mod ambient_occlusion;
 pub mod light;
 pub mod mcrt;
 pub mod mis;
@@ -557,6 +558,7 @@ register_techniques! {
         Whitted(WhittedTracer) = "whitted", "Whitted ray tracing";
         Mcrt(McRayTracer) = "mcrt", "Monte Carlo ray tracing";
         Path(PathTracer) = "path", "Path tracing";
+        AmbientOcclusion(ambient_occlusion::AmbientOcclusion) = "ao", "Ambient occlusion";
     }
     splatting {
         Light(LightTracer) = "light", "Light tracing";

@@ -43,6 +43,9 @@ pub struct IntegratorOptions {
     /// exactly over each pixel where that is possible (`crate::accel::seen_emitters`); off,
     /// camera rays sample them like everything else.
     pub exact_seen_emitters: bool,
+    /// Ambient occlusion: occluders count within this fraction of the
+    /// scene's bounding-box diagonal (0: no limit).
+    pub ao_distance: f32,
 }
 
 impl Default for IntegratorOptions {
@@ -60,6 +63,7 @@ impl Default for IntegratorOptions {
             glass_shadows: GlassShadows::Opaque,
             general: false,
             exact_seen_emitters: true,
+            ao_distance: 0.1,
         }
     }
 }

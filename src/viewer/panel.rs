@@ -141,7 +141,9 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
         IntegratorKind::Whitted => "Max specular depth",
         _ => "Max depth (bounces)",
     };
-    ui.add(egui::Slider::new(&mut options.max_depth, 0..=32).text(depth_label));
+    if options.kind != IntegratorKind::AmbientOcclusion {
+        ui.add(egui::Slider::new(&mut options.max_depth, 0..=32).text(depth_label));
+    }
     match options.kind {
         IntegratorKind::Whitted => {
             ui.add(egui::Slider::new(&mut options.ambient, 0.0..=0.5).text("Ambient"));
@@ -181,6 +183,24 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
             seen_emitters(ui, &mut options.exact_seen_emitters);
         }
         IntegratorKind::Light => roulette(ui, &mut options.russian_roulette, &mut options.rr_depth),
+        IntegratorKind::AmbientOcclusion => {
+            let mut limited = options.ao_distance > 0.0;
+            ui.checkbox(&mut limited, "Distance limit").on_hover_text(
+                "Occluders farther than this fraction of the scene's size do not count",
+            );
+            if !limited {
+                options.ao_distance = 0.0;
+            } else {
+                if options.ao_distance == 0.0 {
+                    options.ao_distance = 0.1;
+                }
+                ui.add(
+                    egui::Slider::new(&mut options.ao_distance, 0.001..=1.0)
+                        .logarithmic(true)
+                        .text("Distance (of the scene's diagonal)"),
+                );
+            }
+        }
     }
     ui.horizontal_wrapped(|ui| {
         ui.label("Sampler");
