@@ -87,7 +87,14 @@ fn no_bsdf_reflects_more_than_it_receives() {
 
 #[test]
 fn bsdfs_are_reciprocal() {
+    let mut tested = 0;
     for (name, bsdf) in bsdfs() {
+        // A mirror's or glass's f is a delta: eval is zero for every pair by
+        // construction, so there is nothing to compare.
+        if bsdf.is_specular() {
+            continue;
+        }
+        let mut nonzero = 0;
         for i in 0..10_000u64 {
             let a = square_to_uniform_sphere(Vec2::new(uniform(1, i, 0), uniform(1, i, 1)));
             let b = square_to_uniform_sphere(Vec2::new(uniform(1, i, 2), uniform(1, i, 3)));
@@ -96,8 +103,16 @@ fn bsdfs_are_reciprocal() {
                 (fab - fba).abs().max_element() <= 1e-5 * fab.max_element().max(1.0),
                 "{name}: {fab} vs {fba} for {a} {b}"
             );
+            nonzero += u32::from(fab.max_element() > 0.0 || fba.max_element() > 0.0);
         }
+        // Both directions lie in the upper hemisphere for a quarter of the
+        // pairs (2500 expected); the narrowest lobe (n = 1000, no diffuse
+        // part) is nonzero within about 25 degrees of the mirror direction
+        // only (438 pairs with this seed), still far more than none.
+        assert!(nonzero > 300, "{name}: only {nonzero} pairs with f > 0");
+        tested += 1;
     }
+    assert_eq!(tested, 5, "reflective BSDFs checked");
 }
 
 #[test]

@@ -125,7 +125,7 @@ fn path_tracing_with_bsdf_or_light_sampling_alone_matches_mitsuba() {
 }
 
 /// Also at depth 1, where a bounce too many (as MC ray tracing had until
-/// session 12: light samples at its last level too) is 14-16% of the image.
+/// commit 2ff4279: light samples at its last level too) is 14-16% of the image.
 #[test]
 fn mc_ray_tracing_without_branching_matches_mitsuba() {
     for (depth, reference, variance) in [
@@ -242,4 +242,92 @@ fn check_against_reference_rmse(options: IntegratorOptions) -> f64 {
         "cornell_box_path_ref.exr",
         "cornell_box_path_ref_var.exr",
     )
+}
+
+/// Sobol points are not independent, so a film's own standard error (which
+/// assumes they are) overstates their error. Owen scrambling with another
+/// seed is an independent randomisation of the same points, though: the
+/// spread of `replicates` renders, each of `spp` samples, estimates the
+/// variance of their mean without assuming anything of the points (the
+/// randomised QMC estimate). The combined image is then held to the same
+/// tests: RMSE within 10% of sqrt(mean(s^2 / R + var_ref)), where s^2 is the
+/// pixel's sample variance over the R renders, and the image mean within
+/// 5.41 standard errors, the 99.9% two-sided quantile of Student's t with
+/// R - 1 = 7 degrees of freedom (the standard error itself comes from 8 values).
+fn check_replicates_against_reference(
+    options: IntegratorOptions,
+    adaptive: Option<Adaptive>,
+    replicates: u32,
+    spp: u32,
+) -> f64 {
+    let images: Vec<_> = (0..replicates)
+        .map(|r| {
+            let (snapshot, stats) = render_adaptive(
+                options.build(),
+                SamplerKind::Sobol,
+                adaptive,
+                cornell_box(),
+                spp,
+                u64::from(r) + 1,
+                0,
+                // Passes of 4: samples spread by noise after the first.
+                4,
+            );
+            assert_eq!(stats.non_finite, 0);
+            snapshot.image
+        })
+        .collect();
+    let reference = reference("cornell_box_path_ref.exr");
+    let reference_variance = crate::common::reference("cornell_box_path_ref_var.exr");
+    let r = f64::from(replicates);
+    let mut combined = images[0].clone();
+    let mut expected_mse = 0.0f64;
+    for (i, pixel) in combined.pixels.iter_mut().enumerate() {
+        for c in 0..3 {
+            let values = images.iter().map(|im| f64::from(im.pixels[i][c]));
+            let mean = values.clone().sum::<f64>() / r;
+            let variance = values.map(|v| (v - mean).powi(2)).sum::<f64>() / (r - 1.0);
+            pixel[c] = mean as f32;
+            expected_mse += variance / r + f64::from(reference_variance.pixels[i][c]);
+        }
+    }
+    expected_mse /= (combined.pixels.len() * 3) as f64;
+    let expected = expected_mse.sqrt();
+    let measured = combined.compare(&reference).unwrap().rmse;
+    eprintln!(
+        "{options:?} sobol {adaptive:?} x{replicates}: RMSE {measured:.5}, expected {expected:.5}"
+    );
+    assert!(
+        measured <= 1.10 * expected,
+        "RMSE {measured:.5} vs expected {expected:.5} from the replicates' spread"
+    );
+
+    let ref_mean = reference.mean();
+    for c in 0..3 {
+        let means: Vec<f64> = images.iter().map(|im| f64::from(im.mean()[c])).collect();
+        let mean = means.iter().sum::<f64>() / r;
+        let se = (means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (r - 1.0) / r).sqrt();
+        let z = (mean - f64::from(ref_mean[c])) / se;
+        assert!(
+            z.abs() < 5.41,
+            "channel {c}: mean {mean} vs reference {} ({z:.2} standard errors)",
+            ref_mean[c]
+        );
+    }
+    measured
+}
+
+#[test]
+fn path_tracing_with_sobol_points_matches_mitsuba() {
+    check_replicates_against_reference(options(IntegratorKind::Path, 8), None, 8, 16);
+}
+
+#[test]
+fn path_tracing_with_sobol_points_spread_by_noise_matches_mitsuba() {
+    check_replicates_against_reference(
+        options(IntegratorKind::Path, 8),
+        Some(Adaptive::Distribute { warmup_spp: 4 }),
+        8,
+        16,
+    );
 }
