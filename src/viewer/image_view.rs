@@ -63,10 +63,16 @@ pub fn image_area(ui: &mut egui::Ui, app: &mut ViewerApp) {
     } else {
         vec![rect]
     };
-    // Fitting enlarges by whole factors only, so that every image pixel
-    // covers the same number of screen pixels (no uneven nearest-neighbour rows).
+    // Fitting fills the area: a 256x256 image in a large area shown at a
+    // whole factor (2x in 700 points) looked small. A whole factor is kept
+    // only where it fills at least 90% of the fit, so that every image
+    // pixel covers the same number of screen pixels when that costs little.
     let fit = (panes[0].width() / image_size.x).min(panes[0].height() / image_size.y);
-    let fit = if fit >= 1.0 { fit.floor() } else { fit };
+    let fit = if fit >= 1.0 && fit.floor() >= 0.9 * fit {
+        fit.floor()
+    } else {
+        fit
+    };
     let zoom = app.view.zoom.unwrap_or(fit).max(0.01);
     let pixels_per_point = ui.ctx().pixels_per_point();
     let snap = |p: Pos2| {
