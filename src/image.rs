@@ -66,10 +66,19 @@ impl Image {
         write_atomically(path, |tmp| self.encode_exr(tmp))
     }
 
+    /// [`Image::write_exr`] without a copy of the pixels: for the end of
+    /// a large render.
+    pub fn into_exr(self, path: &Path) -> Result<()> {
+        write_atomically(path, |tmp| self.into_exr_unchecked(tmp))
+    }
+
     /// Writes an EXR straight to `path` (callers make it atomic).
     pub fn encode_exr(&self, path: &Path) -> std::result::Result<(), String> {
-        let data: Vec<f32> = self.pixels.iter().flatten().copied().collect();
-        let buffer = Rgb32FImage::from_raw(self.width, self.height, data)
+        self.clone().into_exr_unchecked(path)
+    }
+
+    fn into_exr_unchecked(self, path: &Path) -> std::result::Result<(), String> {
+        let buffer = Rgb32FImage::from_raw(self.width, self.height, self.pixels.into_flattened())
             .ok_or("internal: image buffer size mismatch")?;
         buffer
             .save_with_format(path, ImageFormat::OpenExr)

@@ -14,7 +14,7 @@
 
 use crate::accel::PrimaryPixel;
 use crate::error::{Error, Result};
-use crate::film::{Film, FilmSnapshot};
+use crate::film::{Film, FilmSnapshot, Tile, classify, non_finite_of, note_flagged};
 use crate::integrator::{
     ErrorEstimate, Integrator, MultiPassEstimator, MultiPassVisitor, RayCounts, Solver,
     SolverProgress, SolverVisitor, SplattingIntegrator, sample_time,
@@ -127,7 +127,21 @@ pub struct Session {
 impl Session {
     /// Starts a session with its own `settings.threads` worker threads;
     /// nothing renders until [`Session::render_pass`].
+    /// Refuses, before allocating, a render whose film would not fit in
+    /// the memory available ([`Session::memory_estimate`]).
     pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Result<Session> {
+        let needed = Session::memory_estimate(&scene, &settings);
+        if let Some(available) = available_memory()
+            && needed > available
+        {
+            return Err(Error::new(format!(
+                "a {}x{} render needs about {:.1} GB for its film and image, more than the {:.1} GB available",
+                scene.camera.width,
+                scene.camera.height,
+                needed as f64 * 1e-9,
+                available as f64 * 1e-9
+            )));
+        }
         let pool = thread_pool(settings.threads)?;
         Ok(Self::with_pool(scene, settings, pool))
     }
@@ -166,6 +180,20 @@ impl Session {
             solver_progress: Mutex::new(None),
             failure: Mutex::new(None),
         }
+    }
+
+    /// Bytes a session of `settings` on `scene` allocates per pixel, in
+    /// all: the film's statistics, a splatting estimator's buffer, and the
+    /// image it ends with.
+    pub fn memory_estimate(scene: &Scene, settings: &RenderSettings) -> u64 {
+        let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
+        let film = std::mem::size_of::<crate::film::PixelSums>() as u64;
+        let image = 12;
+        let splats = match settings.integrator {
+            Integrator::Splatting(_) => 24,
+            _ => 0,
+        };
+        pixels * (film + image + splats)
     }
 
     pub fn scene(&self) -> &Scene {
@@ -349,7 +377,8 @@ impl Session {
                     let mut skipped = 0u64;
                     let (mut extreme, mut clamped) = (0u64, 0u64);
                     let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
-                    for (i, pixel) in tile.pixels.iter_mut().enumerate() {
+                    let Tile { pixels, flags, .. } = &mut *tile;
+                    for (i, pixel) in pixels.iter_mut().enumerate() {
                         let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
                         let pixel_index = y * width + x;
                         let (begin, count) = match settings.adaptive {
@@ -361,7 +390,8 @@ impl Session {
                                 continue;
                             }
                             Some(Adaptive::Distribute { .. }) => {
-                                (pixel.taken(), plan.map_or(spp, |p| p[pixel_index as usize]))
+                                let taken = pixel.count + non_finite_of(flags, i as u32);
+                                (taken, plan.map_or(spp, |p| p[pixel_index as usize]))
                             }
                             _ => (first, spp),
                         };
@@ -387,12 +417,18 @@ impl Session {
                             }
                             counts.camera += 1;
                             let mut value = estimate(scene, ray, known, &mut sampler, &mut counts);
-                            non_finite += u64::from(!value.is_finite());
-                            extreme += u64::from(pixel.flag(value, s));
+                            let (finite, is_extreme) = classify(value);
+                            if !finite || is_extreme {
+                                note_flagged(flags, i as u32, s, finite);
+                            }
+                            non_finite += u64::from(!finite);
+                            extreme += u64::from(is_extreme);
                             if let Some(limit) = settings.clamp {
                                 clamped += u64::from(clamp_sample(&mut value, limit));
                             }
-                            pixel.add(value);
+                            if finite {
+                                pixel.add(value);
+                            }
                         }
                     }
                     drop(tile);
@@ -477,6 +513,20 @@ impl Session {
     /// True once [`Session::cancel`] was called.
     pub fn is_cancelled(&self) -> bool {
         self.cancelled.load(Ordering::Relaxed)
+    }
+
+    /// Ends the session: its image, made while the film is taken apart, with
+    /// the scene (and what it holds per pixel) released first, so that the
+    /// end of a large render needs little more than the film.
+    pub fn into_final(self) -> crate::film::FinalImage {
+        let Session { scene, film, .. } = self;
+        drop(scene);
+        film.into_final()
+    }
+
+    /// The fewest and the most samples any pixel has.
+    pub fn sample_count_range(&self) -> (u32, u32) {
+        self.film.sample_count_range()
     }
 
     /// Copies the film (means, standard errors, counts) while passes may run.
@@ -584,6 +634,14 @@ impl SolverVisitor for SolverPass<'_> {
         });
         (spp, u64::from(self.k))
     }
+}
+
+/// Memory the system can give without swapping (Linux's MemAvailable), if known.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }
 
 /// A poisoned lock only means a pass panicked; the data is still whole.

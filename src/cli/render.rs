@@ -8,7 +8,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tracelab::film::{EXTREME_LUMINANCE, FilmSnapshot, NOT_FLAGGED};
+use tracelab::film::{EXTREME_LUMINANCE, FinalImage, FlaggedPixel};
 use tracelab::image::check_writable;
 use tracelab::integrator::{
     CameraIntegrator, GlassShadows, Integrator, IntegratorKind, IntegratorOptions, MisHeuristic,
@@ -366,17 +366,15 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         (None, Some(rays)) => render_rays(&session, rays),
         (None, None) => render_time(&session, Duration::from_secs_f64(args.time.unwrap_or(1.0))),
     };
-    let snapshot = session.snapshot();
-    match format {
-        OutputFormat::Exr => snapshot.image.write_exr(out)?,
-        OutputFormat::Png => snapshot.image.write_png(out, args.exposure)?,
-    }
     print_summary(&session, &stats, load_time);
-    print_flagged(
-        &snapshot,
-        session.scene().camera.width,
-        &settings_seed(&session),
-    );
+    let (width, seed) = (session.scene().camera.width, settings_seed(&session));
+    let non_finite = stats.non_finite;
+    let FinalImage { image, flagged } = session.into_final();
+    match format {
+        OutputFormat::Exr => image.into_exr(out)?,
+        OutputFormat::Png => image.write_png(out, args.exposure)?,
+    }
+    print_flagged(&flagged, non_finite, width, &seed);
     eprintln!("wrote {}", out.display());
     Ok(())
 }
@@ -533,19 +531,15 @@ fn settings_seed(session: &Session) -> String {
 }
 
 /// Where the first non-finite or extreme sample is, and how to replay it.
-fn print_flagged(snapshot: &FilmSnapshot, width: u32, seed: &str) {
-    let extreme: u64 = snapshot.extreme_pixels.iter().map(|&n| u64::from(n)).sum();
-    let Some(pixel) = snapshot
-        .first_flagged
-        .iter()
-        .position(|&s| s != NOT_FLAGGED)
-    else {
+fn print_flagged(flagged: &[FlaggedPixel], non_finite: u64, width: u32, seed: &str) {
+    let extreme: u64 = flagged.iter().map(|f| u64::from(f.extreme)).sum();
+    let Some(first) = flagged.first() else {
         return;
     };
-    let (x, y) = (pixel as u32 % width, pixel as u32 / width);
+    let (x, y) = (first.pixel % width, first.pixel / width);
+    let sample = first.first_flagged;
     eprintln!(
-        "{} non-finite and {extreme} extreme samples (luminance > {EXTREME_LUMINANCE}); the first in pixel ({x}, {y}) is sample {}: replay it with the same options plus {seed} --debug-sample {x},{y},{}",
-        snapshot.non_finite, snapshot.first_flagged[pixel], snapshot.first_flagged[pixel]
+        "{non_finite} non-finite and {extreme} extreme samples (luminance > {EXTREME_LUMINANCE}); the first in pixel ({x}, {y}) is sample {sample}: replay it with the same options plus {seed} --debug-sample {x},{y},{sample}"
     );
 }
 
@@ -623,12 +617,9 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
             );
         }
         Some(Adaptive::Distribute { warmup_spp }) => {
-            let counts = &session.snapshot().samples;
-            let (min, max) = (counts.iter().min(), counts.iter().max());
+            let (min, max) = session.sample_count_range();
             eprintln!(
-                "adaptive sampling (slightly biased): samples spread by noise after {warmup_spp} spp; per pixel {} to {}",
-                min.unwrap_or(&0),
-                max.unwrap_or(&0)
+                "adaptive sampling (slightly biased): samples spread by noise after {warmup_spp} spp; per pixel {min} to {max}"
             );
         }
         None => {}
