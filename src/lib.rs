@@ -7,6 +7,7 @@
 
 pub mod accel;
 pub mod allocation;
+pub mod camera;
 pub mod convergence;
 pub mod error;
 pub mod film;
@@ -19,6 +20,7 @@ pub mod render;
 pub mod replay;
 pub mod sampling;
 pub mod scene;
+pub mod shortcuts;
 pub mod stress;
 #[cfg(feature = "viewer")]
 pub mod viewer;

@@ -71,6 +71,10 @@ pub struct LiveView {
     pub done: bool,
     /// Why the technique could not run, if it could not.
     pub failure: Option<String>,
+    /// Which small-scene shortcuts apply, or why not, one line each
+    /// ([`Session::shortcut_report`]; made on the render thread, which
+    /// builds the camera lists).
+    pub shortcuts: Arc<Vec<String>>,
 }
 
 /// Everything published after a pass.
@@ -274,6 +278,7 @@ fn render_loop(shared: &Shared, commands: &Receiver<Command>, pool: &Arc<rayon::
                         history: Vec::new(),
                         done: false,
                         failure: None,
+                        shortcuts: Arc::new(s.shortcut_report()),
                     })
                     .collect();
                 job = Some(Job {

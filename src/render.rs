@@ -12,7 +12,6 @@
 //! samples are summed in sample order, so the film is bit-identical whatever
 //! the thread count or tile schedule.
 
-use crate::accel::PrimaryPixel;
 use crate::error::{Error, Result};
 use crate::film::{Film, FilmSnapshot, Tile, classify, non_finite_of, note_flagged};
 use crate::integrator::{
@@ -23,6 +22,7 @@ use crate::math::{Ray, Rgb};
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Domains, Sampler, SamplerKind};
 use crate::scene::Scene;
+use crate::shortcuts::PrimaryPixel;
 use glam::Vec2;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
@@ -522,6 +522,13 @@ impl Session {
         let Session { scene, film, .. } = self;
         drop(scene);
         film.into_final()
+    }
+
+    /// Which small-scene shortcuts apply to this render, or why not, one
+    /// line each ([`Scene::shortcut_report`]).
+    pub fn shortcut_report(&self) -> Vec<String> {
+        self.scene
+            .shortcut_report(self.settings.integrator.shortcuts_used())
     }
 
     /// The fewest and the most samples any pixel has.

@@ -596,7 +596,7 @@ fn thin_lens_points_are_uniform_over_the_aperture() {
     // Ray origins of a thin-lens camera, in units of the aperture radius on
     // the lens plane, histogrammed in rings and sectors: a uniform disk puts
     // (r2^2 - r1^2) / sectors of the samples in each cell.
-    use tracelab::scene::camera::Camera;
+    use tracelab::camera::Camera;
     let radius = 0.25;
     let camera = Camera::look_at(
         Vec3A::new(0.3, -0.2, 5.0),

@@ -517,3 +517,54 @@ fn stress_command_passes_robust_and_fails_fixed_epsilon() {
     assert_fails(&o, 1, &["stress cases failed"]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("FAIL"));
 }
+
+/// The summary says which small-scene shortcuts apply, and why the others
+/// do not.
+#[test]
+fn the_summary_says_which_shortcuts_apply_and_why_not() {
+    let dir = temp_dir("cli-shortcuts");
+    let out = dir.join("x.exr");
+    let render = |scene: &str, extra: &[&str]| {
+        let scene = repo_path(scene);
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--spp",
+            "1",
+            "--width",
+            "24",
+            "--height",
+            "24",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = tracelab(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    let cornell = render("scenes/cornell_box.toml", &[]);
+    assert!(
+        cornell.contains("camera rays: their pixel's candidate triangles only"),
+        "{cornell}"
+    );
+    assert!(
+        cornell.contains("lights seen directly: integrated exactly over"),
+        "{cornell}"
+    );
+    assert!(
+        cornell.contains("shadow rays to light 0: no test from"),
+        "{cornell}"
+    );
+    let spheres = render("scenes/materials.toml", &[]);
+    assert!(
+        spheres.contains("lights seen directly: sampled (the scene has spheres)")
+            && spheres.contains("camera rays: the whole scene (the scene has spheres)"),
+        "{spheres}"
+    );
+    let off = render("scenes/cornell_box.toml", &["--seen-emitters", "sampled"]);
+    assert!(
+        off.contains("lights seen directly: sampled (switched off)"),
+        "{off}"
+    );
+}

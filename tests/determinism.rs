@@ -64,8 +64,9 @@ fn camera_ray_candidates_and_shadow_voxels_change_no_pixel() {
         mean < 4.0 && full == 0,
         "{mean} candidates per pixel, {full} full"
     );
-    let voxels = scene.clearance[0]
-        .as_ref()
+    let voxels = scene
+        .shortcuts
+        .shadow_voxels(0)
         .expect("its light gets shadow voxels");
     let (clear, listed) = voxels.summary();
     assert!(
@@ -89,9 +90,9 @@ fn camera_ray_candidates_and_shadow_voxels_change_no_pixel() {
     };
     let with_both = render(scene.clone());
     let mut without_lists = scene.clone();
-    without_lists.primary = None;
+    without_lists.shortcuts = without_lists.shortcuts.without_primary_candidates();
     assert_eq!(with_both, render(without_lists));
     let mut without_voxels = scene;
-    without_voxels.clearance = vec![None].into();
+    without_voxels.shortcuts = without_voxels.shortcuts.without_shadow_voxels();
     assert_eq!(with_both, render(without_voxels));
 }

@@ -10,10 +10,10 @@
 use crate::common::{mean_and_standard_error, render};
 use glam::Vec3A;
 use tracelab::accel::{NO_LIGHT, Sphere, TriangleInput};
+use tracelab::camera::Camera;
 use tracelab::integrator::{Integrator, MisHeuristic, PathTracer};
 use tracelab::math::Rgb;
 use tracelab::sampling::SamplerKind;
-use tracelab::scene::camera::Camera;
 use tracelab::scene::light::LightSampling;
 use tracelab::scene::material::{Bsdf, Material};
 use tracelab::scene::{Scene, SceneInput};

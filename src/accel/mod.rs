@@ -8,17 +8,13 @@
 //! are contiguous in memory and a hit's index addresses them directly.
 
 mod block;
-mod clearance;
 mod known_visibility;
-mod primary;
-mod seen_emitters;
 mod soup;
 mod sphere;
-mod triangle;
+pub(crate) mod triangle;
 mod wide_bvh;
 
 use crate::math::{OffsetMode, Ray, gamma};
-pub use clearance::ShadowVoxels;
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
@@ -27,7 +23,6 @@ use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
 use obvhs::ploc::PlocBuilder;
-pub use primary::{PrimaryCandidates, PrimaryPixel};
 use soup::TriangleSoup;
 use sphere::intersect_sphere;
 use wide_bvh::WideBvh;

@@ -574,38 +574,8 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
             eprintln!("specialised for this scene: skipped {}", skipped.join(", "));
         }
     }
-    if matches!(
-        settings.integrator,
-        Integrator::Camera(CameraIntegrator::Path(_))
-    ) {
-        for (light, voxels) in session.scene().clearance.iter().enumerate() {
-            if let Some(voxels) = voxels {
-                let (clear, listed) = voxels.summary();
-                eprintln!(
-                    "shadow rays to light {light}: no test from {:.0}% of the scene's voxels (the light is seen whole), a short list of occluders from {:.0}%",
-                    100.0 * clear,
-                    100.0 * listed
-                );
-            }
-        }
-    }
-    if let (Integrator::Camera(CameraIntegrator::Path(p)), Some(lists)) =
-        (&settings.integrator, session.scene().primary_candidates())
-        && !p.general
-    {
-        let (mean, full) = lists.summary();
-        eprintln!(
-            "camera rays test their pixel's candidate triangles only: {mean:.2} per pixel ({full} pixels test all)"
-        );
-    }
-    if let Some(lists) = session.scene().primary_candidates()
-        && settings.integrator.integrates_seen_emitters()
-        && lists.pixels_with_seen_emission() > 0
-    {
-        eprintln!(
-            "lights seen directly: integrated exactly over {} pixels (--seen-emitters sampled to sample them)",
-            lists.pixels_with_seen_emission()
-        );
+    for line in session.shortcut_report() {
+        eprintln!("{line}");
     }
     match settings.adaptive {
         Some(Adaptive::Stop { threshold, min_spp }) => {

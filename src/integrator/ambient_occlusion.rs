@@ -11,11 +11,11 @@
 //! variable of variance AO (1 - AO). Camera rays that hit nothing give 0.
 
 use super::{CameraEstimator, IntegratorOptions, RayCounts, Technique};
-use crate::accel::PrimaryPixel;
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
+use crate::shortcuts::{PrimaryPixel, ShortcutsUsed};
 
 /// Settings of the ambient occlusion estimator.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -76,6 +76,13 @@ impl Technique for AmbientOcclusion {
 }
 
 impl CameraEstimator for AmbientOcclusion {
+    fn shortcuts_used(&self) -> ShortcutsUsed {
+        ShortcutsUsed {
+            primary_candidates: true,
+            ..ShortcutsUsed::default()
+        }
+    }
+
     fn radiance(
         &self,
         scene: &Scene,

@@ -17,10 +17,10 @@
 //! thesis, 5.2).
 
 use super::{IntegratorOptions, RayCounts, SplattingEstimator, Technique, survives_roulette};
+use crate::camera::CameraConnection;
 use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
-use crate::scene::camera::CameraConnection;
 use crate::scene::material::Bsdf;
 use glam::{Vec2, Vec3A};
 

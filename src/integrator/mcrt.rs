@@ -15,10 +15,11 @@
 //! two branching levels (the classic 186-ray example) is D = 3.
 
 use super::{CameraEstimator, IntegratorOptions, MisHeuristic, RayCounts, Technique};
-use crate::accel::{NO_LIGHT, PrimaryPixel, SurfaceHit};
+use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
+use crate::shortcuts::{PrimaryPixel, ShortcutsUsed};
 
 use super::path::shadow_ray;
 
@@ -131,6 +132,13 @@ impl CameraEstimator for McRayTracer {
 
     fn integrates_seen_emitters(&self) -> bool {
         self.exact_seen_emitters
+    }
+
+    fn shortcuts_used(&self) -> ShortcutsUsed {
+        ShortcutsUsed {
+            seen_emitters: Some(self.exact_seen_emitters),
+            ..ShortcutsUsed::default()
+        }
     }
 }
 

@@ -32,10 +32,10 @@ pub use options::{IntegratorOptions, Strategy};
 pub use path::PathTracer;
 pub use whitted::{GlassShadows, WhittedTracer};
 
-use crate::accel::PrimaryPixel;
 use crate::math::{Ray, Rgb};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
+use crate::shortcuts::{PrimaryPixel, ShortcutsUsed};
 
 /// Rays cast, by kind; kept per thread and summed after each tile. For light
 /// tracing, `camera` counts the rays leaving the lights (the primary rays)
@@ -102,7 +102,7 @@ pub trait Technique: Sized + Send + Sync {
 pub trait CameraEstimator: Technique {
     /// One radiance sample along the camera ray `ray`; counts the rays it
     /// casts after the camera ray into `counts`. `pixel`: what is known in
-    /// advance about the ray's pixel ([`crate::accel::PrimaryCandidates`]).
+    /// advance about the ray's pixel ([`crate::shortcuts::PrimaryCandidates`]).
     fn radiance(
         &self,
         scene: &Scene,
@@ -122,6 +122,12 @@ pub trait CameraEstimator: Technique {
     /// is known instead of sampling the emission camera rays hit.
     fn integrates_seen_emitters(&self) -> bool {
         false
+    }
+
+    /// Which small-scene shortcuts it reads (`crate::shortcuts`), for the
+    /// reports of what applies.
+    fn shortcuts_used(&self) -> ShortcutsUsed {
+        ShortcutsUsed::default()
     }
 
     /// True when the estimator runs its general code even where the scene
@@ -355,6 +361,11 @@ macro_rules! register_techniques {
                 match self { $(CameraIntegrator::$cv(e) => e.is_deterministic(),)* }
             }
 
+            /// [`CameraEstimator::shortcuts_used`].
+            pub fn shortcuts_used(&self) -> ShortcutsUsed {
+                match self { $(CameraIntegrator::$cv(e) => e.shortcuts_used(),)* }
+            }
+
             /// [`CameraEstimator::is_general`].
             pub fn is_general(&self) -> bool {
                 match self { $(CameraIntegrator::$cv(e) => e.is_general(),)* }
@@ -521,6 +532,14 @@ impl Integrator {
     /// per pixel is the image and there is no sampling noise.
     pub fn is_deterministic(&self) -> bool {
         matches!(self, Integrator::Camera(e) if e.is_deterministic())
+    }
+
+    /// Which small-scene shortcuts it reads.
+    pub fn shortcuts_used(&self) -> ShortcutsUsed {
+        match self {
+            Integrator::Camera(e) => e.shortcuts_used(),
+            _ => ShortcutsUsed::default(),
+        }
     }
 
     /// True when the estimator integrates emitters seen directly over each

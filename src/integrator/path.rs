@@ -12,13 +12,14 @@ use super::{
     CameraEstimator, IntegratorOptions, MisHeuristic, RayCounts, Strategy, Technique,
     survives_roulette,
 };
-use crate::accel::{NO_LIGHT, PrimaryPixel, SurfaceHit};
+use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, ray_between};
 use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::scene::light::LightSample;
 use crate::scene::material::{Bsdf, BsdfSample};
+use crate::shortcuts::{PrimaryPixel, ShortcutsUsed};
 use glam::{Vec2, Vec3A};
 use std::f32::consts::FRAC_1_PI;
 
@@ -73,14 +74,14 @@ struct PendingShadow {
 impl PendingShadow {
     /// Traces the shadow ray: whether the light is visible. Where the scene
     /// knows which triangles can block rays from the origin's voxel to the
-    /// light ([`crate::accel::ShadowVoxels`]) only those are tested, and none
+    /// light ([`crate::shortcuts::ShadowVoxels`]) only those are tested, and none
     /// where the light is seen whole; the ray counts either way.
     #[inline(always)]
     fn visible(&self, scene: &Scene, counts: &mut RayCounts) -> bool {
         counts.shadow += 1;
-        match scene.clearance.get(self.light as usize) {
-            Some(Some(voxels)) => !scene.geometry.occluded_towards(&self.ray, voxels),
-            _ => !scene.geometry.occluded(&self.ray),
+        match scene.shortcuts.shadow_voxels(self.light) {
+            Some(voxels) => !voxels.occluded(&scene.geometry, &self.ray),
+            None => !scene.geometry.occluded(&self.ray),
         }
     }
 
@@ -167,7 +168,7 @@ impl Technique for PathTracer {
 impl CameraEstimator for PathTracer {
     /// One radiance sample along `ray`, by the loop specialised for what
     /// the scene uses (see [`crate::scene::Features`]). `pixel`: what is
-    /// known of the camera ray's pixel ([`crate::accel::PrimaryCandidates`]).
+    /// known of the camera ray's pixel ([`crate::shortcuts::PrimaryCandidates`]).
     #[inline]
     fn radiance(
         &self,
@@ -186,6 +187,14 @@ impl CameraEstimator for PathTracer {
 
     fn is_general(&self) -> bool {
         self.general
+    }
+
+    fn shortcuts_used(&self) -> ShortcutsUsed {
+        ShortcutsUsed {
+            primary_candidates: !self.general,
+            seen_emitters: Some(self.exact_seen_emitters),
+            shadow_voxels: true,
+        }
     }
 }
 

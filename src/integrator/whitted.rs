@@ -12,12 +12,13 @@
 //!            + R L(x, reflect(wo)) + (1 - R) T L(x, refract(wo))
 
 use super::{CameraEstimator, IntegratorOptions, RayCounts, Technique};
-use crate::accel::{NO_LIGHT, PrimaryPixel, SurfaceHit};
+use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 use crate::scene::light::{Light, PlanarEmitter};
 use crate::scene::material::{Bsdf, fresnel_dielectric};
+use crate::shortcuts::PrimaryPixel;
 use glam::Vec3A;
 
 /// How shadow rays treat glass in their way (the classic shortcuts: no

@@ -1,7 +1,6 @@
 //! Scenes: camera, geometry, materials and lights, loaded from TOML + OBJ/MTL
 //! and checked before anything renders.
 
-pub mod camera;
 pub mod description;
 pub mod emitters;
 pub mod light;
@@ -9,10 +8,11 @@ pub mod load;
 pub mod material;
 pub mod obj;
 
-use crate::accel::{Geometry, NO_LIGHT, PrimaryCandidates, ShadowVoxels, Sphere, TriangleInput};
+use crate::accel::{Geometry, NO_LIGHT, Sphere, TriangleInput};
+use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::math::OffsetMode;
-use camera::Camera;
+use crate::shortcuts::{NotApplied, PrimaryCandidates, Shortcuts, ShortcutsUsed};
 use emitters::EmitterShape;
 use glam::Vec3A;
 use light::{Light, LightSampling, Lights, PlanarEmitter};
@@ -203,55 +203,22 @@ pub struct Scene {
     pub features: Features,
     /// Things the user should know that did not stop loading (dropped triangles, ...).
     pub warnings: Vec<String>,
-    /// Each pixel's candidate triangles for camera rays, where the camera and
-    /// geometry allow them (made for `camera`: see [`Scene::set_camera`]).
-    pub primary: Option<Arc<PrimaryCandidates>>,
-    /// Per light, which triangles may block shadow rays to it from each
-    /// voxel of the scene (flat lights in soups; see [`ShadowVoxels`]).
-    pub clearance: Arc<[Option<ShadowVoxels>]>,
+    /// What the renderer knows in advance about the rays of a small scene
+    /// (`crate::shortcuts`): per-pixel candidates for camera rays, built for
+    /// `camera` when first asked for, and per-voxel occluders of shadow rays.
+    pub shortcuts: Shortcuts,
 }
 
-/// Camera rays' candidate lists for `camera`, with the emission each pixel
-/// sees directly, where the geometry allows them.
-fn primary_for(
-    geometry: &Geometry,
-    materials: &[Material],
-    camera: &Camera,
-) -> Option<Arc<PrimaryCandidates>> {
-    let triangles = geometry.triangles();
-    let candidates = geometry.primary_candidates(camera)?;
-    let with_seen = candidates.with_seen_emitters(triangles, |i| {
-        if geometry.triangle_light(i) == NO_LIGHT {
-            return None;
-        }
-        // One side of a flat emitter faces the eye everywhere on it.
-        let towards_eye = (camera.eye - triangles[i][0]).normalize_or_zero();
-        let material = &materials[geometry.triangle_material(i) as usize];
-        Some(material.emitted(geometry.triangle_normal(i), towards_eye))
-    });
-    Some(Arc::new(with_seen))
-}
-
-/// Lights up to this many get [`ShadowVoxels`] (each costs a build at load).
-const MAX_CLEARANCE_LIGHTS: usize = 8;
-
-/// Each flat light's [`ShadowVoxels`], where the geometry allows them.
-fn light_clearance(geometry: &Geometry, lights: &Lights) -> Arc<[Option<ShadowVoxels>]> {
-    let lights = lights.as_slice();
-    if lights.len() > MAX_CLEARANCE_LIGHTS {
-        return Arc::from(vec![None; lights.len()]);
-    }
+/// Per light, its corners in order where it is flat.
+fn flat_light_corners(lights: &Lights) -> Vec<Option<Vec<Vec3A>>> {
     lights
+        .as_slice()
         .iter()
-        .enumerate()
-        .map(|(id, light)| match light {
-            Light::Triangle(p) => {
-                geometry.shadow_voxels(id as u32, &[p.p0, p.p0 + p.e1, p.p0 + p.e2])
+        .map(|light| match light {
+            Light::Triangle(p) => Some(vec![p.p0, p.p0 + p.e1, p.p0 + p.e2]),
+            Light::Parallelogram(p) => {
+                Some(vec![p.p0, p.p0 + p.e1, p.p0 + p.e1 + p.e2, p.p0 + p.e2])
             }
-            Light::Parallelogram(p) => geometry.shadow_voxels(
-                id as u32,
-                &[p.p0, p.p0 + p.e1, p.p0 + p.e1 + p.e2, p.p0 + p.e2],
-            ),
             _ => None,
         })
         .collect()
@@ -395,8 +362,7 @@ impl Scene {
             warnings.push("the scene has no light source: the image will be black".into());
         }
         let features = Features::detect(&input.materials, &geometry, &lights, &input.camera);
-        let primary = primary_for(&geometry, &input.materials, &input.camera);
-        let clearance = light_clearance(&geometry, &lights);
+        let shortcuts = Shortcuts::new(&geometry, &flat_light_corners(&lights));
         Ok(Scene {
             camera: input.camera,
             features,
@@ -404,8 +370,7 @@ impl Scene {
             materials: input.materials,
             lights,
             warnings,
-            primary,
-            clearance,
+            shortcuts,
         })
     }
 
@@ -431,18 +396,90 @@ impl Scene {
         self.set_camera(camera);
     }
 
-    /// Replaces the camera, and the camera rays' candidate lists with it.
+    /// Replaces the camera; the camera rays' candidate lists are made
+    /// again for it when first asked for.
     pub fn set_camera(&mut self, camera: Camera) {
         if camera != self.camera {
             self.camera = camera;
-            self.primary = primary_for(&self.geometry, &self.materials, &camera);
+            self.shortcuts.camera_changed();
         }
     }
 
-    /// The camera rays' candidate lists, when they were made for the
-    /// current camera (a caller may have set `camera` directly).
-    #[inline(always)]
+    /// The camera rays' candidate lists for the current camera, built on the
+    /// first call (by a render pass), or why there are none.
+    pub fn try_primary_candidates(&self) -> std::result::Result<&PrimaryCandidates, NotApplied> {
+        let geometry = &self.geometry;
+        let (materials, camera) = (&self.materials, &self.camera);
+        self.shortcuts.primary_candidates(geometry, camera, |i| {
+            if geometry.triangle_light(i) == NO_LIGHT {
+                return None;
+            }
+            // One side of a flat emitter faces the eye everywhere on it.
+            let towards_eye = (camera.eye - geometry.triangles()[i][0]).normalize_or_zero();
+            let material = &materials[geometry.triangle_material(i) as usize];
+            Some(material.emitted(geometry.triangle_normal(i), towards_eye))
+        })
+    }
+
+    /// One line per shortcut that `used` names: whether it applies here and
+    /// what it saves, or why not ("lights seen directly: sampled (the scene
+    /// has spheres)"). Builds the camera lists if they are not built yet.
+    pub fn shortcut_report(&self, used: ShortcutsUsed) -> Vec<String> {
+        let mut lines = Vec::new();
+        let primary = self.try_primary_candidates();
+        if used.primary_candidates {
+            lines.push(match &primary {
+                Ok(lists) => {
+                    let (mean, full) = lists.summary();
+                    format!(
+                        "camera rays: their pixel's candidate triangles only ({mean:.2} per pixel, {full} pixels test all)"
+                    )
+                }
+                Err(reason) => format!("camera rays: the whole scene ({reason})"),
+            });
+        }
+        match used.seen_emitters {
+            Some(true) => lines.push(match &primary {
+                Ok(lists) if lists.pixels_with_seen_emission() > 0 => format!(
+                    "lights seen directly: integrated exactly over {} pixels",
+                    lists.pixels_with_seen_emission()
+                ),
+                Ok(_) => "lights seen directly: sampled (no pixel sees a light it can integrate)"
+                    .to_string(),
+                Err(reason) => format!("lights seen directly: sampled ({reason})"),
+            }),
+            Some(false) => lines.push("lights seen directly: sampled (switched off)".into()),
+            None => {}
+        }
+        if used.shadow_voxels {
+            let voxels = self.shortcuts.all_shadow_voxels();
+            for (light, v) in voxels.iter().enumerate() {
+                match v {
+                    Ok(v) => {
+                        let (clear, listed) = v.summary();
+                        lines.push(format!(
+                            "shadow rays to light {light}: no test from {:.0}% of the voxels (the light is seen whole), a short list of occluders from {:.0}%",
+                            100.0 * clear,
+                            100.0 * listed
+                        ));
+                    }
+                    // One line for lights that all have the same reason.
+                    Err(reason) if voxels.iter().all(|v| v.as_ref().err() == Some(reason)) => {
+                        lines.push(format!("shadow rays: the whole scene ({reason})"));
+                        break;
+                    }
+                    Err(reason) => lines.push(format!(
+                        "shadow rays to light {light}: the whole scene ({reason})"
+                    )),
+                }
+            }
+        }
+        lines
+    }
+
+    /// [`Scene::try_primary_candidates`], where there are lists.
+    #[inline]
     pub fn primary_candidates(&self) -> Option<&PrimaryCandidates> {
-        self.primary.as_deref().filter(|p| p.is_for(&self.camera))
+        self.try_primary_candidates().ok()
     }
 }

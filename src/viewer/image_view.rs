@@ -9,23 +9,6 @@ use super::display::{
 use super::settings::{CompareLayout, ViewMode};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Vec2, pos2, vec2};
 
-/// Zoom and pan of the image area.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ViewTransform {
-    /// Screen points per image pixel; `None` fits the image to the area.
-    pub zoom: Option<f32>,
-    pub pan: egui::Vec2,
-}
-
-impl Default for ViewTransform {
-    fn default() -> Self {
-        ViewTransform {
-            zoom: None,
-            pan: egui::Vec2::ZERO,
-        }
-    }
-}
-
 const UV_FULL: Rect = Rect::from_min_max(Pos2::ZERO, pos2(1.0, 1.0));
 
 pub fn image_area(ui: &mut egui::Ui, app: &mut ViewerApp) {

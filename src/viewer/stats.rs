@@ -22,6 +22,11 @@ pub fn stats_panel(ui: &mut egui::Ui, app: &mut ViewerApp) {
             egui::Label::new(egui::RichText::new(view_summary(name, view, app)).monospace())
                 .truncate(),
         );
+        if !view.shortcuts.is_empty() {
+            let text = format!("{name} shortcuts: {}", view.shortcuts.join(" | "));
+            ui.add(egui::Label::new(egui::RichText::new(text).weak()).truncate())
+                .on_hover_text(view.shortcuts.join("\n"));
+        }
     }
     {
         let mut parts = Vec::new();

@@ -11,6 +11,8 @@
 //! direction); an axis that cannot be found leaves the voxel to the ray test,
 //! so the shortcut only ever answers what the test would have.
 
+use crate::accel::Geometry;
+use crate::math::Ray;
 use glam::{DVec3, Vec3A};
 use rayon::prelude::*;
 
@@ -48,6 +50,41 @@ const MAX_OCCLUDERS: usize = 3;
 const TEST_ALL: u32 = u32::MAX;
 
 impl ShadowVoxels {
+    /// The voxels of the flat light `light_id` (its corners, in order; its
+    /// own triangles carry its id) in a static soup, or None elsewhere.
+    pub fn for_light(
+        geometry: &Geometry,
+        light_id: u32,
+        corners: &[Vec3A],
+    ) -> Option<ShadowVoxels> {
+        let (lo, hi, inner) = geometry.static_soup_box()?;
+        // Shadow rays end just before the light's surface, off its own
+        // triangles by the light sample's error bound; the soup's face
+        // triangles cannot block a segment inside its box.
+        let triangles = geometry.triangles();
+        let occluders: Vec<(u32, [Vec3A; 3])> = (0..inner)
+            .filter(|&i| geometry.triangle_light(i) != light_id)
+            .map(|i| (i as u32, triangles[i]))
+            .collect();
+        let margin = (hi - lo).max_element() * 1e-4;
+        Some(ShadowVoxels::build(lo, hi, corners, &occluders, margin))
+    }
+
+    /// [`Geometry::occluded`] for a shadow ray that ends on this light:
+    /// with both ends inside the soup's box (so that its faces cannot block
+    /// it), only the origin voxel's occluders are tested, by the same
+    /// watertight test, so the answer is the whole test's. Rays that leave
+    /// the box, or whose voxel lists too many, take the whole test.
+    #[inline(always)]
+    pub fn occluded(&self, geometry: &Geometry, ray: &Ray) -> bool {
+        if let Some(occluders) = self.occluders_from(ray.origin)
+            && geometry.segment_inside_soup(ray)
+        {
+            return geometry.occluded_among(ray, occluders);
+        }
+        geometry.occluded(ray)
+    }
+
     /// Voxels of the box [lo, hi] and, for each, which of `occluders`
     /// (triangle index, vertices) may block a segment from it to the light
     /// polygon `light` (its corners, in order). `margin` enlarges each voxel
