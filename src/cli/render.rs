@@ -567,7 +567,10 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         settings.integrator,
         Integrator::Camera(CameraIntegrator::Path(_) | CameraIntegrator::Whitted(_))
     ) {
-        let skipped = session.scene().features.skipped();
+        let mut skipped = session.scene().features.skipped();
+        if !session.scene().lights.has_choice() {
+            skipped.push("light choice (one light)");
+        }
         if matches!(settings.integrator, Integrator::Camera(e) if e.is_general()) {
             eprintln!("general code (--general): nothing skipped");
         } else {

@@ -139,11 +139,8 @@ impl Features {
             v.push("refraction");
             v.push("transparent-shadow tests");
         }
-        if !self.specular() {
-            v.push("specular-bounce branches");
-        }
         if self.diffuse_only() {
-            v.push("non-Lambertian BSDF code");
+            v.push("specular-bounce branches and non-Lambertian BSDF code");
         }
         if !self.point_lights {
             v.push("point lights");
