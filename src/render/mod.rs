@@ -15,8 +15,7 @@
 use crate::error::{Error, Result};
 use crate::film::{Film, FilmSnapshot, Tile, classify, non_finite_of, note_flagged};
 use crate::integrator::{
-    ErrorEstimate, Integrator, MultiPassEstimator, MultiPassVisitor, RayCounts, Solver,
-    SolverProgress, SolverVisitor, SplattingIntegrator, sample_time,
+    ErrorEstimate, Integrator, RayCounts, SolverProgress, SplattingIntegrator, sample_time,
 };
 use crate::math::{Ray, Rgb};
 use crate::sampling::hash::hash_combine;
@@ -25,9 +24,11 @@ use crate::scene::Scene;
 use crate::shortcuts::PrimaryPixel;
 use glam::Vec2;
 use rayon::prelude::*;
+use splats::SplatBuffer;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
+use technique_passes::{MultiPass, SolverPass};
 
 /// How to render.
 #[derive(Clone, Debug, PartialEq)]
@@ -563,86 +564,6 @@ impl Session {
     }
 }
 
-/// A multi-pass estimator's pass: `k` iterations, each a pre-pass (numbered
-/// by the session's passes so far) and one sample per pixel reading it.
-struct MultiPass<'a> {
-    session: &'a Session,
-    first: u32,
-    k: u32,
-}
-
-impl MultiPassVisitor for MultiPass<'_> {
-    type Output = (u32, u64);
-
-    fn visit<E: MultiPassEstimator>(self, estimator: &E) -> (u32, u64) {
-        let session = self.session;
-        let settings = &session.settings;
-        for i in 0..self.k {
-            if session.cancelled.load(Ordering::Relaxed) {
-                break;
-            }
-            let iteration = self.first + i;
-            let mut counts = RayCounts::default();
-            let pass = session.pool.install(|| {
-                estimator.prepare(&session.scene, iteration, settings.seed, &mut counts)
-            });
-            session.add_counts(0, &counts, 0);
-            session.camera_pass(
-                iteration,
-                1,
-                None,
-                0,
-                1,
-                false,
-                |scene, ray, _, sampler, c| estimator.radiance(scene, &pass, ray, sampler, c),
-            );
-        }
-        (self.first + self.k, u64::from(self.k))
-    }
-}
-
-/// A solver's pass: `k` solve steps, then a new image of the solution (the
-/// film restarts: the solution it showed is gone).
-struct SolverPass<'a> {
-    session: &'a Session,
-    k: u32,
-}
-
-impl SolverVisitor for SolverPass<'_> {
-    type Output = (u32, u64);
-
-    fn visit<S: Solver>(self, solver: &S) -> (u32, u64) {
-        let session = self.session;
-        let scene = &*session.scene;
-        let mut state = lock(&session.solver_state);
-        if state.is_none() {
-            match session.pool.install(|| solver.init(scene)) {
-                Ok(initial) => *state = Some(Box::new(initial)),
-                Err(e) => {
-                    *lock(&session.failure) = Some(e);
-                    return (0, 0);
-                }
-            }
-        }
-        let Some(typed) = state.as_mut().and_then(|s| s.downcast_mut::<S::State>()) else {
-            unreachable!("a session's solver state has its solver's type");
-        };
-        let mut counts = RayCounts::default();
-        let progress = session
-            .pool
-            .install(|| solver.step(scene, typed, self.k, &mut counts));
-        session.add_counts(0, &counts, 0);
-        *lock(&session.solver_progress) = Some(progress);
-        session.film.clear();
-        let spp = solver.display_spp().max(1);
-        let typed = &*typed;
-        session.camera_pass(0, spp, None, 0, 1, spp == 1, |scene, ray, _, sampler, c| {
-            solver.radiance(scene, typed, ray, sampler, c)
-        });
-        (spp, u64::from(self.k))
-    }
-}
-
 /// Memory the system can give without swapping (Linux's MemAvailable), if known.
 fn available_memory() -> Option<u64> {
     let info = std::fs::read_to_string("/proc/meminfo").ok()?;
@@ -708,226 +629,8 @@ pub fn thread_pool(threads: usize) -> Result<Arc<rayon::ThreadPool>> {
         .map_err(|e| Error::new(format!("cannot start render threads: {e}")))
 }
 
-/// Per-pixel sums of light-tracing splats in 32.32 fixed point: integer
-/// additions commute, so the sums are the same in any thread order.
-struct SplatBuffer {
-    width: u32,
-    height: u32,
-    sums: Vec<[AtomicU64; 3]>,
-}
-
-/// 2^32: resolution 2.3e-10 per splat, overflow past 4e9 per pixel and pass.
-const SPLAT_SCALE: f64 = 4294967296.0;
-
-impl SplatBuffer {
-    fn new(width: u32, height: u32) -> Self {
-        let sums = (0..width as usize * height as usize)
-            .map(|_| [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)])
-            .collect();
-        SplatBuffer {
-            width,
-            height,
-            sums,
-        }
-    }
-
-    /// Adds `value` to the pixel containing `film`; false (and nothing added)
-    /// when the value is not finite, negative or too large to represent.
-    fn add(&self, film: Vec2, value: Rgb) -> bool {
-        let (x, y) = (film.x as u32, film.y as u32);
-        if x >= self.width || y >= self.height {
-            return true;
-        }
-        let mut fixed = [0u64; 3];
-        for c in 0..3 {
-            let v = f64::from(value[c]) * SPLAT_SCALE;
-            if !(v >= 0.0 && v < 9.0e18) {
-                return false;
-            }
-            fixed[c] = v.round() as u64;
-        }
-        let sums = &self.sums[(y * self.width + x) as usize];
-        for c in 0..3 {
-            sums[c].fetch_add(fixed[c], Ordering::Relaxed);
-        }
-        true
-    }
-
-    fn get(&self, index: u32) -> [f64; 3] {
-        let sums = &self.sums[index as usize];
-        [0, 1, 2].map(|c| sums[c].load(Ordering::Relaxed) as f64 / SPLAT_SCALE)
-    }
-}
+mod splats;
+mod technique_passes;
 
 #[cfg(test)]
-mod tests {
-    //! The drivers of the kinds no shipped technique uses yet, run with
-    //! small techniques whose answers are known exactly.
-    use super::*;
-    use crate::integrator::{IntegratorOptions, Technique};
-
-    fn session() -> Session {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml");
-        let mut scene = Scene::load(&path).unwrap();
-        scene.set_resolution(8, 6);
-        let settings = RenderSettings {
-            integrator: IntegratorOptions::default().build(),
-            sampler: SamplerKind::Independent,
-            seed: 7,
-            planned_spp: 0,
-            threads: 2,
-            adaptive: None,
-            domains: Default::default(),
-            clamp: None,
-        };
-        Session::new(Arc::new(scene), settings).unwrap()
-    }
-
-    /// Each pre-pass builds its own number; every sample reads it.
-    struct PassNumber;
-
-    impl Technique for PassNumber {
-        const SUMMARY: &'static str = "test";
-        fn from_options(_: &IntegratorOptions) -> Self {
-            PassNumber
-        }
-        fn describe(&self) -> String {
-            "pass number".into()
-        }
-    }
-
-    impl MultiPassEstimator for PassNumber {
-        type Pass = f32;
-        fn prepare(&self, _: &Scene, pass: u32, _: u64, counts: &mut RayCounts) -> f32 {
-            counts.bounce += 10;
-            pass as f32
-        }
-        fn radiance(
-            &self,
-            _: &Scene,
-            pass: &f32,
-            _: Ray,
-            _: &mut Sampler,
-            _: &mut RayCounts,
-        ) -> Rgb {
-            Rgb::splat(*pass)
-        }
-    }
-
-    #[test]
-    fn a_multi_pass_estimator_prepares_once_per_iteration() {
-        let session = session();
-        let (spp, progress) = MultiPass {
-            session: &session,
-            first: 0,
-            k: 4,
-        }
-        .visit(&PassNumber);
-        assert_eq!((spp, progress), (4, 4));
-        let snapshot = session.snapshot();
-        // Passes 0..4 each add one sample of their number: mean 1.5.
-        assert!(snapshot.image.pixels.iter().all(|p| *p == [1.5; 3]));
-        assert!(snapshot.samples.iter().all(|&n| n == 4));
-        assert_eq!(session.stats().rays.bounce, 40);
-    }
-
-    /// x <- (x + 1) / 2 from 0: the residual 1 - x halves every step.
-    struct Halving {
-        fail: bool,
-    }
-
-    impl Technique for Halving {
-        const SUMMARY: &'static str = "test";
-        fn from_options(_: &IntegratorOptions) -> Self {
-            Halving { fail: false }
-        }
-        fn describe(&self) -> String {
-            "halving".into()
-        }
-    }
-
-    impl Solver for Halving {
-        type State = f64;
-        fn init(&self, _: &Scene) -> crate::Result<f64> {
-            if self.fail {
-                Err(Error::new("no patches"))
-            } else {
-                Ok(0.0)
-            }
-        }
-        fn step(&self, _: &Scene, x: &mut f64, steps: u32, _: &mut RayCounts) -> SolverProgress {
-            for _ in 0..steps {
-                *x = (*x + 1.0) / 2.0;
-            }
-            SolverProgress {
-                steps: u64::from(steps),
-                residual: 1.0 - *x,
-                converged: *x == 1.0,
-            }
-        }
-        fn radiance(&self, _: &Scene, x: &f64, _: Ray, _: &mut Sampler, _: &mut RayCounts) -> Rgb {
-            Rgb::splat(*x as f32)
-        }
-        fn display_spp(&self) -> u32 {
-            2
-        }
-    }
-
-    #[test]
-    fn a_solver_shows_only_its_latest_solution() {
-        let session = session();
-        let solver = Halving { fail: false };
-        assert_eq!(
-            SolverPass {
-                session: &session,
-                k: 1
-            }
-            .visit(&solver),
-            (2, 1)
-        );
-        assert_eq!(
-            SolverPass {
-                session: &session,
-                k: 2
-            }
-            .visit(&solver),
-            (2, 2)
-        );
-        // Three steps: x = 7/8, and the film holds only its image.
-        let snapshot = session.snapshot();
-        assert!(snapshot.image.pixels.iter().all(|p| *p == [0.875; 3]));
-        assert!(snapshot.samples.iter().all(|&n| n == 2));
-        assert_eq!(
-            session.error_estimate(&snapshot),
-            ErrorEstimate::Residual(0.125)
-        );
-    }
-
-    #[test]
-    fn a_solver_that_cannot_start_says_why() {
-        let session = session();
-        SolverPass {
-            session: &session,
-            k: 1,
-        }
-        .visit(&Halving { fail: true });
-        assert_eq!(session.failure().unwrap().message(), "no patches");
-    }
-
-    #[test]
-    fn a_deterministic_estimator_has_no_sampling_error() {
-        let mut session = session();
-        session.settings.integrator = IntegratorOptions {
-            kind: crate::integrator::IntegratorKind::Whitted,
-            ..Default::default()
-        }
-        .build();
-        assert!(session.render_pass(1));
-        let snapshot = session.snapshot();
-        assert_eq!(
-            session.error_estimate(&snapshot),
-            ErrorEstimate::Deterministic
-        );
-        assert_eq!(session.stats().passes, 1);
-    }
-}
+mod tests;
