@@ -8,6 +8,7 @@ use super::display::render_view;
 use super::export::{export_path, write_color_image, write_exr};
 use super::launch::{Launch, list_scene_files, resolve_scene_path};
 use super::settings::{Config, Display, Settings, load_settings, settings_file};
+use super::view_transform::ViewTransform;
 use crate::camera::Camera;
 use crate::image::Image;
 use crate::live::{ErrorPoint, LiveConfig, LiveFrame, LiveRender};
@@ -76,23 +77,6 @@ fn camera_key(c: &Camera) -> CameraKey {
 
 /// Frame times kept for the p95 figure.
 const FRAME_TIME_WINDOW: usize = 600;
-
-/// Zoom and pan of the image area.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ViewTransform {
-    /// Screen points per image pixel; `None` fits the image to the area.
-    pub zoom: Option<f32>,
-    pub pan: egui::Vec2,
-}
-
-impl Default for ViewTransform {
-    fn default() -> Self {
-        ViewTransform {
-            zoom: None,
-            pan: egui::Vec2::ZERO,
-        }
-    }
-}
 
 pub struct ViewerApp {
     pub settings: Settings,

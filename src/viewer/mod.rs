@@ -16,6 +16,7 @@ pub mod launch;
 pub mod panel;
 pub mod settings;
 pub mod stats;
+pub mod view_transform;
 
 pub use app::ViewerApp;
 pub use launch::Launch;
@@ -212,7 +213,7 @@ fn shortcuts(ctx: &egui::Context, app: &mut ViewerApp) {
             app.settings.show_help = !app.settings.show_help;
         }
         if i.key_pressed(Key::F) {
-            app.view = app::ViewTransform::default();
+            app.view = view_transform::ViewTransform::default();
         }
         if i.key_pressed(Key::Num1) {
             app.view.zoom = Some(1.0);
