@@ -130,10 +130,6 @@ impl CameraEstimator for McRayTracer {
         emitted + self.scattered(scene, &hit, -ray.direction, 0, sampler, counts)
     }
 
-    fn integrates_seen_emitters(&self) -> bool {
-        self.exact_seen_emitters
-    }
-
     fn shortcuts_used(&self) -> ShortcutsUsed {
         ShortcutsUsed {
             seen_emitters: Some(self.exact_seen_emitters),

@@ -118,12 +118,6 @@ pub trait CameraEstimator: Technique {
         false
     }
 
-    /// True when the estimator adds [`PrimaryPixel::seen_emission`] where it
-    /// is known instead of sampling the emission camera rays hit.
-    fn integrates_seen_emitters(&self) -> bool {
-        false
-    }
-
     /// Which small-scene shortcuts it reads (`crate::shortcuts`), for the
     /// reports of what applies.
     fn shortcuts_used(&self) -> ShortcutsUsed {
@@ -371,10 +365,6 @@ macro_rules! register_techniques {
                 match self { $(CameraIntegrator::$cv(e) => e.is_general(),)* }
             }
 
-            /// [`CameraEstimator::integrates_seen_emitters`].
-            pub fn integrates_seen_emitters(&self) -> bool {
-                match self { $(CameraIntegrator::$cv(e) => e.integrates_seen_emitters(),)* }
-            }
         }
 
         /// A configured splatting estimator.
@@ -540,12 +530,6 @@ impl Integrator {
             Integrator::Camera(e) => e.shortcuts_used(),
             _ => ShortcutsUsed::default(),
         }
-    }
-
-    /// True when the estimator integrates emitters seen directly over each
-    /// pixel where that is known.
-    pub fn integrates_seen_emitters(&self) -> bool {
-        matches!(self, Integrator::Camera(e) if e.integrates_seen_emitters())
     }
 }
 
