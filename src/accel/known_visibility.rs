@@ -56,6 +56,20 @@ impl Geometry {
         })
     }
 
+    /// [`Geometry::intersect_among`] where the ray's possible hits are known
+    /// (a camera ray's candidates), else [`Geometry::intersect`].
+    #[inline(always)]
+    pub fn intersect_maybe_among(
+        &self,
+        ray: &Ray,
+        candidates: Option<&[u32]>,
+    ) -> Option<SurfaceHit> {
+        match candidates {
+            Some(among) => self.intersect_among(ray, among),
+            None => self.intersect(ray),
+        }
+    }
+
     /// [`Geometry::intersect`] for a ray that can only hit the triangles
     /// `candidates` (in storage order): the same hit, by the same
     /// watertight test, without testing the rest.

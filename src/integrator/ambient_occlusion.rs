@@ -92,11 +92,7 @@ impl CameraEstimator for AmbientOcclusion {
         counts: &mut RayCounts,
     ) -> Rgb {
         let u = sampler.next_2d_for(Domain::Bsdf);
-        let hit = match pixel.candidates {
-            Some(among) => scene.geometry.intersect_among(&ray, among),
-            None => scene.geometry.intersect(&ray),
-        };
-        let Some(hit) = hit else {
+        let Some(hit) = scene.geometry.intersect_maybe_among(&ray, pixel.candidates) else {
             return Rgb::ZERO;
         };
         // The hemisphere on the side the camera sees.

@@ -181,10 +181,6 @@ impl CameraEstimator for PathTracer {
         self.radiance_observed(scene, ray, pixel, sampler, counts, &mut NoObserver)
     }
 
-    fn integrates_seen_emitters(&self) -> bool {
-        self.exact_seen_emitters
-    }
-
     fn is_general(&self) -> bool {
         self.general
     }
@@ -280,10 +276,9 @@ impl PathTracer {
             let u_light = sampler.get_2d_for(vertex_dim + 1, Domain::Light);
             let u_bsdf = sampler.get_2d_for(vertex_dim + 3, Domain::Bsdf);
             // The camera ray tests only its pixel's candidates, if known.
-            let hit = match candidates.take() {
-                Some(among) => scene.geometry.intersect_among(&ray, among),
-                None => scene.geometry.intersect(&ray),
-            };
+            let hit = scene
+                .geometry
+                .intersect_maybe_among(&ray, candidates.take());
             let Some(hit) = hit else {
                 observer.escaped();
                 break;
