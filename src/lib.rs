@@ -13,6 +13,7 @@ pub mod error;
 pub mod film;
 pub mod image;
 pub mod integrator;
+pub mod lab;
 pub mod live;
 pub mod math;
 pub mod plot;

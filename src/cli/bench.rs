@@ -9,7 +9,7 @@ use tracelab::convergence::{
     BenchConfig, Checkpoint, StopAt, log_log_slope, mean_variance, measure, time_to_rmse,
 };
 use tracelab::image::{Image, check_writable};
-use tracelab::plot::{PlotFormat, Series, log_log_plot};
+use tracelab::plot::{PlotFormat, Series, SeriesStyle, log_log_plot};
 use tracelab::render::{RenderSettings, Session};
 use tracelab::scene::{Limits, Scene};
 use tracelab::{Error, Result};
@@ -224,9 +224,10 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
         if let Some(path) = path {
             let series: Vec<Series> = results
                 .iter()
-                .map(|(name, points)| Series {
-                    name: name.clone(),
-                    points: points.iter().map(|p| (x(p), p.rmse)).collect(),
+                .enumerate()
+                .map(|(i, (name, points))| {
+                    let points: Vec<(f64, f64)> = points.iter().map(|p| (x(p), p.rmse)).collect();
+                    Series::new(name, SeriesStyle::Line, i, &points)
                 })
                 .collect();
             log_log_plot(path, &args.title, x_label, "RMSE", &series)?;

@@ -2,6 +2,7 @@
 //! (`view` and `compare` here; `render`, `bench` and `stress` in their own files).
 
 mod bench;
+mod lab;
 mod render;
 mod stress;
 
@@ -32,6 +33,10 @@ enum Command {
     /// The numerical stress suite: scaled, far-away and awkward scenes against
     /// their references; exits non-zero when a case fails.
     Stress(stress::StressArgs),
+    /// The Monte Carlo lab: pi by darts, coin flips, stratified sampling,
+    /// importance sampling, point sets and warps; prints a table and checks,
+    /// writes CSV and plots.
+    Lab(lab::LabArgs),
     /// Compare two images: RMSE, relative MSE and mean relative error (as tev computes them).
     Compare {
         /// The image to measure.
@@ -105,6 +110,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Compare { image, reference }) => compare(&image, &reference),
         Some(Command::Bench(args)) => bench::bench(&args),
         Some(Command::Stress(args)) => stress::stress(&args),
+        Some(Command::Lab(args)) => lab::lab(&args),
         #[cfg(feature = "viewer")]
         Some(Command::View(args)) => view(args),
         #[cfg(feature = "viewer")]

@@ -53,7 +53,7 @@ enum SeenEmittersArg {
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
-enum SamplerArg {
+pub(crate) enum SamplerArg {
     /// Independent uniform numbers.
     Independent,
     /// Jittered strata in every dimension and pair, shuffled between dimensions.
@@ -63,6 +63,17 @@ enum SamplerArg {
     /// Owen-scrambled Sobol, shuffled per dimension pair (path tracing:
     /// for the camera sample and the first two vertices, then independent).
     Sobol,
+}
+
+impl SamplerArg {
+    pub(crate) fn kind(self) -> SamplerKind {
+        match self {
+            SamplerArg::Independent => SamplerKind::Independent,
+            SamplerArg::Stratified => SamplerKind::Stratified,
+            SamplerArg::Multijitter => SamplerKind::MultiJittered,
+            SamplerArg::Sobol => SamplerKind::Sobol,
+        }
+    }
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -275,12 +286,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     let load_time = load_start.elapsed();
 
     let integrator = integrator_options(args)?.build();
-    let sampler = match args.sampler {
-        SamplerArg::Independent => SamplerKind::Independent,
-        SamplerArg::Stratified => SamplerKind::Stratified,
-        SamplerArg::Multijitter => SamplerKind::MultiJittered,
-        SamplerArg::Sobol => SamplerKind::Sobol,
-    };
+    let sampler = args.sampler.kind();
     if let Some(a) = args.adaptive
         && !(a.is_finite() && a > 0.0)
     {
@@ -404,7 +410,7 @@ pub(crate) fn override_resolution(
     Ok(())
 }
 
-fn progress_bar(len: u64, unit: &str) -> ProgressBar {
+pub(crate) fn progress_bar(len: u64, unit: &str) -> ProgressBar {
     if !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
