@@ -12,6 +12,8 @@
 use glam::{Vec2, Vec3A};
 use std::f64::consts::PI;
 use tracelab::accel::{Geometry, NO_LIGHT, TriangleInput};
+use tracelab::lab::stats::{ChiSquare, gamma_q, sidak};
+use tracelab::lab::warps::{Domain, Histogram};
 use tracelab::math::{Frame, Rgb};
 use tracelab::sampling::hash::{hash_combine, to_unit_float};
 use tracelab::sampling::warp::*;
@@ -20,9 +22,6 @@ use tracelab::scene::material::{Bsdf, fresnel_dielectric};
 
 /// Number of `assert_fits` calls below (the significance is split over them).
 const TESTS_IN_FILE: f64 = 28.0;
-const COS_BINS: usize = 20;
-const PHI_BINS: usize = 40;
-const SUBDIVISIONS: usize = 16;
 const SAMPLES: u64 = 500_000;
 
 /// Uniform numbers for test `seed`, sample `i`.
@@ -30,197 +29,40 @@ fn uniform(seed: u64, i: u64, dim: u64) -> f32 {
     to_unit_float(hash_combine(hash_combine(seed, i), dim))
 }
 
-/// ln Γ(x) for x > 0 (Lanczos, g = 7).
-fn ln_gamma(x: f64) -> f64 {
-    const C: [f64; 9] = [
-        0.999_999_999_999_809_9,
-        676.520_368_121_885_1,
-        -1_259.139_216_722_402_8,
-        771.323_428_777_653_1,
-        -176.615_029_162_140_6,
-        12.507_343_278_686_905,
-        -0.138_571_095_265_720_12,
-        9.984_369_578_019_572e-6,
-        1.505_632_735_149_311_6e-7,
-    ];
-    if x < 0.5 {
-        return (PI / (PI * x).sin()).ln() - ln_gamma(1.0 - x);
-    }
-    let x = x - 1.0;
-    let mut a = C[0];
-    let t = x + 7.5;
-    for (i, c) in C.iter().enumerate().skip(1) {
-        a += c / (x + i as f64);
-    }
-    0.5 * (2.0 * PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
-}
-
-/// Regularised upper incomplete gamma Q(a, x): the chi-square survival
-/// function is Q(dof / 2, chi2 / 2). Series for x < a + 1, else Lentz's
-/// continued fraction.
-fn gamma_q(a: f64, x: f64) -> f64 {
-    let prefactor = (-x + a * x.ln() - ln_gamma(a)).exp();
-    if x < a + 1.0 {
-        let (mut term, mut sum, mut ap) = (1.0 / a, 1.0 / a, a);
-        for _ in 0..10_000 {
-            ap += 1.0;
-            term *= x / ap;
-            sum += term;
-            if term.abs() < sum.abs() * 1e-15 {
-                break;
-            }
-        }
-        1.0 - sum * prefactor
-    } else {
-        let tiny = 1e-300;
-        let mut b = x + 1.0 - a;
-        let mut c = 1.0 / tiny;
-        let mut d = 1.0 / b;
-        let mut h = d;
-        for i in 1..10_000 {
-            let an = -(i as f64) * (i as f64 - a);
-            b += 2.0;
-            d = an * d + b;
-            if d.abs() < tiny {
-                d = tiny;
-            }
-            c = b + an / c;
-            if c.abs() < tiny {
-                c = tiny;
-            }
-            d = 1.0 / d;
-            let delta = d * c;
-            h *= delta;
-            if (delta - 1.0).abs() < 1e-15 {
-                break;
-            }
-        }
-        prefactor * h
-    }
-}
-
-/// Chi-square test of observed against expected counts; pools small cells.
+/// Chi-square test of observed against expected counts (the lab's, which
+/// pools cells expecting fewer than 5 samples).
 fn assert_fits(name: &str, observed: &[f64], expected: &[f64]) {
-    let mut cells: Vec<(f64, f64)> = observed
-        .iter()
-        .copied()
-        .zip(expected.iter().copied())
-        .collect();
-    cells.sort_by(|a, b| a.1.partial_cmp(&b.1).unwrap());
-    let (mut chi2, mut dof) = (0.0, 0usize);
-    let (mut pooled_obs, mut pooled_exp) = (0.0, 0.0);
-    for (o, e) in cells {
-        if e < 5.0 {
-            pooled_obs += o;
-            pooled_exp += e;
-            continue;
-        }
-        chi2 += (o - e) * (o - e) / e;
-        dof += 1;
-    }
-    if pooled_exp >= 5.0 {
-        chi2 += (pooled_obs - pooled_exp).powi(2) / pooled_exp;
-        dof += 1;
-    } else {
-        // Samples where nothing should be: any one of them is a failure.
-        assert!(
-            pooled_obs <= 2.0 + 3.0 * pooled_exp,
-            "{name}: {pooled_obs} samples in cells expecting {pooled_exp:.2}"
-        );
-    }
-    let dof = dof.saturating_sub(1).max(1);
-    let p_value = gamma_q(dof as f64 / 2.0, chi2 / 2.0);
-    let alpha = 1.0 - (1.0 - 0.01f64).powf(1.0 / TESTS_IN_FILE);
-    eprintln!("{name}: chi2 {chi2:.1}, dof {dof}, p {p_value:.4}");
+    let test = ChiSquare::test(observed, expected);
+    let alpha = sidak(0.01, TESTS_IN_FILE as usize);
+    eprintln!(
+        "{name}: chi2 {:.1}, dof {}, p {:.4}",
+        test.chi2, test.dof, test.p_value
+    );
     assert!(
-        p_value > alpha,
-        "{name}: chi2 = {chi2:.1} with {dof} dof, p = {p_value:.2e} < {alpha:.2e}"
+        test.passes(alpha),
+        "{name}: chi2 = {:.1} with {} dof, p = {:.2e} < {alpha:.2e}, {} samples where {:.2} expected",
+        test.chi2,
+        test.dof,
+        test.p_value,
+        test.stray,
+        test.stray_expected
     );
 }
 
-fn cell_of(w: Vec3A) -> usize {
-    let cos_theta = w.z.clamp(-1.0, 1.0) as f64;
-    let mut phi = (w.y as f64).atan2(w.x as f64);
-    if phi < 0.0 {
-        phi += 2.0 * PI;
-    }
-    let i = (((cos_theta + 1.0) * 0.5 * COS_BINS as f64) as usize).min(COS_BINS - 1);
-    let j = ((phi / (2.0 * PI) * PHI_BINS as f64) as usize).min(PHI_BINS - 1);
-    i * PHI_BINS + j
-}
-
 /// Histograms `SAMPLES` directions from `sample` (None = sample lost) and
-/// compares them with `pdf` (solid angle) integrated over each cell.
+/// compares them with `pdf` (solid angle) integrated over each cell, as
+/// `tracelab lab warps` does.
 fn check_directions(
     name: &str,
-    mut sample: impl FnMut(u64) -> Option<Vec3A>,
+    sample: impl FnMut(u64) -> Option<Vec3A>,
     pdf: impl Fn(Vec3A) -> f64,
 ) {
-    let cells = COS_BINS * PHI_BINS;
-    let mut observed = vec![0.0; cells];
-    for i in 0..SAMPLES {
-        if let Some(w) = sample(i) {
-            assert!(
-                w.is_finite() && (w.length() - 1.0).abs() < 1e-4,
-                "{name}: bad direction {w:?}"
-            );
-            observed[cell_of(w.normalize())] += 1.0;
-        }
-    }
-    let mut expected = vec![0.0; cells];
-    let (d_cos, d_phi) = (2.0 / COS_BINS as f64, 2.0 * PI / PHI_BINS as f64);
-    // Midpoint rule on a sub-grid.
-    let integrate = |i: usize, j: usize, subdivisions: usize| -> (f64, bool) {
-        let (mut integral, mut zeros) = (0.0, 0usize);
-        for a in 0..subdivisions {
-            for b in 0..subdivisions {
-                let cos_theta = -1.0 + d_cos * (i as f64 + (a as f64 + 0.5) / subdivisions as f64);
-                let phi = d_phi * (j as f64 + (b as f64 + 0.5) / subdivisions as f64);
-                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-                let w = Vec3A::new(
-                    (sin_theta * phi.cos()) as f32,
-                    (sin_theta * phi.sin()) as f32,
-                    cos_theta as f32,
-                );
-                let p = pdf(w);
-                zeros += usize::from(p == 0.0);
-                integral += p;
-            }
-        }
-        let partial = zeros > 0 && zeros < subdivisions * subdivisions;
-        (
-            integral * d_cos * d_phi / (subdivisions * subdivisions) as f64,
-            partial,
-        )
-    };
-    let mut partial = vec![false; cells];
-    for i in 0..COS_BINS {
-        for j in 0..PHI_BINS {
-            let (integral, is_partial) = integrate(i, j, SUBDIVISIONS);
-            expected[i * PHI_BINS + j] = integral;
-            partial[i * PHI_BINS + j] = is_partial;
-        }
-    }
-    // Refine cells the pdf partly covers and empty cells next to covered ones
-    // (a silhouette may clip a corner between sub-grid points).
-    let covered = |i: isize, j: isize| -> bool {
-        i >= 0
-            && i < COS_BINS as isize
-            && expected[i as usize * PHI_BINS + j.rem_euclid(PHI_BINS as isize) as usize] > 0.0
-    };
-    let mut refined = expected.clone();
-    for i in 0..COS_BINS {
-        for j in 0..PHI_BINS {
-            let k = i * PHI_BINS + j;
-            let (ii, jj) = (i as isize, j as isize);
-            let near_covered = (-1..=1).any(|di| (-1..=1).any(|dj| covered(ii + di, jj + dj)));
-            if partial[k] || (expected[k] == 0.0 && near_covered) {
-                refined[k] = integrate(i, j, 8 * SUBDIVISIONS).0;
-            }
-        }
-    }
-    let expected: Vec<f64> = refined.iter().map(|e| e * SAMPLES as f64).collect();
-    assert_fits(name, &observed, &expected);
+    let histogram = Histogram::new(Domain::Sphere, SAMPLES, sample, pdf);
+    assert_eq!(
+        histogram.invalid, 0,
+        "{name}: directions not of unit length"
+    );
+    assert_fits(name, &histogram.observed, &histogram.expected);
 }
 
 #[test]

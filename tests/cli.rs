@@ -568,3 +568,34 @@ fn the_summary_says_which_shortcuts_apply_and_why_not() {
         "{off}"
     );
 }
+
+#[test]
+fn lab_prints_tables_writes_csv_and_plots_and_refuses_bad_names() {
+    let dir = temp_dir("lab-cli");
+    let csv = dir.join("coins.csv");
+    let plot = dir.join("coins.svg");
+    let o = tracelab(&[
+        "lab",
+        "coins",
+        "--runs",
+        "2000",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--plot",
+        plot.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("0.187500") && out.contains("[holds]"), "{out}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("table,n,exact,"), "{text}");
+    // 11 rows (n = 1 ... 1024) and the header.
+    assert_eq!(text.lines().count(), 12);
+    assert!(std::fs::read_to_string(&plot).unwrap().starts_with("<svg"));
+    // A bad plot name is refused before any work; an unknown experiment too.
+    let o = tracelab(&["lab", "coins", "--plot", "x.jpg"]);
+    assert_fails(&o, 1, &["x.jpg", ".svg or .png"]);
+    let o = tracelab(&["lab", "dice"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("point-sets"));
+}

@@ -9,6 +9,8 @@ mod reference;
 mod furnace;
 // Chi-square goodness of fit of every sampling routine against its pdf.
 mod chi2;
+// The Monte Carlo lab's experiments meet their closed-form statements.
+mod lab;
 // BSDF energy conservation, reciprocity and sample/eval/pdf consistency.
 mod bsdf;
 // Whitted by hand, MC ray tracing's ray count.
