@@ -148,7 +148,8 @@ mod tests {
         assert_eq!(exact_mean_absolute_error(1), 0.5);
         assert_eq!(exact_mean_absolute_error(2), 0.25);
         assert_eq!(exact_mean_absolute_error(4), 0.1875);
-        // n = 3: outcomes with 0..3 heads, pmf 1/8, 3/8, 3/8, 1/8; |k/3 - 1/2| = 1/2, 1/6, 1/6, 1/2.
-        assert!((exact_mean_absolute_error(3) - (1.0 / 8.0 + 3.0 / 48.0) * 2.0).abs() < 1e-15);
+        // n = 3: 0..3 heads with pmf 1/8, 3/8, 3/8, 1/8 and |k/3 - 1/2| =
+        // 1/2, 1/6, 1/6, 1/2: 2 (1/16 + 1/16) = 1/4.
+        assert!((exact_mean_absolute_error(3) - 0.25).abs() < 1e-15);
     }
 }
