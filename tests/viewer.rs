@@ -11,6 +11,7 @@ use egui_kittest::{Harness, SnapshotOptions};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use tracelab::integrator::IntegratorKind;
+use tracelab::lab::Experiment;
 use tracelab::render::Adaptive;
 use tracelab::sampling::SamplerKind;
 use tracelab::viewer::{Launch, Window};
@@ -220,4 +221,47 @@ fn window_layout_snapshot() {
         &SnapshotOptions::new().output_path(repo_path("tests/snapshots")),
     );
     harness.state_mut().app.shutdown();
+}
+
+#[test]
+fn the_lab_tab_runs_every_experiment_live_and_cancels() {
+    let dir = temp_dir("viewer-lab");
+    let mut harness = Harness::builder()
+        .with_size(SIZE)
+        .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 4)));
+    harness.get_by_label("MC lab").click();
+    // One frame to take the click, one to draw the lab.
+    harness.step();
+    harness.step();
+    assert_eq!(harness.state().app.settings.tab, tracelab::viewer::Tab::Lab);
+    for experiment in Experiment::ALL {
+        click(&mut harness, experiment.label());
+        assert_eq!(harness.state().app.lab.experiment(), experiment);
+        // Partial reports appear while it runs: the UI never waits for the end.
+        step_until(&mut harness, "a first stage", |w| {
+            w.app.lab.report().is_some_and(|r| r.stages_done >= 1)
+        });
+        step_until(&mut harness, experiment.name(), |w| {
+            w.app.lab.frames_since_finished >= 2
+        });
+        let report = harness.state().app.lab.report().unwrap();
+        assert!(
+            !report.figures.is_empty() && report.all_hold(),
+            "{experiment:?}"
+        );
+        // The checks are on screen.
+        let shown = harness.query_all_by_label_contains("holds:").count();
+        assert_eq!(shown, report.checks.len(), "{experiment:?}");
+    }
+    // A long run is cancelled by its button and says so.
+    click(&mut harness, Experiment::Stratified.label());
+    harness.state_mut().app.lab.settings.runs = 100_000;
+    harness.state_mut().app.lab.start();
+    harness.step();
+    click(&mut harness, "Cancel");
+    step_until(&mut harness, "the cancel", |w| w.app.lab.was_cancelled());
+    harness.get_by_label_contains("cancelled");
+    // Back to the renderer: it renders again.
+    harness.get_by_label("Renderer").click();
+    step_until(&mut harness, "the render", finished);
 }

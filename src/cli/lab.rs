@@ -38,7 +38,7 @@ pub struct LabArgs {
 
 /// An experiment, by its name in [`Experiment::name`].
 #[derive(Clone, Copy, Debug)]
-struct ExperimentArg(Experiment);
+pub(super) struct ExperimentArg(pub(super) Experiment);
 
 impl ValueEnum for ExperimentArg {
     fn value_variants<'a>() -> &'a [Self] {

@@ -101,6 +101,9 @@ struct ViewArgs {
     /// Folder for exports (default: ./exports).
     #[arg(long)]
     export_dir: Option<PathBuf>,
+    /// Open the Monte Carlo lab tab on this experiment.
+    #[arg(long, value_enum)]
+    lab: Option<lab::ExperimentArg>,
 }
 
 /// Runs the parsed command line.
@@ -126,6 +129,7 @@ pub fn run(cli: Cli) -> Result<()> {
             threads: 0,
             fresh: false,
             export_dir: None,
+            lab: None,
         }),
         #[cfg(not(feature = "viewer"))]
         None => {
@@ -176,6 +180,7 @@ fn view(args: ViewArgs) -> Result<()> {
             ShowArg::Samples => tracelab::viewer::ViewMode::Samples,
         }),
         threads: args.threads,
+        lab: args.lab.map(|e| e.0),
         export_dir: args.export_dir,
     })
 }

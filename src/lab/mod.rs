@@ -19,7 +19,7 @@ pub mod stats;
 pub mod stratified;
 pub mod warps;
 
-pub use report::{Cell, Check, Figure, Report, Series, SeriesStyle, Table};
+pub use report::{Axes, Cell, Check, Figure, Heatmap, Report, Series, SeriesStyle, Table};
 pub use runner::{LabRunner, Progress};
 
 use crate::sampling::SamplerKind;

@@ -6,8 +6,9 @@
 
 use super::display::render_view;
 use super::export::{export_path, write_color_image, write_exr};
+use super::lab::LabState;
 use super::launch::{Launch, list_scene_files, resolve_scene_path};
-use super::settings::{Config, Display, Settings, load_settings, settings_file};
+use super::settings::{Config, Display, Settings, Tab, load_settings, settings_file};
 use super::view_transform::ViewTransform;
 use crate::camera::Camera;
 use crate::image::Image;
@@ -57,6 +58,8 @@ type RenderKey = (
         Option<(u32, u32)>,
         crate::math::OffsetMode,
     ),
+    // The renderer pauses while the lab tab is shown.
+    bool,
     Option<CameraKey>,
     usize,
     u64,
@@ -110,6 +113,8 @@ pub struct ViewerApp {
     pub sheet_mode: bool,
     /// The path typed into the scene field.
     pub scene_field: String,
+    /// The Monte Carlo lab tab.
+    pub lab: LabState,
 }
 
 impl ViewerApp {
@@ -145,6 +150,11 @@ impl ViewerApp {
         }
         if let Some(dir) = &launch.export_dir {
             settings.export_dir = dir.to_string_lossy().into_owned();
+        }
+        let mut lab = LabState::default();
+        if let Some(experiment) = launch.lab {
+            settings.tab = Tab::Lab;
+            lab = LabState::new(experiment);
         }
         if let Some(path) = &launch.screenshot {
             settings.target_spp = settings.target_spp.max(launch.after_spp);
@@ -190,6 +200,7 @@ impl ViewerApp {
             captured: Arc::new(Mutex::new(None)),
             capture_requested: false,
             sheet_mode: false,
+            lab,
         };
         let scene_path = resolve_scene_path(&app.settings.scene_path);
         app.load_scene(&scene_path);
@@ -314,6 +325,7 @@ impl ViewerApp {
         };
         let key: RenderKey = (
             self.settings.render_key(),
+            self.settings.tab == Tab::Lab,
             self.camera.as_ref().map(camera_key),
             Arc::as_ptr(&scene) as usize,
             self.restarts,
@@ -335,6 +347,13 @@ impl ViewerApp {
         }
         let excess = self.curves.len().saturating_sub(8);
         self.curves.drain(..excess);
+        if self.settings.tab == Tab::Lab {
+            // Both cores go to the lab; coming back restarts the render.
+            self.rendered_configs.clear();
+            self.live
+                .restart(Vec::new(), self.settings.lock, self.reference.clone());
+            return;
+        }
 
         let mut scene = (*scene).clone();
         if let Some(camera) = self.camera {
@@ -594,8 +613,12 @@ impl ViewerApp {
             ctx.request_repaint();
             return;
         }
-        // The automated screenshot waits for its sample count; exports go now.
+        // The automated screenshot waits for its sample count (or the lab
+        // for its run to finish and show); exports go now.
         let ready = match &capture {
+            Capture::Window {
+                quit_after: true, ..
+            } if self.settings.tab == Tab::Lab => self.lab.frames_since_finished >= 3,
             Capture::Window {
                 quit_after: true, ..
             } => {

@@ -3,6 +3,7 @@
 
 use super::settings::ViewMode;
 use crate::integrator::IntegratorKind;
+use crate::lab::Experiment;
 use std::path::{Path, PathBuf};
 
 /// How the viewer was started (command line or tests).
@@ -26,6 +27,8 @@ pub struct Launch {
     /// Start from default settings instead of the saved ones.
     pub fresh: bool,
     pub export_dir: Option<PathBuf>,
+    /// Open the Monte Carlo lab on this experiment.
+    pub lab: Option<Experiment>,
 }
 
 /// A relative scene path that does not exist here is looked up in the source

@@ -12,6 +12,7 @@ pub mod app;
 pub mod display;
 pub mod export;
 pub mod image_view;
+pub mod lab;
 pub mod launch;
 pub mod panel;
 pub mod settings;
@@ -20,7 +21,7 @@ pub mod view_transform;
 
 pub use app::ViewerApp;
 pub use launch::Launch;
-pub use settings::ViewMode;
+pub use settings::{Tab, ViewMode};
 
 use crate::error::{Error, Result};
 use eframe::egui::{self, Color32, Key, RichText};
@@ -83,6 +84,9 @@ impl eframe::App for Window {
 
         if app.sheet_mode {
             sheet(ui, app);
+        } else if app.settings.tab == Tab::Lab {
+            app.lab.ensure_started();
+            lab_layout(ui, app);
         } else {
             layout(ui, app, &mut self.editing);
         }
@@ -91,7 +95,7 @@ impl eframe::App for Window {
             help_window(&ctx, app);
         }
         app.record_frame_time(start.elapsed().as_secs_f32());
-        if app.live().is_rendering() || app.capture.is_some() {
+        if app.live().is_rendering() || app.capture.is_some() || app.lab.is_running() {
             ctx.request_repaint_after(Duration::from_millis(30));
         }
     }
@@ -112,19 +116,42 @@ impl eframe::App for Window {
     }
 }
 
-fn layout(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing) {
+/// The tabs, the scene's name and the view modes (renderer) or nothing more (lab).
+fn top_bar(ui: &mut egui::Ui, app: &mut ViewerApp) {
     egui::Panel::top("top_bar").show(ui, |ui| {
         ui.horizontal(|ui| {
             ui.strong("tracelab");
-            ui.label(RichText::new(app.scene_name().to_string()).weak());
+            ui.selectable_value(&mut app.settings.tab, Tab::Renderer, "Renderer");
+            ui.selectable_value(&mut app.settings.tab, Tab::Lab, "MC lab");
             ui.separator();
-            for mode in ViewMode::ALL {
-                ui.selectable_value(&mut app.settings.display.view, mode, mode.label());
+            if app.settings.tab == Tab::Renderer {
+                ui.label(RichText::new(app.scene_name().to_string()).weak());
+                ui.separator();
+                for mode in ViewMode::ALL {
+                    ui.selectable_value(&mut app.settings.display.view, mode, mode.label());
+                }
+                ui.separator();
+            } else {
+                ui.label(RichText::new("the renderer pauses while the lab is shown").weak());
+                ui.separator();
             }
-            ui.separator();
             ui.toggle_value(&mut app.settings.show_help, "Help (H)");
         });
     });
+}
+
+/// The Monte Carlo lab: its panel on the left, figures and tables in the middle.
+fn lab_layout(ui: &mut egui::Ui, app: &mut ViewerApp) {
+    top_bar(ui, app);
+    egui::Panel::left("lab_controls")
+        .resizable(true)
+        .default_size(310.0)
+        .show(ui, |ui| lab::lab_panel(ui, &mut app.lab));
+    egui::CentralPanel::default().show(ui, |ui| lab::lab_area(ui, &mut app.lab));
+}
+
+fn layout(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing) {
+    top_bar(ui, app);
     if !app.errors.is_empty() {
         egui::Panel::top("errors").show(ui, |ui| {
             let mut dismiss = false;

@@ -203,6 +203,17 @@ pub struct Settings {
     pub export_dir: String,
     pub display: Display,
     pub show_help: bool,
+    /// The renderer or the Monte Carlo lab.
+    pub tab: Tab,
+}
+
+/// What the window shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Tab {
+    #[default]
+    Renderer,
+    /// The Monte Carlo lab; the renderer pauses while it is shown.
+    Lab,
 }
 
 impl Default for Settings {
@@ -224,6 +235,7 @@ impl Default for Settings {
             export_dir: "exports".into(),
             display: Display::default(),
             show_help: false,
+            tab: Tab::Renderer,
         }
     }
 }

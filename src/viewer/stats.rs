@@ -202,7 +202,7 @@ pub fn convergence_plot(ui: &mut egui::Ui, app: &mut ViewerApp) {
 /// powers of ten alone when the axis spans more than four decades; decades
 /// get the thicker lines. Labels then read 1, 2, 5, 10, 20 ... instead of
 /// 10^x at the plot's own linear steps (1.9953, 2.5119, 3.1623 ...).
-fn log_grid(input: egui_plot::GridInput) -> Vec<egui_plot::GridMark> {
+pub(super) fn log_grid(input: egui_plot::GridInput) -> Vec<egui_plot::GridMark> {
     let (lo, hi) = input.bounds;
     if !(lo.is_finite() && hi.is_finite()) || hi <= lo {
         return Vec::new();
@@ -227,7 +227,7 @@ fn log_grid(input: egui_plot::GridInput) -> Vec<egui_plot::GridMark> {
 
 /// Axis label of a log10 value: 10^x as a plain number (0.002, 5, 20) where
 /// short, else in exponent form (2e-5).
-fn format_power(x: f64) -> String {
+pub(super) fn format_power(x: f64) -> String {
     let v = 10f64.powf(x);
     // Round to 3 significant digits so that log10 round trips print cleanly.
     let digits = 2 - v.log10().floor() as i32;
