@@ -1,7 +1,9 @@
 //! Responsiveness of the viewer, driven headless through egui_kittest (the
 //! real app, without a window): UI frame times while rendering, time from a
 //! setting change to the first image of the new settings, CPU-time fairness
-//! of an equal-time comparison, and memory over a long session.
+//! of an equal-time comparison, memory over a long session, and UI frame
+//! times in the MC lab tab while its experiments run
+//! (`TRACELAB_BENCH_ONLY=lab` measures only those).
 //!
 //! `cargo bench --bench viewer` (TRACELAB_SOAK_SECONDS=600 for the 10-minute
 //! memory figure). Prints a table; asserts nothing.
@@ -14,7 +16,8 @@ use tracelab::integrator::IntegratorKind;
 use tracelab::live::Lock;
 use tracelab::sampling::SamplerKind;
 use tracelab::viewer::stats::resident_memory_mib;
-use tracelab::viewer::{Launch, Window};
+use tracelab::lab::Experiment;
+use tracelab::viewer::{Launch, Tab, Window};
 
 fn harness() -> Harness<'static, Window> {
     let launch = Launch {
@@ -50,12 +53,46 @@ fn percentile(mut v: Vec<f64>, q: f64) -> f64 {
     v[((v.len() - 1) as f64 * q).round() as usize]
 }
 
+/// UI frame times in the MC lab tab while each experiment runs live.
+fn lab_frames(h: &mut Harness<'static, Window>) {
+    h.state_mut().app.settings.tab = Tab::Lab;
+    let mut all = Vec::new();
+    for experiment in Experiment::ALL {
+        h.state_mut().app.lab.select(experiment);
+        let mut frames = Vec::new();
+        let start = Instant::now();
+        while h.state_mut().app.lab.is_running() {
+            frames.push(frame(h).as_secs_f64() * 1e3);
+        }
+        println!(
+            "UI frame time while the lab runs {:<11} median {:.2} ms, p95 {:.2} ms, max {:.2} ms ({} frames, {:.1} s)",
+            experiment.name(),
+            percentile(frames.clone(), 0.5),
+            percentile(frames.clone(), 0.95),
+            percentile(frames.clone(), 1.0),
+            frames.len(),
+            start.elapsed().as_secs_f64()
+        );
+        all.extend(frames);
+    }
+    println!(
+        "UI frame time while the lab runs, all experiments: median {:.2} ms, p95 {:.2} ms",
+        percentile(all.clone(), 0.5),
+        percentile(all, 0.95)
+    );
+    h.state_mut().app.settings.tab = Tab::Renderer;
+}
+
 fn main() {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
         "viewer responsiveness, 512x512 Cornell box, {cores} cores, kittest (no GPU painting)"
     );
     let mut h = harness();
+    lab_frames(&mut h);
+    if std::env::var("TRACELAB_BENCH_ONLY").is_ok_and(|v| v == "lab") {
+        return;
+    }
     let rss_start = resident_memory_mib().unwrap_or(f64::NAN);
 
     // 1. Frame times while rendering.
