@@ -13,10 +13,10 @@ use egui_kittest::Harness;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use tracelab::integrator::IntegratorKind;
+use tracelab::lab::Experiment;
 use tracelab::live::Lock;
 use tracelab::sampling::SamplerKind;
 use tracelab::viewer::stats::resident_memory_mib;
-use tracelab::lab::Experiment;
 use tracelab::viewer::{Launch, Tab, Window};
 
 fn harness() -> Harness<'static, Window> {

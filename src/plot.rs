@@ -291,12 +291,13 @@ where
     Ok(())
 }
 
-fn draw_contents<'a, DB: 'a, X, Y>(
+/// Axes, heatmap, series and legend, on linear or logarithmic coordinates.
+fn draw_contents<'a, DB, X, Y>(
     figure: &Figure,
     mut chart: ChartContext<'a, DB, Cartesian2d<X, Y>>,
 ) -> DrawResult
 where
-    DB: DrawingBackend,
+    DB: DrawingBackend + 'a,
     DB::ErrorType: 'static,
     X: Ranged<ValueType = f64> + ValueFormatter<f64>,
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,

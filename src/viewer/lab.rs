@@ -381,9 +381,10 @@ fn draw_figure(ui: &mut egui::Ui, figure: &Figure, index: usize, size: egui::Vec
             .y_grid_spacer(super::stats::log_grid);
     } else if let Axes::Linear { x, y } = figure.axes {
         plot = plot.default_x_bounds(x.0, x.1).default_y_bounds(y.0, y.1);
-        // Point sets and warped points are shapes: keep circles round.
+        // Point sets and warped points are shapes: a square plot keeps circles round.
         if x == y {
-            plot = plot.data_aspect(1.0);
+            let side = size.x.min(size.y);
+            plot = plot.width(side).height(side);
         }
     }
     plot.show(ui, |plot_ui| {
