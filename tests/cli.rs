@@ -595,6 +595,10 @@ fn lab_prints_tables_writes_csv_and_plots_and_refuses_bad_names() {
     // A bad plot name is refused before any work; an unknown experiment too.
     let o = tracelab(&["lab", "coins", "--plot", "x.jpg"]);
     assert_fails(&o, 1, &["x.jpg", ".svg or .png"]);
+    let o = tracelab(&["lab", "point-sets", "--n", "1000000"]);
+    assert_fails(&o, 1, &["O(N^2)", "65536"]);
+    let o = tracelab(&["lab", "pi", "--runs", "0"]);
+    assert_fails(&o, 1, &["at least 1"]);
     let o = tracelab(&["lab", "dice"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("point-sets"));

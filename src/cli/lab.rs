@@ -69,9 +69,7 @@ pub fn lab(args: &LabArgs) -> Result<()> {
     settings.sampler = args.sampler.kind();
     settings.n = args.n.unwrap_or(settings.n);
     settings.runs = args.runs.unwrap_or(settings.runs);
-    if settings.n == 0 || settings.runs == 0 {
-        return Err(Error::new("--n and --runs must be at least 1"));
-    }
+    experiment.check(&settings).map_err(Error::new)?;
     println!("{}\n", experiment.label());
     println!("{}\n", wrap(experiment.text(), 88));
     let mut runner = LabRunner::start(settings);

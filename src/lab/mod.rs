@@ -116,6 +116,21 @@ impl Experiment {
         }
     }
 
+    /// Why `settings` cannot be run, if they cannot: counts of zero, and
+    /// point sets past what the O(N²) discrepancy finishes in minutes.
+    pub fn check(self, settings: &LabSettings) -> Result<(), String> {
+        if settings.n == 0 || settings.runs == 0 {
+            return Err("the largest N and the number of runs must be at least 1".into());
+        }
+        if self == Experiment::PointSets && settings.n > MAX_POINT_SET {
+            return Err(format!(
+                "point-sets computes the L2 star discrepancy in O(N^2): N is at most {MAX_POINT_SET}, got {}",
+                settings.n
+            ));
+        }
+        Ok(())
+    }
+
     /// Runs the experiment; partial reports go to `progress` as it goes.
     pub fn run(self, settings: &LabSettings, progress: &Progress) -> Result<Report, Cancelled> {
         let report = match self {
@@ -147,6 +162,9 @@ pub struct LabSettings {
     /// curves grow (the viewer); zero on the command line.
     pub pace: std::time::Duration,
 }
+
+/// The largest point set `point-sets` accepts.
+pub const MAX_POINT_SET: u32 = 1 << 16;
 
 /// The run was cancelled (the viewer's Cancel, a new run, the window closing).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -136,11 +136,14 @@ fn slopes(curves: &[Vec<(f64, f64)>]) -> Table {
     }
 }
 
+/// Most darts a scatter plot shows (the first ones of the set).
+const SHOWN: u32 = 20_000;
+
 /// One run's darts, inside and outside, and the quarter circle.
 fn scatter(kind: SamplerKind, seed: u64, n: u32) -> Figure {
     let mut points = PointSet::new(kind, seed, 0, n);
     let (mut inside, mut outside) = (Vec::new(), Vec::new());
-    for i in 0..n {
+    for i in 0..n.min(SHOWN) {
         let p = points.point_2d(i);
         let xy = (p.x as f64, p.y as f64);
         if p.length_squared() < 1.0 {
@@ -156,7 +159,11 @@ fn scatter(kind: SamplerKind, seed: u64, n: u32) -> Figure {
         })
         .collect();
     Figure::linear(
-        format!("{n} darts ({})", kind.name()),
+        if n > SHOWN {
+            format!("the first {SHOWN} of {n} darts ({})", kind.name())
+        } else {
+            format!("{n} darts ({})", kind.name())
+        },
         ("x", "y"),
         (0.0, 1.0),
         (0.0, 1.0),

@@ -13,9 +13,9 @@ points. Independent points give an RMSE of σ/√N (σ = 0.600215 for one sample
 Jittered points, one in each of N equal strata, leave in each stratum only the variation of \
 f across it, about f'·(1/N); N such errors of size 1/N² in variance add up to 1/N³, so the \
 RMSE falls as N^(-1.5) on this smooth integrand. The lecture's O(1/N) is the bound for an \
-integrand with jumps, where the strata the jump crosses dominate. In one dimension the \
-multi-jittered sampler's Latin hypercube points are jittered points too (one per stratum); \
-Owen-scrambled Sobol reaches N^(-1.5) at powers of two and is slower at N = 10^k, where its \
+integrand with jumps, where the strata the jump crosses dominate. In one dimension a Latin \
+hypercube and a jittered set are the same thing (one point per stratum): the multi-jittered \
+sampler gives the stratified sampler's numbers here, number for number. Owen-scrambled Sobol reaches N^(-1.5) at powers of two and is slower at N = 10^k, where its \
 prefix is not a complete net.";
 
 /// The integral the lecture quotes.

@@ -229,7 +229,7 @@ pub fn lab_panel(ui: &mut egui::Ui, lab: &mut LabState) {
             }
             let max_n = match current {
                 Experiment::Coins => 1 << 14,
-                Experiment::PointSets => 1 << 13,
+                Experiment::PointSets => crate::lab::MAX_POINT_SET,
                 _ => 10_000_000,
             };
             ui.label("Largest N");
