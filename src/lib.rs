@@ -17,6 +17,7 @@ pub mod lab;
 pub mod live;
 pub mod math;
 pub mod plot;
+pub mod radiosity;
 pub mod render;
 pub mod replay;
 pub mod sampling;

@@ -15,6 +15,7 @@ use tracelab::integrator::{
     Strategy,
 };
 use tracelab::math::OffsetMode;
+use tracelab::radiosity::{FormFactorMethod, RadiositySolver};
 use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
 use tracelab::replay::replay_sample;
 use tracelab::sampling::{Domains, SamplerKind};
@@ -50,6 +51,20 @@ enum GlassShadowsArg {
 enum SeenEmittersArg {
     Exact,
     Sampled,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum SolverArg {
+    Jacobi,
+    GaussSeidel,
+    /// Progressive refinement (shooting).
+    Progressive,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum FormFactorArg {
+    Analytic,
+    RayCast,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -140,6 +155,26 @@ pub struct RenderArgs {
     /// scene's bounding-box diagonal (0: no limit).
     #[arg(long, default_value_t = 0.1)]
     ao_distance: f32,
+    /// Radiosity: the solver.
+    #[arg(long, value_enum, default_value = "gauss-seidel")]
+    solver: SolverArg,
+    /// Radiosity, progressive solver: add the ambient term to the display.
+    #[arg(long)]
+    ambient_term: bool,
+    /// Radiosity: sweeps (Jacobi, Gauss-Seidel) or shots (progressive) to
+    /// run; 0 runs until the solution stops changing.
+    #[arg(long, default_value_t = 0)]
+    iterations: u32,
+    /// Radiosity: longest element edge, as a fraction of the scene's diagonal.
+    #[arg(long, default_value_t = 0.1)]
+    patch_size: f32,
+    /// Radiosity: samples (point pairs or points) per element pair for form factors.
+    #[arg(long, default_value_t = 16)]
+    ff_rays: u32,
+    /// Radiosity: form factors by the point-to-polygon contour integral
+    /// times visibility (`analytic`) or by point pairs (`ray-cast`).
+    #[arg(long, value_enum, default_value = "analytic")]
+    ff_method: FormFactorArg,
     /// Path tracing and Whitted: run the general code, not the code
     /// specialised for the scene's features (to measure what that saves).
     #[arg(long)]
@@ -366,8 +401,10 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     let Some((out, format)) = output else {
         return Err(Error::new("--out FILE is required"));
     };
+    let solver = matches!(settings.integrator, Integrator::Solver(_));
     let session = Session::new(Arc::new(scene), settings)?;
     let stats = match (target_spp, args.rays_per_pixel) {
+        _ if solver => render_solver(&session)?,
         (Some(spp), _) => render_spp(&session, spp),
         (None, Some(rays)) => render_rays(&session, rays),
         (None, None) => render_time(&session, Duration::from_secs_f64(args.time.unwrap_or(1.0))),
@@ -421,6 +458,31 @@ pub(crate) fn progress_bar(len: u64, unit: &str) -> ProgressBar {
         ProgressStyle::with_template(&template).unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar
+}
+
+/// Runs a solver's steps until it converges (or reaches its step limit),
+/// in passes of 1, 2, 4, ... steps, each followed by an image of the solution.
+fn render_solver(session: &Session) -> Result<RenderStats> {
+    let bar = progress_bar(1, "steps");
+    let mut steps = 1;
+    loop {
+        if !session.render_pass(steps) {
+            break;
+        }
+        let stats = session.stats();
+        let Some(progress) = stats.solver else { break };
+        bar.set_message(format!("residual {:.2e}", progress.residual));
+        bar.set_position(progress.steps);
+        if progress.converged {
+            break;
+        }
+        steps = (steps * 2).min(64);
+    }
+    bar.finish_and_clear();
+    if let Some(e) = session.failure() {
+        return Err(e);
+    }
+    Ok(session.stats())
 }
 
 /// Renders exactly `spp` samples per pixel in passes small enough for a live progress bar.
@@ -477,6 +539,12 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
             args.ao_distance
         )));
     }
+    if !(args.patch_size > 0.0 && args.patch_size <= 1.0) || args.ff_rays == 0 {
+        return Err(Error::new(format!(
+            "--patch-size must be in (0, 1] (got {}) and --ff-rays at least 1 (got {})",
+            args.patch_size, args.ff_rays
+        )));
+    }
     if integrator_kind(args.integrator) == IntegratorKind::Mcrt
         && args.shadow_rays + args.glossy_rays == 0
     {
@@ -504,6 +572,19 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
         general: args.general,
         exact_seen_emitters: args.seen_emitters == SeenEmittersArg::Exact,
         ao_distance: args.ao_distance,
+        radiosity_solver: match args.solver {
+            SolverArg::Jacobi => RadiositySolver::Jacobi,
+            SolverArg::GaussSeidel => RadiositySolver::GaussSeidel,
+            SolverArg::Progressive => RadiositySolver::Progressive,
+        },
+        patch_size: args.patch_size,
+        form_factor_method: match args.ff_method {
+            FormFactorArg::Analytic => FormFactorMethod::Analytic,
+            FormFactorArg::RayCast => FormFactorMethod::RayCast,
+        },
+        form_factor_samples: args.ff_rays,
+        radiosity_ambient: args.ambient_term,
+        radiosity_iterations: args.iterations,
     })
 }
 

@@ -23,6 +23,7 @@ pub mod mcrt;
 pub mod mis;
 pub mod options;
 pub mod path;
+pub mod radiosity;
 pub mod whitted;
 
 pub use light::{LightTracer, Splat};
@@ -567,5 +568,7 @@ register_techniques! {
         Light(LightTracer) = "light", "Light tracing";
     }
     multi_pass {}
-    solver {}
+    solver {
+        Radiosity(radiosity::Radiosity) = "radiosity", "Radiosity";
+    }
 }

@@ -3,6 +3,7 @@
 //! [`super::Integrator`], each technique reading the fields it has.
 
 use super::{GlassShadows, IntegratorKind, MisHeuristic};
+use crate::radiosity::{FormFactorMethod, RadiositySolver};
 
 /// Which sampling strategies the path tracer uses for direct light.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
@@ -46,6 +47,16 @@ pub struct IntegratorOptions {
     /// Ambient occlusion: occluders count within this fraction of the
     /// scene's bounding-box diagonal (0: no limit).
     pub ao_distance: f32,
+    /// Radiosity: the solver, the longest element edge (fraction of the
+    /// scene's diagonal), how form factors are estimated and with how many
+    /// samples per pair, the ambient term (progressive), and the steps to
+    /// run (0: until converged).
+    pub radiosity_solver: RadiositySolver,
+    pub patch_size: f32,
+    pub form_factor_method: FormFactorMethod,
+    pub form_factor_samples: u32,
+    pub radiosity_ambient: bool,
+    pub radiosity_iterations: u32,
 }
 
 impl Default for IntegratorOptions {
@@ -64,6 +75,12 @@ impl Default for IntegratorOptions {
             general: false,
             exact_seen_emitters: true,
             ao_distance: 0.1,
+            radiosity_solver: RadiositySolver::GaussSeidel,
+            patch_size: 0.1,
+            form_factor_method: FormFactorMethod::Analytic,
+            form_factor_samples: 16,
+            radiosity_ambient: true,
+            radiosity_iterations: 0,
         }
     }
 }

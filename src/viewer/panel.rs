@@ -7,6 +7,7 @@ use super::settings::{CompareLayout, Config, ToneMap, ViewMode};
 use crate::integrator::{GlassShadows, IntegratorKind, MisHeuristic, Strategy};
 use crate::live::Lock;
 use crate::math::OffsetMode;
+use crate::radiosity::{FormFactorMethod, RadiositySolver};
 use crate::sampling::SamplerKind;
 use eframe::egui::{self, RichText};
 
@@ -141,7 +142,10 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
         IntegratorKind::Whitted => "Max specular depth",
         _ => "Max depth (bounces)",
     };
-    if options.kind != IntegratorKind::AmbientOcclusion {
+    if !matches!(
+        options.kind,
+        IntegratorKind::AmbientOcclusion | IntegratorKind::Radiosity
+    ) {
         ui.add(egui::Slider::new(&mut options.max_depth, 0..=32).text(depth_label));
     }
     match options.kind {
@@ -200,6 +204,40 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                         .text("Distance (of the scene's diagonal)"),
                 );
             }
+        }
+        IntegratorKind::Radiosity => {
+            ui.horizontal(|ui| {
+                ui.label("Solver");
+                for solver in RadiositySolver::ALL {
+                    ui.radio_value(&mut options.radiosity_solver, solver, solver.name());
+                }
+            });
+            if options.radiosity_solver == RadiositySolver::Progressive {
+                ui.checkbox(&mut options.radiosity_ambient, "Ambient term");
+            }
+            ui.add(
+                egui::Slider::new(&mut options.patch_size, 0.02..=0.5)
+                    .logarithmic(true)
+                    .text("Patch size (of the scene's diagonal)"),
+            );
+            ui.horizontal(|ui| {
+                ui.label("Form factors");
+                ui.radio_value(
+                    &mut options.form_factor_method,
+                    FormFactorMethod::Analytic,
+                    "Contour integral",
+                );
+                ui.radio_value(
+                    &mut options.form_factor_method,
+                    FormFactorMethod::RayCast,
+                    "Ray casting",
+                );
+            });
+            ui.add(
+                egui::Slider::new(&mut options.form_factor_samples, 1..=256)
+                    .logarithmic(true)
+                    .text("Samples per pair"),
+            );
         }
     }
     ui.horizontal_wrapped(|ui| {

@@ -1,0 +1,166 @@
+//! Form factors between elements. F_ij = (1/A_i) ∫_i ∫_j cos θ_i cos θ_j
+//! V / (π r²) dA_j dA_i, estimated two ways:
+//!
+//! - **ray casting**: n pairs of points (x on i, y on j), the point-to-point
+//!   kernel times the visibility of the segment, times A_j;
+//! - **analytic**: n points x on i, the unoccluded point-to-polygon form
+//!   factor of j from x by Lambert's contour integral, times the visibility
+//!   of one point of j.
+//!
+//! Points come from the renderer's stratified sampler warped onto the
+//! triangles; shadow rays leave and reach surfaces by their error bounds, so
+//! nothing depends on the scene's units.
+
+use super::mesh::Element;
+use crate::accel::Geometry;
+use crate::math::{gamma, ray_between};
+use crate::sampling::warp::square_to_uniform_triangle;
+use crate::sampling::{Sampler, SamplerKind};
+use glam::{Vec2, Vec3A};
+use std::f32::consts::PI;
+
+/// How form factors are estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FormFactorMethod {
+    /// Point-to-point kernel between n point pairs, with visibility.
+    RayCast,
+    /// Point-to-polygon contour integral at n points, times visibility.
+    #[default]
+    Analytic,
+}
+
+/// The unoccluded form factor from a differential area at `p` with unit
+/// normal `n` to the polygon `vertices` (either winding), clipped to the
+/// hemisphere above `p`: (1/2π) |Σ_edges n · γ_k|, γ_k the unit normal of
+/// the plane through p and the edge, times the angle the edge subtends.
+pub fn point_to_polygon(p: Vec3A, n: Vec3A, vertices: &[Vec3A]) -> f32 {
+    // Clip to n · (x - p) >= 0 (Sutherland–Hodgman against one plane).
+    let mut clipped = [Vec3A::ZERO; 8];
+    let mut count = 0;
+    for (k, &a) in vertices.iter().enumerate() {
+        let b = vertices[(k + 1) % vertices.len()];
+        let (da, db) = (n.dot(a - p), n.dot(b - p));
+        if da >= 0.0 && count < clipped.len() {
+            clipped[count] = a - p;
+            count += 1;
+        }
+        if (da >= 0.0) != (db >= 0.0) && count < clipped.len() {
+            let t = da / (da - db);
+            clipped[count] = a + t * (b - a) - p;
+            count += 1;
+        }
+    }
+    if count < 3 {
+        return 0.0;
+    }
+    let mut sum = 0.0f64;
+    for k in 0..count {
+        let (a, b) = (clipped[k], clipped[(k + 1) % count]);
+        let cross = a.cross(b);
+        let length = cross.length();
+        if length == 0.0 {
+            continue;
+        }
+        let angle = length.atan2(a.dot(b));
+        sum += (n.dot(cross) / length * angle) as f64;
+    }
+    (sum.abs() / (2.0 * std::f64::consts::PI)) as f32
+}
+
+/// A point of `element` and its rounding-error bound.
+#[inline]
+fn point_on(element: &Element, u: Vec2) -> (Vec3A, Vec3A) {
+    let b = square_to_uniform_triangle(u);
+    let [a, v1, v2] = element.vertices;
+    let (e1, e2) = (b.x * (v1 - a), b.y * (v2 - a));
+    (a + e1 + e2, gamma(7) * (a.abs() + e1.abs() + e2.abs()))
+}
+
+/// Whether `j` lies entirely behind `i`'s plane or `i` behind `j`'s (then
+/// F_ij = 0), measured relative to the elements' sizes.
+pub fn faces(i: &Element, j: &Element) -> bool {
+    let above = |from: &Element, to: &Element| {
+        let scale = from.area.sqrt().max(to.area.sqrt());
+        to.vertices
+            .iter()
+            .any(|v| from.normal.dot(*v - from.vertices[0]) > 1e-5 * scale)
+    };
+    above(i, j) && above(j, i)
+}
+
+/// F_ij with `n` samples; `key` decorrelates pairs. Returns the estimate and
+/// the shadow rays cast.
+pub fn element_to_element(
+    geometry: &Geometry,
+    i: &Element,
+    j: &Element,
+    method: FormFactorMethod,
+    n: u32,
+    key: u32,
+) -> (f32, u32) {
+    if !faces(i, j) {
+        return (0.0, 0);
+    }
+    let mut sampler = Sampler::new(SamplerKind::Stratified, 0x5eed, n);
+    let mut sum = 0.0f32;
+    let mut rays = 0;
+    for k in 0..n {
+        sampler.start(key, k);
+        let (x, x_error) = point_on(i, sampler.next_2d());
+        let (y, y_error) = point_on(j, sampler.next_2d());
+        let d = y - x;
+        let r2 = d.length_squared();
+        let value = match method {
+            FormFactorMethod::RayCast => {
+                let (cos_i, cos_j) = (i.normal.dot(d), -j.normal.dot(d));
+                if cos_i <= 0.0 || cos_j <= 0.0 || r2 == 0.0 {
+                    continue;
+                }
+                cos_i * cos_j / (PI * r2 * r2) * j.area
+            }
+            FormFactorMethod::Analytic => point_to_polygon(x, i.normal, &j.vertices),
+        };
+        if value == 0.0 {
+            continue;
+        }
+        rays += 1;
+        let ray = ray_between(x, x_error, i.normal, y, y_error, j.normal);
+        if !geometry.occluded(&ray) {
+            sum += value;
+        }
+    }
+    (sum / n as f32, rays)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_point_under_a_huge_square_sees_all_of_the_hemisphere() {
+        let big = 1e4;
+        let square = [
+            Vec3A::new(-big, -big, 1.0),
+            Vec3A::new(big, -big, 1.0),
+            Vec3A::new(big, big, 1.0),
+            Vec3A::new(-big, big, 1.0),
+        ];
+        let f = point_to_polygon(Vec3A::ZERO, Vec3A::Z, &square);
+        assert!((f - 1.0).abs() < 1e-3, "{f}");
+        // A disc of radius R at height h: R² / (h² + R²); a 64-gon is close.
+        let (r, h) = (1.0f32, 1.0f32);
+        let disc: Vec<Vec3A> = (0..64)
+            .map(|k| {
+                let a = k as f32 / 64.0 * 2.0 * PI;
+                Vec3A::new(r * a.cos(), r * a.sin(), h)
+            })
+            .collect();
+        let f = point_to_polygon(Vec3A::ZERO, Vec3A::Z, &disc);
+        let polygon_share = (64.0 / (2.0 * PI) * (2.0 * PI / 64.0).sin()) as f32;
+        assert!((f - 0.5 * polygon_share).abs() < 1e-3, "{f}");
+        // Behind the point: nothing.
+        let f = point_to_polygon(Vec3A::ZERO, -Vec3A::Z, &disc);
+        assert_eq!(f, 0.0);
+    }
+}

@@ -1,0 +1,11 @@
+//! Radiosity's building blocks: meshing diffuse surfaces into elements,
+//! form factors between elements, and the solvers of the linear system.
+//! The technique that renders with them is `crate::integrator::radiosity`.
+
+pub mod form_factor;
+pub mod mesh;
+pub mod solve;
+
+pub use form_factor::FormFactorMethod;
+pub use mesh::{Element, Mesh};
+pub use solve::{FormFactors, RadiositySolver, Solution};
