@@ -11,6 +11,8 @@ mod furnace;
 mod chi2;
 // The Monte Carlo lab's experiments meet their closed-form statements.
 mod lab;
+// Radiosity: form factors and a closed box against closed forms, at any scale.
+mod radiosity;
 // BSDF energy conservation, reciprocity and sample/eval/pdf consistency.
 mod bsdf;
 // Whitted by hand, MC ray tracing's ray count.

@@ -89,26 +89,32 @@ pub fn faces(i: &Element, j: &Element) -> bool {
     above(i, j) && above(j, i)
 }
 
-/// F_ij with `n` samples; `key` decorrelates pairs. Returns the estimate and
-/// the shadow rays cast.
+/// F_ij with `n` samples. The points on i depend on `key_i` only, so that
+/// every form factor of row i is estimated at the same points: with the
+/// contour integral, whose values at a point sum to 1 over a closed
+/// surrounding, the row sums of a closed scene are 1 to rounding. The
+/// points on j depend on `key_pair`. Returns the estimate and the shadow
+/// rays cast.
 pub fn element_to_element(
     geometry: &Geometry,
     i: &Element,
     j: &Element,
     method: FormFactorMethod,
     n: u32,
-    key: u32,
+    (key_i, key_pair): (u32, u32),
 ) -> (f32, u32) {
     if !faces(i, j) {
         return (0.0, 0);
     }
-    let mut sampler = Sampler::new(SamplerKind::Stratified, 0x5eed, n);
+    let mut on_i = Sampler::new(SamplerKind::Stratified, 0x5eed, n);
+    let mut on_j = Sampler::new(SamplerKind::Stratified, 0x5eed_0001, n);
     let mut sum = 0.0f32;
     let mut rays = 0;
     for k in 0..n {
-        sampler.start(key, k);
-        let (x, x_error) = point_on(i, sampler.next_2d());
-        let (y, y_error) = point_on(j, sampler.next_2d());
+        on_i.start(key_i, k);
+        on_j.start(key_pair, k);
+        let (x, x_error) = point_on(i, on_i.next_2d());
+        let (y, y_error) = point_on(j, on_j.next_2d());
         let d = y - x;
         let r2 = d.length_squared();
         let value = match method {

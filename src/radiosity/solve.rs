@@ -37,8 +37,9 @@ impl RadiositySolver {
     }
 }
 
-/// The form factors of every element pair, row-major, with F_ji from F_ij by
-/// reciprocity (A_i F_ij = A_j F_ji), so each pair is estimated once.
+/// The form factors of every element pair, row-major. Each row is estimated
+/// on its own (not filled in by reciprocity, A_i F_ij = A_j F_ji), so that
+/// it conserves energy: a closed scene's rows sum to 1.
 pub struct FormFactors {
     n: usize,
     values: Vec<f32>,
@@ -61,37 +62,31 @@ impl FormFactors {
     ) -> FormFactors {
         let elements = &mesh.elements;
         let n = elements.len();
-        let rows: Vec<(Vec<f32>, u64)> = (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let mut row = vec![0.0f32; n - i];
+        let mut values = vec![0.0f32; n * n];
+        let rays: u64 = values
+            .par_chunks_mut(n.max(1))
+            .enumerate()
+            .map(|(i, row)| {
                 let mut rays = 0u64;
-                for (k, j) in (i + 1..n).enumerate() {
-                    let key = (i * n + j) as u32;
-                    let (f, r) = element_to_element(
+                for (j, f) in row.iter_mut().enumerate() {
+                    if j == i {
+                        continue;
+                    }
+                    let keys = (i as u32, (i * n + j) as u32);
+                    let (fij, r) = element_to_element(
                         geometry,
                         &elements[i],
                         &elements[j],
                         method,
                         samples,
-                        key,
+                        keys,
                     );
-                    row[k + 1] = f;
+                    *f = fij;
                     rays += r as u64;
                 }
-                (row, rays)
+                rays
             })
-            .collect();
-        let mut values = vec![0.0f32; n * n];
-        let mut rays = 0;
-        for (i, (row, r)) in rows.into_iter().enumerate() {
-            rays += r;
-            for (k, f) in row.into_iter().enumerate().skip(1) {
-                let j = i + k;
-                values[i * n + j] = f;
-                values[j * n + i] = f * elements[i].area / elements[j].area;
-            }
-        }
+            .sum();
         FormFactors { n, values, rays }
     }
 
@@ -203,14 +198,13 @@ pub fn step(
             };
             let shot = s.unshot[shooter];
             s.unshot[shooter] = Rgb::ZERO;
-            let area = elements[shooter].area;
-            // L_j += ρ_j F_ji ΔL_i, with F_ji = F_ij A_i / A_j.
+            // L_j += ρ_j F_ji ΔL_i.
             for (j, e) in elements.iter().enumerate() {
-                let fij = f.get(shooter, j);
-                if fij == 0.0 {
+                let fji = f.get(j, shooter);
+                if fji == 0.0 {
                     continue;
                 }
-                let received = e.reflectance * shot * (fij * area / e.area);
+                let received = e.reflectance * shot * fji;
                 s.radiance[j] += received;
                 s.unshot[j] += received;
             }
