@@ -34,7 +34,10 @@ pub enum FormFactorMethod {
 /// normal `n` to the polygon `vertices` (either winding), clipped to the
 /// hemisphere above `p`: (1/2π) |Σ_edges n · γ_k|, γ_k the unit normal of
 /// the plane through p and the edge, times the angle the edge subtends.
+///
+/// Polygons of up to 7 vertices (elements are triangles, quads at most).
 pub fn point_to_polygon(p: Vec3A, n: Vec3A, vertices: &[Vec3A]) -> f32 {
+    debug_assert!(vertices.len() <= 7, "clipping keeps at most 8 vertices");
     // Clip to n · (x - p) >= 0 (Sutherland–Hodgman against one plane).
     let mut clipped = [Vec3A::ZERO; 8];
     let mut count = 0;
@@ -162,11 +165,22 @@ mod tests {
                 Vec3A::new(r * a.cos(), r * a.sin(), h)
             })
             .collect();
-        let f = point_to_polygon(Vec3A::ZERO, Vec3A::Z, &disc);
+        // As a fan of 64 triangles (form factors add over a partition).
+        let fan = |n: Vec3A| -> f32 {
+            (0..64)
+                .map(|k| {
+                    point_to_polygon(
+                        Vec3A::ZERO,
+                        n,
+                        &[Vec3A::new(0.0, 0.0, h), disc[k], disc[(k + 1) % 64]],
+                    )
+                })
+                .sum()
+        };
+        let f = fan(Vec3A::Z);
         let polygon_share = (64.0 / (2.0 * PI) * (2.0 * PI / 64.0).sin()) as f32;
         assert!((f - 0.5 * polygon_share).abs() < 1e-3, "{f}");
         // Behind the point: nothing.
-        let f = point_to_polygon(Vec3A::ZERO, -Vec3A::Z, &disc);
-        assert_eq!(f, 0.0);
+        assert_eq!(fan(-Vec3A::Z), 0.0);
     }
 }
