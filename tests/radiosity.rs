@@ -186,3 +186,32 @@ fn radiosity_refuses_what_it_cannot_solve() {
     let e = Mesh::build(&dark, 0.3, MAX_ELEMENTS).unwrap_err();
     assert!(e.contains("emissive"), "{e}");
 }
+
+#[test]
+fn the_ambient_term_shows_the_converged_level_early() {
+    // In a uniform closed box, Cohen's ambient term makes the displayed
+    // radiance E/(1 - ρ) = 2 exact before any shot, and the area-weighted
+    // mean stays close after a few (the unshot light is what the term
+    // spreads evenly); without it the display starts at E = 1.
+    let scene = closed_box(1.0, "radiosity-ambient");
+    for ambient in [false, true] {
+        let mut technique = radiosity(RadiositySolver::Progressive, 0.3);
+        technique.ambient = ambient;
+        let mut state = technique.init(&scene).unwrap();
+        let mut counts = Default::default();
+        technique.step(&scene, &mut state, 10, &mut counts);
+        let s = &state.solution;
+        let (mut sum, mut area) = (0.0f64, 0.0f64);
+        for (l, e) in s.radiance.iter().zip(&state.mesh.elements) {
+            sum += (l.x + e.reflectance.x * s.ambient.x) as f64 * e.area as f64;
+            area += e.area as f64;
+        }
+        let mean = sum / area;
+        eprintln!("ambient {ambient}: mean displayed radiance after 10 shots {mean:.4}");
+        if ambient {
+            assert!((mean - 2.0).abs() < 0.02, "{mean}");
+        } else {
+            assert!(mean < 1.2, "{mean}");
+        }
+    }
+}

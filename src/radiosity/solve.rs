@@ -96,6 +96,11 @@ impl FormFactors {
         self.values[i * self.n + j]
     }
 
+    /// Σ_j F_ij: the share of light leaving i that reaches other elements.
+    pub fn row_sum(&self, i: usize) -> f32 {
+        self.row(i).iter().sum()
+    }
+
     /// Row i: F_i0 .. F_i(n-1).
     #[inline]
     pub fn row(&self, i: usize) -> &[f32] {
@@ -214,7 +219,7 @@ pub fn step(
                 .map(|(e, u)| e.area as f64 * luminance(*u) as f64)
                 .sum();
             s.ambient = if ambient {
-                ambient_term(mesh, &s.unshot)
+                ambient_term(mesh, f, &s.unshot)
             } else {
                 Rgb::ZERO
             };
@@ -223,17 +228,22 @@ pub fn step(
     }
 }
 
-/// Cohen et al.'s ambient term: the area-weighted unshot radiance times
-/// the interreflection factor 1 / (1 - ρ_avg), ρ_avg the area-weighted mean
-/// reflectance.
-fn ambient_term(mesh: &Mesh, unshot: &[Rgb]) -> Rgb {
+/// Cohen et al.'s ambient term: the area-weighted unshot radiance, times
+/// the interreflection factor. Cohen's 1 / (1 - ρ_avg) assumes a closed
+/// scene, where all unshot light lands on some surface; in an open one (the
+/// Cornell box has no front wall) only the area-weighted mean form factor
+/// row sum f of it does, at each bounce: f / (1 - ρ_avg f). f = 1 gives
+/// Cohen's term.
+fn ambient_term(mesh: &Mesh, f: &FormFactors, unshot: &[Rgb]) -> Rgb {
     let total: f32 = mesh.elements.iter().map(|e| e.area).sum();
     let mut rho = Rgb::ZERO;
     let mut mean_unshot = Rgb::ZERO;
-    for (e, u) in mesh.elements.iter().zip(unshot) {
+    let mut enclosed = 0.0;
+    for (i, (e, u)) in mesh.elements.iter().zip(unshot).enumerate() {
         rho += e.reflectance * e.area;
         mean_unshot += *u * e.area;
+        enclosed += f.row_sum(i) * e.area;
     }
-    let rho = rho / total;
-    mean_unshot / total / (Rgb::ONE - rho).max(Rgb::splat(1e-3))
+    let (rho, enclosed) = (rho / total, enclosed / total);
+    mean_unshot / total * enclosed / (Rgb::ONE - rho * enclosed).max(Rgb::splat(1e-3))
 }
