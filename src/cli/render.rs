@@ -10,6 +10,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tracelab::film::{EXTREME_LUMINANCE, FinalImage, FlaggedPixel};
 use tracelab::image::check_writable;
+use tracelab::integrator::radiosity::RadiosityDisplay;
 use tracelab::integrator::{
     CameraIntegrator, GlassShadows, Integrator, IntegratorKind, IntegratorOptions, MisHeuristic,
     Strategy,
@@ -59,6 +60,13 @@ enum SolverArg {
     GaussSeidel,
     /// Progressive refinement (shooting).
     Progressive,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum DisplayArg {
+    Flat,
+    Smooth,
+    Gather,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -171,6 +179,10 @@ pub struct RenderArgs {
     /// Radiosity: samples (point pairs or points) per element pair for form factors.
     #[arg(long, default_value_t = 16)]
     ff_rays: u32,
+    /// Radiosity: how the solution is shown (`flat`, `smooth`, or `gather`:
+    /// direct light sampled, indirect read from the solution).
+    #[arg(long, value_enum, default_value = "gather")]
+    display: DisplayArg,
     /// Radiosity: form factors by the point-to-polygon contour integral
     /// times visibility (`analytic`) or by point pairs (`ray-cast`).
     #[arg(long, value_enum, default_value = "analytic")]
@@ -588,6 +600,11 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
         form_factor_samples: args.ff_rays,
         radiosity_ambient: args.ambient_term,
         radiosity_iterations: args.iterations,
+        radiosity_display: match args.display {
+            DisplayArg::Flat => RadiosityDisplay::Flat,
+            DisplayArg::Smooth => RadiosityDisplay::Smooth,
+            DisplayArg::Gather => RadiosityDisplay::Gather,
+        },
     })
 }
 

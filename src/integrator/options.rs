@@ -2,6 +2,7 @@
 //! both fill in; [`IntegratorOptions::build`] turns them into an
 //! [`super::Integrator`], each technique reading the fields it has.
 
+use super::radiosity::RadiosityDisplay;
 use super::{GlassShadows, IntegratorKind, MisHeuristic};
 use crate::radiosity::{FormFactorMethod, RadiositySolver};
 
@@ -57,6 +58,7 @@ pub struct IntegratorOptions {
     pub form_factor_samples: u32,
     pub radiosity_ambient: bool,
     pub radiosity_iterations: u32,
+    pub radiosity_display: RadiosityDisplay,
 }
 
 impl Default for IntegratorOptions {
@@ -81,6 +83,7 @@ impl Default for IntegratorOptions {
             form_factor_samples: 16,
             radiosity_ambient: true,
             radiosity_iterations: 0,
+            radiosity_display: RadiosityDisplay::Gather,
         }
     }
 }

@@ -9,14 +9,23 @@
 //! ambient term for display). A solver technique: each step is a sweep or a
 //! shot, after which the whole image is redrawn from the solution.
 //!
-//! Display (ray-cast, 16 camera rays per pixel): a camera ray reads the
-//! radiance of the element it hits first; mirrors and glass are traced from
-//! the camera until a diffuse surface (the classic two-pass combination), so
-//! caustics are missing.
+//! Display (16 camera rays per pixel; mirrors and glass are traced from the
+//! camera until a diffuse surface, the classic two-pass combination, so
+//! caustics are missing), at the first diffuse hit:
+//!
+//! - `flat`: the radiance of the element hit;
+//! - `smooth`: interpolated from the element's vertices, each the
+//!   area-weighted mean of the elements that share it on the same plane;
+//! - `gather`: emitted light, direct light by light sampling (one shadow
+//!   ray), and indirect light by one cosine-sampled ray that reads L - E of
+//!   the element it lands on: path tracing's first bounce with the mesh's
+//!   solution in place of the rest, so it agrees with path tracing up to
+//!   the mesh's error in the indirect term.
 
 use super::{IntegratorOptions, RayCounts, Solver, SolverProgress, Technique};
 use crate::math::{Frame, Ray, Rgb};
 use crate::radiosity::{FormFactorMethod, FormFactors, Mesh, RadiositySolver, Solution, solve};
+use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
@@ -39,6 +48,36 @@ pub struct Radiosity {
     pub ambient: bool,
     /// Stop after this many steps (0: when converged).
     pub iterations: u32,
+    pub display: RadiosityDisplay,
+}
+
+/// How the solution is shown.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RadiosityDisplay {
+    /// Each element's constant radiance.
+    Flat,
+    /// Radiance interpolated from the elements' vertices.
+    Smooth,
+    /// Direct light sampled, indirect gathered from the solution.
+    #[default]
+    Gather,
+}
+
+impl RadiosityDisplay {
+    pub const ALL: [RadiosityDisplay; 3] = [
+        RadiosityDisplay::Flat,
+        RadiosityDisplay::Smooth,
+        RadiosityDisplay::Gather,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            RadiosityDisplay::Flat => "flat",
+            RadiosityDisplay::Smooth => "smooth",
+            RadiosityDisplay::Gather => "gather",
+        }
+    }
 }
 
 impl Technique for Radiosity {
@@ -52,12 +91,13 @@ impl Technique for Radiosity {
             form_factor_samples: options.form_factor_samples.max(1),
             ambient: options.radiosity_ambient,
             iterations: options.radiosity_iterations,
+            display: options.radiosity_display,
         }
     }
 
     fn describe(&self) -> String {
         format!(
-            "radiosity ({}{}, patch size {}, form factors {:?} x {})",
+            "radiosity ({}{}, patch size {}, form factors {:?} x {}, {} display)",
             self.solver.name(),
             if self.solver == RadiositySolver::Progressive && self.ambient {
                 " + ambient"
@@ -66,7 +106,8 @@ impl Technique for Radiosity {
             },
             self.patch_size,
             self.form_factors,
-            self.form_factor_samples
+            self.form_factor_samples,
+            self.display.name()
         )
     }
 }
@@ -76,6 +117,8 @@ pub struct RadiosityState {
     pub mesh: Mesh,
     pub form_factors: FormFactors,
     pub solution: Solution,
+    /// Smooth display: per element, its three vertices' radiance.
+    vertex_radiance: Vec<[Rgb; 3]>,
     residual: f64,
 }
 
@@ -94,12 +137,18 @@ impl Solver for Radiosity {
             self.form_factor_samples,
         );
         let solution = Solution::new(&mesh);
-        Ok(RadiosityState {
+        let vertex_radiance = vec![[Rgb::ZERO; 3]; mesh.elements.len()];
+        let mut state = RadiosityState {
             mesh,
             form_factors,
             solution,
+            vertex_radiance,
             residual: 1.0,
-        })
+        };
+        if self.display == RadiosityDisplay::Smooth {
+            state.vertex_radiance = state.mesh.vertex_average(&state.solution.radiance);
+        }
+        Ok(state)
     }
 
     fn step(
@@ -129,6 +178,9 @@ impl Solver for Radiosity {
                 &mut state.solution,
                 self.ambient,
             );
+        }
+        if self.display == RadiosityDisplay::Smooth {
+            state.vertex_radiance = state.mesh.vertex_average(&state.solution.radiance);
         }
         SolverProgress {
             steps: state.solution.steps,
@@ -167,17 +219,40 @@ impl Solver for Radiosity {
                     ray = hit.spawn_ray(frame.to_world(s.wi));
                 }
                 _ => {
-                    let Some(element) = element_hit(scene, state, &hit) else {
+                    let Some((element, b)) = element_hit(scene, state, &hit) else {
                         // Spheres are not patches: their own emission only.
                         return weight * material.emitted(hit.normal, -ray.direction);
                     };
                     let e = &state.mesh.elements[element];
-                    let mut radiance = state.solution.radiance[element];
-                    // One-sided emitters are dark from behind.
-                    if e.normal.dot(ray.direction) > 0.0 {
-                        radiance -= e.emission;
-                    }
-                    return weight * (radiance + e.reflectance * state.solution.ambient);
+                    let seen_emission = if e.normal.dot(ray.direction) < 0.0 {
+                        e.emission
+                    } else {
+                        Rgb::ZERO
+                    };
+                    let ambient = e.reflectance * state.solution.ambient;
+                    let reflected = match self.display {
+                        RadiosityDisplay::Flat => state.solution.radiance[element] - e.emission,
+                        RadiosityDisplay::Smooth => {
+                            let [l0, l1, l2] = state.vertex_radiance[element];
+                            ((1.0 - b.x - b.y) * l0 + b.x * l1 + b.y * l2 - e.emission)
+                                .max(Rgb::ZERO)
+                        }
+                        RadiosityDisplay::Gather => {
+                            return weight
+                                * (seen_emission
+                                    + gather(
+                                        scene,
+                                        state,
+                                        &hit,
+                                        e.reflectance,
+                                        -ray.direction,
+                                        sampler,
+                                        counts,
+                                    )
+                                    + ambient);
+                        }
+                    };
+                    return weight * (seen_emission + reflected + ambient);
                 }
             }
         }
@@ -189,22 +264,78 @@ impl Solver for Radiosity {
     }
 }
 
-/// The element a camera ray's hit lies in (None for spheres).
+/// The element a hit lies in (None for spheres and non-patches), and the
+/// hit's barycentrics in that element.
 fn element_hit(
     scene: &Scene,
     state: &RadiosityState,
     hit: &crate::accel::SurfaceHit,
-) -> Option<usize> {
+) -> Option<(usize, glam::Vec2)> {
     let triangle = hit.primitive as usize;
     let [a, b, c] = *scene.geometry.triangles().get(triangle)?;
-    // Barycentrics by the areas of the sub-triangles (in the plane).
-    let n = (b - a).cross(c - a);
-    let inv = 1.0 / n.length_squared();
-    let b1 = (hit.point - a).cross(c - a).dot(n) * inv;
-    let b2 = (b - a).cross(hit.point - a).dot(n) * inv;
-    state.mesh.element_at(
+    let (b1, b2) = barycentrics(hit.point, [a, b, c]);
+    let element = state.mesh.element_at(
         triangle,
         b1.clamp(0.0, 1.0),
         b2.clamp(0.0, 1.0 - b1.clamp(0.0, 1.0)),
+    )?;
+    let (e1, e2) = barycentrics(hit.point, state.mesh.elements[element].vertices);
+    Some((element, glam::Vec2::new(e1, e2)))
+}
+
+/// Barycentrics (b1, b2) of `p` in the triangle `v`, by sub-triangle areas.
+fn barycentrics(p: glam::Vec3A, [a, b, c]: [glam::Vec3A; 3]) -> (f32, f32) {
+    let n = (b - a).cross(c - a);
+    let inv = 1.0 / n.length_squared();
+    (
+        (p - a).cross(c - a).dot(n) * inv,
+        (b - a).cross(p - a).dot(n) * inv,
     )
+}
+
+/// Reflected radiance at a diffuse hit: direct light by one light sample,
+/// indirect by one cosine-sampled ray reading the solution (L - E) where it lands.
+fn gather(
+    scene: &Scene,
+    state: &RadiosityState,
+    hit: &crate::accel::SurfaceHit,
+    reflectance: Rgb,
+    wo: glam::Vec3A,
+    sampler: &mut Sampler,
+    counts: &mut RayCounts,
+) -> Rgb {
+    // The side the camera ray came from.
+    let normal = if hit.normal.dot(wo) < 0.0 {
+        -hit.normal
+    } else {
+        hit.normal
+    };
+    let mut direct = Rgb::ZERO;
+    let u_select = sampler.next_1d_for(Domain::Light);
+    let u_light = sampler.next_2d_for(Domain::Light);
+    if let Some(ls) = scene.lights.sample(hit.point, u_select, u_light) {
+        let cos = normal.dot(ls.wi);
+        if cos > 0.0 {
+            counts.shadow += 1;
+            if !scene.geometry.occluded(&super::path::shadow_ray(hit, &ls)) {
+                // f = ρ/π (Lambert).
+                direct = reflectance * ls.radiance * (cos / (std::f32::consts::PI * ls.pdf));
+            }
+        }
+    }
+    let local = square_to_cosine_hemisphere(sampler.next_2d_for(Domain::Bsdf));
+    let ray = hit.spawn_ray(Frame::from_normal(normal).to_world(local));
+    counts.bounce += 1;
+    let indirect = match scene.geometry.intersect(&ray) {
+        Some(next) => match element_hit(scene, state, &next) {
+            Some((element, _)) => {
+                let e = &state.mesh.elements[element];
+                state.solution.radiance[element] - e.emission
+            }
+            None => Rgb::ZERO,
+        },
+        None => Rgb::ZERO,
+    };
+    // Cosine sampling: f cos / p = ρ.
+    direct + reflectance * indirect
 }

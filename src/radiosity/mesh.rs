@@ -155,6 +155,36 @@ impl Mesh {
         Ok(mesh)
     }
 
+    /// Per element, the radiance at its three vertices: the area-weighted
+    /// mean of `radiance` over the elements that share the vertex (same
+    /// position, exactly: midpoints are computed alike on both sides of an
+    /// edge) and lie in the same plane, so that walls meeting at a corner
+    /// keep their own values.
+    pub fn vertex_average(&self, radiance: &[Rgb]) -> Vec<[Rgb; 3]> {
+        use std::collections::HashMap;
+        let key = |v: Vec3A, n: Vec3A| {
+            let q = |x: f32| (x * 1024.0).round() as i32;
+            (v.to_array().map(f32::to_bits), [q(n.x), q(n.y), q(n.z)])
+        };
+        let mut sums: HashMap<_, (Rgb, f32)> = HashMap::with_capacity(self.elements.len() * 2);
+        for (e, l) in self.elements.iter().zip(radiance) {
+            for v in e.vertices {
+                let entry = sums.entry(key(v, e.normal)).or_insert((Rgb::ZERO, 0.0));
+                entry.0 += *l * e.area;
+                entry.1 += e.area;
+            }
+        }
+        self.elements
+            .iter()
+            .map(|e| {
+                e.vertices.map(|v| {
+                    let (sum, area) = sums[&key(v, e.normal)];
+                    sum / area
+                })
+            })
+            .collect()
+    }
+
     /// The element of scene triangle `triangle` that contains the point at
     /// barycentrics (b1, b2) of the triangle, if the triangle is a patch.
     pub fn element_at(&self, triangle: usize, b1: f32, b2: f32) -> Option<usize> {

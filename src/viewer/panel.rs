@@ -4,6 +4,7 @@
 
 use super::app::ViewerApp;
 use super::settings::{CompareLayout, Config, ToneMap, ViewMode};
+use crate::integrator::radiosity::RadiosityDisplay;
 use crate::integrator::{GlassShadows, IntegratorKind, MisHeuristic, Strategy};
 use crate::live::Lock;
 use crate::math::OffsetMode;
@@ -232,6 +233,12 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                     FormFactorMethod::RayCast,
                     "Ray casting",
                 );
+            });
+            ui.horizontal(|ui| {
+                ui.label("Display");
+                for display in RadiosityDisplay::ALL {
+                    ui.radio_value(&mut options.radiosity_display, display, display.name());
+                }
             });
             ui.add(
                 egui::Slider::new(&mut options.form_factor_samples, 1..=256)
