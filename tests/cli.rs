@@ -603,3 +603,63 @@ fn lab_prints_tables_writes_csv_and_plots_and_refuses_bad_names() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("point-sets"));
 }
+
+#[test]
+fn radiosity_reports_rows_and_refuses_bad_input() {
+    let dir = temp_dir("radiosity-cli");
+    let csv = dir.join("rows.csv");
+    let o = tracelab(&[
+        "radiosity",
+        repo_path("scenes/cornell_box.toml").to_str().unwrap(),
+        "--reference",
+        repo_path("tests/data/cornell_box_path_ref.exr")
+            .to_str()
+            .unwrap(),
+        "--patch-size",
+        "0.3",
+        "--ff-rays",
+        "4",
+        "--display",
+        "smooth",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let rows = std::fs::read_to_string(&csv).unwrap();
+    assert!(rows.starts_with("steps,elements,links,"), "{rows}");
+    // Gauss-Seidel converges in a few sweeps; each row's masked RMSE is a number.
+    let last = rows.lines().last().unwrap();
+    let masked: f64 = last.rsplit(',').next().unwrap().parse().unwrap();
+    assert!(masked > 0.0 && masked < 0.05, "{last}");
+    // A scene without diffuse emitters, a patch size out of range.
+    let dark = scene_dir(
+        "radiosity-dark",
+        &[(
+            "dark.toml",
+            &format!(
+                "{CAMERA}[materials.white]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\n\
+                 [[quad]]\ncorner = [-1, 0, -1]\nu = [2, 0, 0]\nv = [0, 0, 2]\nmaterial = \"white\"\n"
+            ),
+        )],
+    );
+    let o = tracelab(&[
+        "render",
+        dark.join("dark.toml").to_str().unwrap(),
+        "--integrator",
+        "radiosity",
+        "--out",
+        dark.join("x.exr").to_str().unwrap(),
+    ]);
+    assert_fails(&o, 1, &["emissive"]);
+    let o = tracelab(&[
+        "render",
+        repo_path("scenes/cornell_box.toml").to_str().unwrap(),
+        "--integrator",
+        "radiosity",
+        "--patch-size",
+        "0",
+        "--out",
+        dark.join("y.exr").to_str().unwrap(),
+    ]);
+    assert_fails(&o, 1, &["--patch-size"]);
+}

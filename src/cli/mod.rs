@@ -3,6 +3,7 @@
 
 mod bench;
 mod lab;
+mod radiosity;
 mod render;
 mod stress;
 
@@ -37,6 +38,9 @@ enum Command {
     /// importance sampling, point sets and warps; prints a table and checks,
     /// writes CSV and plots.
     Lab(lab::LabArgs),
+    /// Radiosity step by step against a reference: elements, links, rays,
+    /// seconds, residual and RMSE per row; CSV and a plot.
+    Radiosity(radiosity::RadiosityArgs),
     /// Compare two images: RMSE, relative MSE and mean relative error (as tev computes them).
     Compare {
         /// The image to measure.
@@ -114,6 +118,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Bench(args)) => bench::bench(&args),
         Some(Command::Stress(args)) => stress::stress(&args),
         Some(Command::Lab(args)) => lab::lab(&args),
+        Some(Command::Radiosity(args)) => radiosity::radiosity(&args),
         #[cfg(feature = "viewer")]
         Some(Command::View(args)) => view(args),
         #[cfg(feature = "viewer")]

@@ -1,6 +1,7 @@
 //! `tracelab render`: one image from the command line, with a progress bar
 //! and a summary of what it cost; `--debug-sample` replays one path.
 
+use super::radiosity::RadiosityFlags;
 use super::{IntegratorArg, integrator_kind};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -10,13 +11,11 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tracelab::film::{EXTREME_LUMINANCE, FinalImage, FlaggedPixel};
 use tracelab::image::check_writable;
-use tracelab::integrator::radiosity::RadiosityDisplay;
 use tracelab::integrator::{
     CameraIntegrator, GlassShadows, Integrator, IntegratorKind, IntegratorOptions, MisHeuristic,
     Strategy,
 };
 use tracelab::math::OffsetMode;
-use tracelab::radiosity::{FormFactorMethod, RadiositySolver};
 use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
 use tracelab::replay::replay_sample;
 use tracelab::sampling::{Domains, SamplerKind};
@@ -52,27 +51,6 @@ enum GlassShadowsArg {
 enum SeenEmittersArg {
     Exact,
     Sampled,
-}
-
-#[derive(ValueEnum, Clone, Copy, Debug)]
-enum SolverArg {
-    Jacobi,
-    GaussSeidel,
-    /// Progressive refinement (shooting).
-    Progressive,
-}
-
-#[derive(ValueEnum, Clone, Copy, Debug)]
-enum DisplayArg {
-    Flat,
-    Smooth,
-    Gather,
-}
-
-#[derive(ValueEnum, Clone, Copy, Debug)]
-enum FormFactorArg {
-    Analytic,
-    RayCast,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -163,30 +141,8 @@ pub struct RenderArgs {
     /// scene's bounding-box diagonal (0: no limit).
     #[arg(long, default_value_t = 0.1)]
     ao_distance: f32,
-    /// Radiosity: the solver.
-    #[arg(long, value_enum, default_value = "gauss-seidel")]
-    solver: SolverArg,
-    /// Radiosity, progressive solver: add the ambient term to the display.
-    #[arg(long)]
-    ambient_term: bool,
-    /// Radiosity: sweeps (Jacobi, Gauss-Seidel) or shots (progressive) to
-    /// run; 0 runs until the solution stops changing.
-    #[arg(long, default_value_t = 0)]
-    iterations: u32,
-    /// Radiosity: longest element edge, as a fraction of the scene's diagonal.
-    #[arg(long, default_value_t = 0.1)]
-    patch_size: f32,
-    /// Radiosity: samples (point pairs or points) per element pair for form factors.
-    #[arg(long, default_value_t = 16)]
-    ff_rays: u32,
-    /// Radiosity: how the solution is shown (`flat`, `smooth`, or `gather`:
-    /// direct light sampled, indirect read from the solution).
-    #[arg(long, value_enum, default_value = "gather")]
-    display: DisplayArg,
-    /// Radiosity: form factors by the point-to-polygon contour integral
-    /// times visibility (`analytic`) or by point pairs (`ray-cast`).
-    #[arg(long, value_enum, default_value = "analytic")]
-    ff_method: FormFactorArg,
+    #[command(flatten)]
+    pub(crate) radiosity: RadiosityFlags,
     /// Path tracing and Whitted: run the general code, not the code
     /// specialised for the scene's features (to measure what that saves).
     #[arg(long)]
@@ -554,12 +510,7 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
             args.ao_distance
         )));
     }
-    if !(args.patch_size > 0.0 && args.patch_size <= 1.0) || args.ff_rays == 0 {
-        return Err(Error::new(format!(
-            "--patch-size must be in (0, 1] (got {}) and --ff-rays at least 1 (got {})",
-            args.patch_size, args.ff_rays
-        )));
-    }
+    args.radiosity.check()?;
     if integrator_kind(args.integrator) == IntegratorKind::Mcrt
         && args.shadow_rays + args.glossy_rays == 0
     {
@@ -587,24 +538,7 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
         general: args.general,
         exact_seen_emitters: args.seen_emitters == SeenEmittersArg::Exact,
         ao_distance: args.ao_distance,
-        radiosity_solver: match args.solver {
-            SolverArg::Jacobi => RadiositySolver::Jacobi,
-            SolverArg::GaussSeidel => RadiositySolver::GaussSeidel,
-            SolverArg::Progressive => RadiositySolver::Progressive,
-        },
-        patch_size: args.patch_size,
-        form_factor_method: match args.ff_method {
-            FormFactorArg::Analytic => FormFactorMethod::Analytic,
-            FormFactorArg::RayCast => FormFactorMethod::RayCast,
-        },
-        form_factor_samples: args.ff_rays,
-        radiosity_ambient: args.ambient_term,
-        radiosity_iterations: args.iterations,
-        radiosity_display: match args.display {
-            DisplayArg::Flat => RadiosityDisplay::Flat,
-            DisplayArg::Smooth => RadiosityDisplay::Smooth,
-            DisplayArg::Gather => RadiosityDisplay::Gather,
-        },
+        ..args.radiosity.options()
     })
 }
 

@@ -1,0 +1,269 @@
+//! Radiosity on the command line: the flags `render` and `radiosity` share,
+//! and `tracelab radiosity SCENE --reference REF.exr`, which prints one row
+//! per iteration (elements, links, rays, seconds, unshot or changed power,
+//! RMSE against the reference with and without the pixels that see lights)
+//! and writes them as CSV and a plot.
+
+use super::render::override_resolution;
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+use std::sync::Arc;
+use tracelab::image::{Image, check_writable};
+use tracelab::integrator::radiosity::{MAX_ELEMENTS, RadiosityDisplay};
+use tracelab::integrator::{IntegratorKind, IntegratorOptions};
+use tracelab::plot::{PlotFormat, Series, SeriesStyle, log_log_plot};
+use tracelab::radiosity::{FormFactorMethod, FormFactors, Mesh, RadiositySolver};
+use tracelab::render::{RenderSettings, Session};
+use tracelab::sampling::SamplerKind;
+use tracelab::scene::{Limits, Scene};
+use tracelab::{Error, Result};
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum SolverArg {
+    Jacobi,
+    GaussSeidel,
+    /// Progressive refinement (shooting).
+    Progressive,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum DisplayArg {
+    Flat,
+    Smooth,
+    Gather,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum FormFactorArg {
+    Analytic,
+    RayCast,
+}
+
+/// The radiosity technique's flags.
+#[derive(Args, Debug)]
+pub struct RadiosityFlags {
+    /// Radiosity: the solver.
+    #[arg(long, value_enum, default_value = "gauss-seidel")]
+    solver: SolverArg,
+    /// Radiosity, progressive solver: add the ambient term to the display.
+    #[arg(long)]
+    ambient_term: bool,
+    /// Radiosity: sweeps (Jacobi, Gauss-Seidel) or shots (progressive) to
+    /// run; 0 runs until the solution stops changing.
+    #[arg(long, default_value_t = 0)]
+    iterations: u32,
+    /// Radiosity: longest element edge, as a fraction of the scene's diagonal.
+    #[arg(long, default_value_t = 0.1)]
+    patch_size: f32,
+    /// Radiosity: samples (point pairs or points) per element pair for form factors.
+    #[arg(long, default_value_t = 16)]
+    ff_rays: u32,
+    /// Radiosity: how the solution is shown (`flat`, `smooth`, or `gather`:
+    /// direct light sampled, indirect read from the solution).
+    #[arg(long, value_enum, default_value = "gather")]
+    display: DisplayArg,
+    /// Radiosity: form factors by the point-to-polygon contour integral
+    /// times visibility (`analytic`) or by point pairs (`ray-cast`).
+    #[arg(long, value_enum, default_value = "analytic")]
+    ff_method: FormFactorArg,
+}
+
+impl RadiosityFlags {
+    /// Default options with the radiosity fields from the flags.
+    pub fn options(&self) -> IntegratorOptions {
+        IntegratorOptions {
+            radiosity_solver: match self.solver {
+                SolverArg::Jacobi => RadiositySolver::Jacobi,
+                SolverArg::GaussSeidel => RadiositySolver::GaussSeidel,
+                SolverArg::Progressive => RadiositySolver::Progressive,
+            },
+            patch_size: self.patch_size,
+            form_factor_method: match self.ff_method {
+                FormFactorArg::Analytic => FormFactorMethod::Analytic,
+                FormFactorArg::RayCast => FormFactorMethod::RayCast,
+            },
+            form_factor_samples: self.ff_rays,
+            radiosity_ambient: self.ambient_term,
+            radiosity_iterations: self.iterations,
+            radiosity_display: match self.display {
+                DisplayArg::Flat => RadiosityDisplay::Flat,
+                DisplayArg::Smooth => RadiosityDisplay::Smooth,
+                DisplayArg::Gather => RadiosityDisplay::Gather,
+            },
+            ..IntegratorOptions::default()
+        }
+    }
+
+    /// Refuses sizes and counts that mean nothing.
+    pub fn check(&self) -> Result<()> {
+        if !(self.patch_size > 0.0 && self.patch_size <= 1.0) || self.ff_rays == 0 {
+            return Err(Error::new(format!(
+                "--patch-size must be in (0, 1] (got {}) and --ff-rays at least 1 (got {})",
+                self.patch_size, self.ff_rays
+            )));
+        }
+        Ok(())
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct RadiosityArgs {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// The image to measure against (EXR, the scene's resolution).
+    #[arg(long)]
+    reference: PathBuf,
+    /// Write the rows here (CSV).
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Plot RMSE and residual against steps here (.svg or .png).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Render threads (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Reference pixels brighter than this (any channel) see a light and
+    /// are left out of the masked RMSE.
+    #[arg(long, default_value_t = 1.0)]
+    mask_above: f32,
+    #[command(flatten)]
+    radiosity: RadiosityFlags,
+}
+
+/// RMSE of `image` against `reference` over all pixels, and over those
+/// whose reference stays at or below `mask_above`.
+fn rmse(image: &Image, reference: &Image, mask_above: f32) -> (f64, f64, usize) {
+    let (mut all, mut masked, mut kept) = (0.0f64, 0.0f64, 0usize);
+    for (p, r) in image.pixels.iter().zip(&reference.pixels) {
+        let e: f64 = (0..3).map(|c| ((p[c] - r[c]) as f64).powi(2)).sum::<f64>() / 3.0;
+        all += e;
+        if r.iter().all(|&v| v <= mask_above) {
+            masked += e;
+            kept += 1;
+        }
+    }
+    let n = image.pixels.len().max(1) as f64;
+    ((all / n).sqrt(), (masked / kept.max(1) as f64).sqrt(), kept)
+}
+
+pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
+    args.radiosity.check()?;
+    for path in [&args.csv, &args.plot].into_iter().flatten() {
+        check_writable(path)?;
+    }
+    if let Some(plot) = &args.plot {
+        PlotFormat::of(plot)?;
+    }
+    let limits = Limits::default();
+    let mut scene = Scene::load_with_limits(&args.scene, &limits)?;
+    let reference = Image::read(&args.reference)?;
+    override_resolution(
+        &mut scene,
+        Some(reference.width),
+        Some(reference.height),
+        &limits,
+    )?;
+    let options = IntegratorOptions {
+        kind: IntegratorKind::Radiosity,
+        ..args.radiosity.options()
+    };
+    // The same mesh the solver builds, for its counts.
+    let mesh = Mesh::build(&scene, options.patch_size, MAX_ELEMENTS).map_err(Error::new)?;
+    for note in &mesh.notes {
+        eprintln!("note: {note}");
+    }
+    let elements = mesh.elements.len();
+    let settings = RenderSettings {
+        integrator: options.build(),
+        sampler: SamplerKind::Independent,
+        seed: 0,
+        planned_spp: 0,
+        threads: args.threads,
+        adaptive: None,
+        domains: Default::default(),
+        clamp: None,
+    };
+    let session = Session::new(Arc::new(scene), settings)?;
+    println!(
+        "{:>7} {:>9} {:>11} {:>9} {:>9} {:>11} {:>9} {:>13}",
+        "steps", "elements", "links", "rays M", "seconds", "residual", "RMSE", "masked RMSE"
+    );
+    let links = elements as u64 * (elements as u64 - 1);
+    let mut rows = Vec::new();
+    let mut k = 1;
+    loop {
+        if !session.render_pass(k) {
+            break;
+        }
+        let stats = session.stats();
+        let Some(progress) = stats.solver else { break };
+        let (all, masked, _) = rmse(&session.snapshot().image, &reference, args.mask_above);
+        let seconds = stats.render_time.as_secs_f64();
+        println!(
+            "{:>7} {:>9} {:>11} {:>9.2} {:>9.3} {:>11.3e} {:>9.5} {:>13.5}",
+            progress.steps,
+            elements,
+            links,
+            stats.rays.shadow as f64 * 1e-6,
+            seconds,
+            progress.residual,
+            all,
+            masked
+        );
+        rows.push((
+            progress.steps,
+            stats.rays.shadow,
+            seconds,
+            progress.residual,
+            all,
+            masked,
+        ));
+        if progress.converged {
+            break;
+        }
+        k = (progress.steps as u32).max(1);
+    }
+    if let Some(e) = session.failure() {
+        return Err(e);
+    }
+    println!(
+        "form factor matrix: {:.1} MB ({elements} elements, every pair a link)",
+        FormFactors::bytes(elements) as f64 / 1e6
+    );
+    if let Some(path) = &args.csv {
+        let mut text =
+            String::from("steps,elements,links,shadow_rays,seconds,residual,rmse,masked_rmse\n");
+        for (steps, rays, seconds, residual, all, masked) in &rows {
+            text.push_str(&format!(
+                "{steps},{elements},{links},{rays},{seconds},{residual},{all},{masked}\n"
+            ));
+        }
+        tracelab::image::write_atomically(path, |tmp| {
+            std::fs::write(tmp, &text).map_err(|e| e.to_string())
+        })?;
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.plot {
+        let series = [
+            (
+                "masked RMSE",
+                rows.iter().map(|r| (r.0 as f64, r.5)).collect::<Vec<_>>(),
+            ),
+            ("residual", rows.iter().map(|r| (r.0 as f64, r.3)).collect()),
+        ];
+        let series: Vec<Series> = series
+            .iter()
+            .enumerate()
+            .map(|(i, (name, points))| Series::new(name, SeriesStyle::Line, i, points))
+            .collect();
+        log_log_plot(
+            path,
+            "Radiosity: error against steps",
+            "steps",
+            "RMSE / residual",
+            &series,
+        )?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
