@@ -9,10 +9,10 @@ use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::sync::Arc;
 use tracelab::image::{Image, check_writable};
-use tracelab::integrator::radiosity::{MAX_ELEMENTS, RadiosityDisplay};
+use tracelab::integrator::radiosity::RadiosityDisplay;
 use tracelab::integrator::{IntegratorKind, IntegratorOptions};
 use tracelab::plot::{PlotFormat, Series, SeriesStyle, log_log_plot};
-use tracelab::radiosity::{FormFactorMethod, FormFactors, Mesh, RadiositySolver};
+use tracelab::radiosity::{FormFactorMethod, FormFactors, RadiositySolver};
 use tracelab::render::{RenderSettings, Session};
 use tracelab::sampling::SamplerKind;
 use tracelab::scene::{Limits, Scene};
@@ -24,6 +24,8 @@ enum SolverArg {
     GaussSeidel,
     /// Progressive refinement (shooting).
     Progressive,
+    /// Hierarchical radiosity (links refined by the BF oracle).
+    Hierarchical,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -52,9 +54,14 @@ pub struct RadiosityFlags {
     /// run; 0 runs until the solution stops changing.
     #[arg(long, default_value_t = 0)]
     iterations: u32,
-    /// Radiosity: longest element edge, as a fraction of the scene's diagonal.
+    /// Radiosity: longest element edge (the smallest one, hierarchical),
+    /// as a fraction of the scene's diagonal.
     #[arg(long, default_value_t = 0.1)]
     patch_size: f32,
+    /// Radiosity, hierarchical: a link may carry at most this share of the
+    /// emitted power (smaller: more links, more accuracy, more time).
+    #[arg(long, default_value_t = 1e-4)]
+    epsilon: f32,
     /// Radiosity: samples (point pairs or points) per element pair for form factors.
     #[arg(long, default_value_t = 16)]
     ff_rays: u32,
@@ -76,7 +83,9 @@ impl RadiosityFlags {
                 SolverArg::Jacobi => RadiositySolver::Jacobi,
                 SolverArg::GaussSeidel => RadiositySolver::GaussSeidel,
                 SolverArg::Progressive => RadiositySolver::Progressive,
+                SolverArg::Hierarchical => RadiositySolver::Hierarchical,
             },
+            radiosity_epsilon: self.epsilon,
             patch_size: self.patch_size,
             form_factor_method: match self.ff_method {
                 FormFactorArg::Analytic => FormFactorMethod::Analytic,
@@ -96,6 +105,12 @@ impl RadiosityFlags {
 
     /// Refuses sizes and counts that mean nothing.
     pub fn check(&self) -> Result<()> {
+        if !(self.epsilon > 0.0 && self.epsilon.is_finite()) {
+            return Err(Error::new(format!(
+                "--epsilon must be positive, got {}",
+                self.epsilon
+            )));
+        }
         if !(self.patch_size > 0.0 && self.patch_size <= 1.0) || self.ff_rays == 0 {
             return Err(Error::new(format!(
                 "--patch-size must be in (0, 1] (got {}) and --ff-rays at least 1 (got {})",
@@ -167,12 +182,6 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
         kind: IntegratorKind::Radiosity,
         ..args.radiosity.options()
     };
-    // The same mesh the solver builds, for its counts.
-    let mesh = Mesh::build(&scene, options.patch_size, MAX_ELEMENTS).map_err(Error::new)?;
-    for note in &mesh.notes {
-        eprintln!("note: {note}");
-    }
-    let elements = mesh.elements.len();
     let settings = RenderSettings {
         integrator: options.build(),
         sampler: SamplerKind::Independent,
@@ -188,7 +197,6 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
         "{:>7} {:>9} {:>11} {:>9} {:>9} {:>11} {:>9} {:>13}",
         "steps", "elements", "links", "rays M", "seconds", "residual", "RMSE", "masked RMSE"
     );
-    let links = elements as u64 * (elements as u64 - 1);
     let mut rows = Vec::new();
     let mut k = 1;
     loop {
@@ -202,8 +210,8 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
         println!(
             "{:>7} {:>9} {:>11} {:>9.2} {:>9.3} {:>11.3e} {:>9.5} {:>13.5}",
             progress.steps,
-            elements,
-            links,
+            progress.elements,
+            progress.links,
             stats.rays.shadow as f64 * 1e-6,
             seconds,
             progress.residual,
@@ -212,6 +220,8 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
         );
         rows.push((
             progress.steps,
+            progress.elements,
+            progress.links,
             stats.rays.shadow,
             seconds,
             progress.residual,
@@ -226,14 +236,19 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
     if let Some(e) = session.failure() {
         return Err(e);
     }
-    println!(
-        "form factor matrix: {:.1} MB ({elements} elements, every pair a link)",
-        FormFactors::bytes(elements) as f64 / 1e6
-    );
+    if options.radiosity_solver != RadiositySolver::Hierarchical
+        && let Some(last) = rows.last()
+    {
+        println!(
+            "form factor matrix: {:.1} MB ({} elements, every pair a link)",
+            FormFactors::bytes(last.1 as usize) as f64 / 1e6,
+            last.1
+        );
+    }
     if let Some(path) = &args.csv {
         let mut text =
             String::from("steps,elements,links,shadow_rays,seconds,residual,rmse,masked_rmse\n");
-        for (steps, rays, seconds, residual, all, masked) in &rows {
+        for (steps, elements, links, rays, seconds, residual, all, masked) in &rows {
             text.push_str(&format!(
                 "{steps},{elements},{links},{rays},{seconds},{residual},{all},{masked}\n"
             ));
@@ -247,9 +262,9 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
         let series = [
             (
                 "masked RMSE",
-                rows.iter().map(|r| (r.0 as f64, r.5)).collect::<Vec<_>>(),
+                rows.iter().map(|r| (r.0 as f64, r.7)).collect::<Vec<_>>(),
             ),
-            ("residual", rows.iter().map(|r| (r.0 as f64, r.3)).collect()),
+            ("residual", rows.iter().map(|r| (r.0 as f64, r.5)).collect()),
         ];
         let series: Vec<Series> = series
             .iter()

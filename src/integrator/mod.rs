@@ -205,6 +205,10 @@ pub struct SolverProgress {
     pub residual: f64,
     /// No further step changes the solution.
     pub converged: bool,
+    /// The solver's unknowns and couplings (radiosity: leaf elements and
+    /// links), for reports; 0 where they mean nothing.
+    pub elements: u64,
+    pub links: u64,
 }
 
 /// What a session can say about a technique's error without a reference.

@@ -59,6 +59,7 @@ pub struct IntegratorOptions {
     pub radiosity_ambient: bool,
     pub radiosity_iterations: u32,
     pub radiosity_display: RadiosityDisplay,
+    pub radiosity_epsilon: f32,
 }
 
 impl Default for IntegratorOptions {
@@ -84,6 +85,7 @@ impl Default for IntegratorOptions {
             radiosity_ambient: true,
             radiosity_iterations: 0,
             radiosity_display: RadiosityDisplay::Gather,
+            radiosity_epsilon: 1e-4,
         }
     }
 }

@@ -24,7 +24,10 @@
 
 use super::{IntegratorOptions, RayCounts, Solver, SolverProgress, Technique};
 use crate::math::{Frame, Ray, Rgb};
-use crate::radiosity::{FormFactorMethod, FormFactors, Mesh, RadiositySolver, Solution, solve};
+use crate::radiosity::{
+    Element, FormFactorMethod, FormFactors, Hierarchy, HierarchySettings, Mesh, RadiositySolver,
+    Solution, solve,
+};
 use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
@@ -49,6 +52,8 @@ pub struct Radiosity {
     /// Stop after this many steps (0: when converged).
     pub iterations: u32,
     pub display: RadiosityDisplay,
+    /// Hierarchical: the BF oracle's threshold, relative to the emitted power.
+    pub epsilon: f32,
 }
 
 /// How the solution is shown.
@@ -92,6 +97,7 @@ impl Technique for Radiosity {
             ambient: options.radiosity_ambient,
             iterations: options.radiosity_iterations,
             display: options.radiosity_display,
+            epsilon: options.radiosity_epsilon,
         }
     }
 
@@ -112,23 +118,82 @@ impl Technique for Radiosity {
     }
 }
 
-/// The mesh, its form factors and the current solution.
-pub struct RadiosityState {
+/// The full-matrix model: a uniform mesh, every pair's form factor, the solution.
+pub struct MatrixModel {
     pub mesh: Mesh,
     pub form_factors: FormFactors,
     pub solution: Solution,
     /// Smooth display: per element, its three vertices' radiance.
     vertex_radiance: Vec<[Rgb; 3]>,
+}
+
+/// What a radiosity solver works on.
+pub enum Model {
+    Matrix(MatrixModel),
+    Hierarchical(Hierarchy),
+}
+
+/// The model and where its solve stands.
+pub struct RadiosityState {
+    pub model: Model,
+    steps: u64,
     residual: f64,
+}
+
+impl RadiosityState {
+    /// The full-matrix model, unless the solver is hierarchical.
+    pub fn matrix(&self) -> Option<&MatrixModel> {
+        match &self.model {
+            Model::Matrix(m) => Some(m),
+            Model::Hierarchical(_) => None,
+        }
+    }
+
+    /// The hierarchy, if the solver is hierarchical.
+    pub fn hierarchy(&self) -> Option<&Hierarchy> {
+        match &self.model {
+            Model::Hierarchical(h) => Some(h),
+            Model::Matrix(_) => None,
+        }
+    }
+
+    /// (elements, links): leaves and links, or elements and every ordered pair.
+    pub fn counts(&self) -> (usize, usize) {
+        match &self.model {
+            Model::Matrix(m) => {
+                let n = m.mesh.elements.len();
+                (n, n * n.saturating_sub(1))
+            }
+            Model::Hierarchical(h) => h.counts(),
+        }
+    }
 }
 
 /// The residual at which the solution counts as converged.
 const CONVERGED: f64 = 1e-6;
 
+/// Most hierarchy nodes (about 120 bytes each, plus their links).
+pub const MAX_NODES: usize = 4_000_000;
+
 impl Solver for Radiosity {
     type State = RadiosityState;
 
     fn init(&self, scene: &Scene) -> crate::Result<RadiosityState> {
+        if self.solver.matrix().is_none() {
+            let settings = HierarchySettings {
+                epsilon: self.epsilon,
+                min_size: self.patch_size,
+                method: self.form_factors,
+                samples: self.form_factor_samples,
+                max_nodes: MAX_NODES,
+            };
+            let hierarchy = Hierarchy::build(scene, settings).map_err(crate::Error::new)?;
+            return Ok(RadiosityState {
+                model: Model::Hierarchical(hierarchy),
+                steps: 0,
+                residual: 1.0,
+            });
+        }
         let mesh = Mesh::build(scene, self.patch_size, MAX_ELEMENTS).map_err(crate::Error::new)?;
         let form_factors = FormFactors::compute(
             &scene.geometry,
@@ -137,55 +202,77 @@ impl Solver for Radiosity {
             self.form_factor_samples,
         );
         let solution = Solution::new(&mesh);
-        let vertex_radiance = vec![[Rgb::ZERO; 3]; mesh.elements.len()];
-        let mut state = RadiosityState {
-            mesh,
-            form_factors,
-            solution,
-            vertex_radiance,
-            residual: 1.0,
+        let vertex_radiance = if self.display == RadiosityDisplay::Smooth {
+            mesh.vertex_average(&solution.radiance)
+        } else {
+            Vec::new()
         };
-        if self.display == RadiosityDisplay::Smooth {
-            state.vertex_radiance = state.mesh.vertex_average(&state.solution.radiance);
-        }
-        Ok(state)
+        Ok(RadiosityState {
+            model: Model::Matrix(MatrixModel {
+                mesh,
+                form_factors,
+                solution,
+                vertex_radiance,
+            }),
+            steps: 0,
+            residual: 1.0,
+        })
     }
 
     fn step(
         &self,
-        _: &Scene,
+        scene: &Scene,
         state: &mut RadiosityState,
         steps: u32,
         counts: &mut RayCounts,
     ) -> SolverProgress {
-        // The form factors' rays are counted with the first step.
-        if state.solution.steps == 0 {
-            counts.shadow += state.form_factors.rays;
-        }
         let limit = if self.iterations == 0 {
             u64::MAX
         } else {
             self.iterations as u64
         };
         for _ in 0..steps {
-            if state.solution.steps >= limit || state.residual <= CONVERGED {
+            if state.steps >= limit || state.residual <= CONVERGED {
                 break;
             }
-            state.residual = solve::step(
-                self.solver,
-                &state.mesh,
-                &state.form_factors,
-                &mut state.solution,
-                self.ambient,
-            );
+            state.steps += 1;
+            match &mut state.model {
+                Model::Matrix(m) => {
+                    // The form factors' rays are counted with the first step.
+                    if state.steps == 1 {
+                        counts.shadow += m.form_factors.rays;
+                    }
+                    if let Some(solver) = self.solver.matrix() {
+                        state.residual = solve::step(
+                            solver,
+                            &m.mesh,
+                            &m.form_factors,
+                            &mut m.solution,
+                            self.ambient,
+                        );
+                    }
+                }
+                Model::Hierarchical(h) => {
+                    let before = h.rays;
+                    state.residual = h.step(&scene.geometry);
+                    counts.shadow += h.rays - before;
+                    if state.steps == 1 {
+                        counts.shadow += before;
+                    }
+                }
+            }
         }
-        if self.display == RadiosityDisplay::Smooth {
-            state.vertex_radiance = state.mesh.vertex_average(&state.solution.radiance);
+        if let Model::Matrix(m) = &mut state.model
+            && self.display == RadiosityDisplay::Smooth
+        {
+            m.vertex_radiance = m.mesh.vertex_average(&m.solution.radiance);
         }
         SolverProgress {
-            steps: state.solution.steps,
+            steps: state.steps,
             residual: state.residual,
-            converged: state.solution.steps >= limit || state.residual <= CONVERGED,
+            converged: state.steps >= limit || state.residual <= CONVERGED,
+            elements: state.counts().0 as u64,
+            links: state.counts().1 as u64,
         }
     }
 
@@ -219,38 +306,34 @@ impl Solver for Radiosity {
                     ray = hit.spawn_ray(frame.to_world(s.wi));
                 }
                 _ => {
-                    let Some((element, b)) = element_hit(scene, state, &hit) else {
+                    let Some(surface) = surface_at(scene, state, &hit) else {
                         // Spheres are not patches: their own emission only.
                         return weight * material.emitted(hit.normal, -ray.direction);
                     };
-                    let e = &state.mesh.elements[element];
+                    let e = &surface.element;
                     let seen_emission = if e.normal.dot(ray.direction) < 0.0 {
                         e.emission
                     } else {
                         Rgb::ZERO
                     };
-                    let ambient = e.reflectance * state.solution.ambient;
-                    let reflected = match self.display {
-                        RadiosityDisplay::Flat => state.solution.radiance[element] - e.emission,
-                        RadiosityDisplay::Smooth => {
-                            let [l0, l1, l2] = state.vertex_radiance[element];
+                    let ambient = e.reflectance * surface.ambient;
+                    let reflected = match (self.display, surface.vertices) {
+                        (RadiosityDisplay::Gather, _) => gather(
+                            scene,
+                            state,
+                            &hit,
+                            e.reflectance,
+                            -ray.direction,
+                            sampler,
+                            counts,
+                        ),
+                        (RadiosityDisplay::Smooth, Some([l0, l1, l2])) => {
+                            let b = surface.barycentrics;
                             ((1.0 - b.x - b.y) * l0 + b.x * l1 + b.y * l2 - e.emission)
                                 .max(Rgb::ZERO)
                         }
-                        RadiosityDisplay::Gather => {
-                            return weight
-                                * (seen_emission
-                                    + gather(
-                                        scene,
-                                        state,
-                                        &hit,
-                                        e.reflectance,
-                                        -ray.direction,
-                                        sampler,
-                                        counts,
-                                    )
-                                    + ambient);
-                        }
+                        // Flat, and smooth over a hierarchy (not interpolated yet).
+                        _ => surface.radiance - e.emission,
                     };
                     return weight * (seen_emission + reflected + ambient);
                 }
@@ -264,23 +347,52 @@ impl Solver for Radiosity {
     }
 }
 
-/// The element a hit lies in (None for spheres and non-patches), and the
-/// hit's barycentrics in that element.
-fn element_hit(
+/// What the solution says at a surface point.
+struct Surface {
+    /// The element's radiance (emission included).
+    radiance: Rgb,
+    element: Element,
+    /// The point's barycentrics in the element.
+    barycentrics: glam::Vec2,
+    /// Smooth display: the element's vertex radiance.
+    vertices: Option<[Rgb; 3]>,
+    ambient: Rgb,
+}
+
+/// The element a hit lies in and its solution (None for spheres and
+/// surfaces that are not patches).
+fn surface_at(
     scene: &Scene,
     state: &RadiosityState,
     hit: &crate::accel::SurfaceHit,
-) -> Option<(usize, glam::Vec2)> {
+) -> Option<Surface> {
     let triangle = hit.primitive as usize;
     let [a, b, c] = *scene.geometry.triangles().get(triangle)?;
     let (b1, b2) = barycentrics(hit.point, [a, b, c]);
-    let element = state.mesh.element_at(
-        triangle,
-        b1.clamp(0.0, 1.0),
-        b2.clamp(0.0, 1.0 - b1.clamp(0.0, 1.0)),
-    )?;
-    let (e1, e2) = barycentrics(hit.point, state.mesh.elements[element].vertices);
-    Some((element, glam::Vec2::new(e1, e2)))
+    let (b1, b2) = (b1.clamp(0.0, 1.0), b2.clamp(0.0, 1.0 - b1.clamp(0.0, 1.0)));
+    let (radiance, element, vertices, ambient) = match &state.model {
+        Model::Matrix(m) => {
+            let k = m.mesh.element_at(triangle, b1, b2)?;
+            (
+                m.solution.radiance[k],
+                m.mesh.elements[k],
+                m.vertex_radiance.get(k).copied(),
+                m.solution.ambient,
+            )
+        }
+        Model::Hierarchical(h) => {
+            let (radiance, element) = h.leaf_at(triangle, b1, b2)?;
+            (radiance, *element, None, Rgb::ZERO)
+        }
+    };
+    let (e1, e2) = barycentrics(hit.point, element.vertices);
+    Some(Surface {
+        radiance,
+        element,
+        barycentrics: glam::Vec2::new(e1, e2),
+        vertices,
+        ambient,
+    })
 }
 
 /// Barycentrics (b1, b2) of `p` in the triangle `v`, by sub-triangle areas.
@@ -327,11 +439,8 @@ fn gather(
     let ray = hit.spawn_ray(Frame::from_normal(normal).to_world(local));
     counts.bounce += 1;
     let indirect = match scene.geometry.intersect(&ray) {
-        Some(next) => match element_hit(scene, state, &next) {
-            Some((element, _)) => {
-                let e = &state.mesh.elements[element];
-                state.solution.radiance[element] - e.emission
-            }
+        Some(next) => match surface_at(scene, state, &next) {
+            Some(s) => s.radiance - s.element.emission,
             None => Rgb::ZERO,
         },
         None => Rgb::ZERO,

@@ -3,9 +3,11 @@
 //! The technique that renders with them is `crate::integrator::radiosity`.
 
 pub mod form_factor;
+pub mod hierarchy;
 pub mod mesh;
 pub mod solve;
 
 pub use form_factor::FormFactorMethod;
+pub use hierarchy::{Hierarchy, HierarchySettings};
 pub use mesh::{Element, Mesh};
 pub use solve::{FormFactors, RadiositySolver, Solution};

@@ -19,13 +19,16 @@ pub enum RadiositySolver {
     GaussSeidel,
     /// Progressive refinement: shoot the element with the most unshot power.
     Progressive,
+    /// Hierarchical radiosity: links refined by the BF oracle (see `hierarchy`).
+    Hierarchical,
 }
 
 impl RadiositySolver {
-    pub const ALL: [RadiositySolver; 3] = [
+    pub const ALL: [RadiositySolver; 4] = [
         RadiositySolver::Jacobi,
         RadiositySolver::GaussSeidel,
         RadiositySolver::Progressive,
+        RadiositySolver::Hierarchical,
     ];
 
     pub fn name(self) -> &'static str {
@@ -33,6 +36,27 @@ impl RadiositySolver {
             RadiositySolver::Jacobi => "jacobi",
             RadiositySolver::GaussSeidel => "gauss-seidel",
             RadiositySolver::Progressive => "progressive",
+            RadiositySolver::Hierarchical => "hierarchical",
+        }
+    }
+}
+
+/// The solvers of the full form factor matrix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MatrixSolver {
+    Jacobi,
+    GaussSeidel,
+    Progressive,
+}
+
+impl RadiositySolver {
+    /// The matrix solver, or None for the hierarchical one.
+    pub fn matrix(self) -> Option<MatrixSolver> {
+        match self {
+            RadiositySolver::Jacobi => Some(MatrixSolver::Jacobi),
+            RadiositySolver::GaussSeidel => Some(MatrixSolver::GaussSeidel),
+            RadiositySolver::Progressive => Some(MatrixSolver::Progressive),
+            RadiositySolver::Hierarchical => None,
         }
     }
 }
@@ -148,7 +172,7 @@ pub fn emitted_power(mesh: &Mesh) -> f64 {
 /// Returns the residual: the power changed by the sweep, or the unshot
 /// power, over the emitted power.
 pub fn step(
-    solver: RadiositySolver,
+    solver: MatrixSolver,
     mesh: &Mesh,
     f: &FormFactors,
     s: &mut Solution,
@@ -158,7 +182,7 @@ pub fn step(
     let emitted = emitted_power(mesh).max(f64::MIN_POSITIVE);
     s.steps += 1;
     match solver {
-        RadiositySolver::Jacobi => {
+        MatrixSolver::Jacobi => {
             let old = &s.radiance;
             let new: Vec<Rgb> = (0..elements.len())
                 .into_par_iter()
@@ -180,7 +204,7 @@ pub fn step(
             s.radiance = new;
             change / emitted
         }
-        RadiositySolver::GaussSeidel => {
+        MatrixSolver::GaussSeidel => {
             let mut change = 0.0;
             for i in 0..elements.len() {
                 let gathered = f
@@ -194,7 +218,7 @@ pub fn step(
             }
             change / emitted
         }
-        RadiositySolver::Progressive => {
+        MatrixSolver::Progressive => {
             let Some(shooter) = (0..elements.len()).max_by(|&a, &b| {
                 let power = |k: usize| elements[k].area * luminance(s.unshot[k]);
                 power(a).total_cmp(&power(b))

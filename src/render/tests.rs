@@ -96,6 +96,7 @@ impl Solver for Halving {
             steps: u64::from(steps),
             residual: 1.0 - *x,
             converged: *x == 1.0,
+            ..SolverProgress::default()
         }
     }
     fn radiance(&self, _: &Scene, x: &f64, _: Ray, _: &mut Sampler, _: &mut RayCounts) -> Rgb {

@@ -216,6 +216,13 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
             if options.radiosity_solver == RadiositySolver::Progressive {
                 ui.checkbox(&mut options.radiosity_ambient, "Ambient term");
             }
+            if options.radiosity_solver == RadiositySolver::Hierarchical {
+                ui.add(
+                    egui::Slider::new(&mut options.radiosity_epsilon, 1e-7..=1e-2)
+                        .logarithmic(true)
+                        .text("Epsilon (share of the emitted power)"),
+                );
+            }
             ui.add(
                 egui::Slider::new(&mut options.patch_size, 0.02..=0.5)
                     .logarithmic(true)
