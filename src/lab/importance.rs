@@ -192,20 +192,10 @@ pub fn run(settings: &LabSettings, progress: &Progress) -> Result<Report, Cancel
                 64,
             );
         }
-        let mut set = PointSet::new(
-            SamplerKind::Independent,
-            hash_combine(settings.seed, k as u64),
-            0,
-            n,
-        );
-        let mut measured = Moments::default();
-        for i in 0..n {
-            let (x, p) = density.sample(set.point_2d(i), &table);
-            measured.add(integrand(x) / p);
-            if i % 65_536 == 0 {
-                progress.advance(65_536.min(n - i) as u64)?;
-            }
-        }
+        let measured = measure(hash_combine(settings.seed, k as u64), n, progress, |u| {
+            let (x, p) = density.sample(u, &table);
+            integrand(x) / p
+        })?;
         rows.push(Row {
             name: density.name(),
             target: exact,
@@ -227,15 +217,10 @@ pub fn run(settings: &LabSettings, progress: &Progress) -> Result<Report, Cancel
                 256,
             );
         let seed = hash_combine(settings.seed, 100 + k as u64);
-        let mut set = PointSet::new(SamplerKind::Independent, seed, 0, n);
-        let mut measured = Moments::default();
-        for i in 0..n {
-            let (mu, p) = density.sample(set.point_2d(i));
-            measured.add(sky_integrand(mu) / p);
-            if i % 65_536 == 0 {
-                progress.advance(65_536.min(n - i) as u64)?;
-            }
-        }
+        let measured = measure(seed, n, progress, |u| {
+            let (mu, p) = density.sample(u);
+            sky_integrand(mu) / p
+        })?;
         rows.push(Row {
             name: density.name(),
             target: sky_exact,
@@ -272,6 +257,24 @@ pub fn run(settings: &LabSettings, progress: &Progress) -> Result<Report, Cancel
         holds: z > 10.0,
     });
     Ok(report)
+}
+
+/// Mean and variance of `estimate` over `n` independent points (seed `seed`).
+fn measure(
+    seed: u64,
+    n: u32,
+    progress: &Progress,
+    estimate: impl Fn(Vec2) -> f64,
+) -> Result<Moments, Cancelled> {
+    let mut set = PointSet::new(SamplerKind::Independent, seed, 0, n);
+    let mut measured = Moments::default();
+    for i in 0..n {
+        measured.add(estimate(set.point_2d(i)));
+        if i % 65_536 == 0 {
+            progress.advance(65_536.min(n - i) as u64)?;
+        }
+    }
+    Ok(measured)
 }
 
 /// The alias table of f's integrals over `BINS` equal bins.

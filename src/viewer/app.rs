@@ -9,6 +9,7 @@ use super::export::{export_path, write_color_image, write_exr};
 use super::lab::LabState;
 use super::launch::{Launch, list_scene_files, resolve_scene_path};
 use super::settings::{Config, Display, Settings, Tab, load_settings, settings_file};
+use super::stats::percentile;
 use super::view_transform::ViewTransform;
 use crate::camera::Camera;
 use crate::image::Image;
@@ -151,15 +152,13 @@ impl ViewerApp {
         if let Some(dir) = &launch.export_dir {
             settings.export_dir = dir.to_string_lossy().into_owned();
         }
-        let mut lab = LabState::default();
-        if let Some(experiment) = launch.lab {
+        if launch.lab.is_some() {
             settings.tab = Tab::Lab;
-            lab = LabState::new(experiment);
         }
-        if let Some(path) = &launch.screenshot {
+        let lab = LabState::new(launch.lab.unwrap_or_default());
+        if launch.screenshot.is_some() {
             settings.target_spp = settings.target_spp.max(launch.after_spp);
             settings.unlimited = false;
-            let _ = path;
         }
         let mut errors = Vec::new();
         let live = match LiveRender::start(launch.threads) {
@@ -698,14 +697,4 @@ impl ViewerApp {
     pub fn shutdown(&mut self) {
         self.live.stop();
     }
-}
-
-fn percentile(values: impl Iterator<Item = f32>, q: f32) -> Option<f32> {
-    let mut v: Vec<f32> = values.collect();
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f32::total_cmp);
-    let i = ((v.len() - 1) as f32 * q).round() as usize;
-    Some(v[i])
 }

@@ -247,6 +247,17 @@ pub(super) fn format_power(x: f64) -> String {
     }
 }
 
+/// The `q` quantile (0..=1) of `values`, None when there are none.
+pub(super) fn percentile(values: impl Iterator<Item = f32>, q: f32) -> Option<f32> {
+    let mut v: Vec<f32> = values.collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f32::total_cmp);
+    let i = ((v.len() - 1) as f32 * q).round() as usize;
+    Some(v[i])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
