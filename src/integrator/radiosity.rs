@@ -262,10 +262,11 @@ impl Solver for Radiosity {
                 }
             }
         }
-        if let Model::Matrix(m) = &mut state.model
-            && self.display == RadiosityDisplay::Smooth
-        {
-            m.vertex_radiance = m.mesh.vertex_average(&m.solution.radiance);
+        if self.display == RadiosityDisplay::Smooth {
+            match &mut state.model {
+                Model::Matrix(m) => m.vertex_radiance = m.mesh.vertex_average(&m.solution.radiance),
+                Model::Hierarchical(h) => h.smooth(),
+            }
         }
         SolverProgress {
             steps: state.steps,
@@ -332,7 +333,6 @@ impl Solver for Radiosity {
                             ((1.0 - b.x - b.y) * l0 + b.x * l1 + b.y * l2 - e.emission)
                                 .max(Rgb::ZERO)
                         }
-                        // Flat, and smooth over a hierarchy (not interpolated yet).
                         _ => surface.radiance - e.emission,
                     };
                     return weight * (seen_emission + reflected + ambient);
@@ -381,8 +381,8 @@ fn surface_at(
             )
         }
         Model::Hierarchical(h) => {
-            let (radiance, element) = h.leaf_at(triangle, b1, b2)?;
-            (radiance, *element, None, Rgb::ZERO)
+            let (radiance, element, vertices) = h.leaf_at(triangle, b1, b2)?;
+            (radiance, *element, vertices, Rgb::ZERO)
         }
     };
     let (e1, e2) = barycentrics(hit.point, element.vertices);

@@ -73,6 +73,9 @@ pub struct Hierarchy {
     /// What is not a patch, and whether refinement hit the node budget.
     pub notes: Vec<String>,
     budget_spent: bool,
+    /// Smooth display: per node, its vertices' radiance (leaves only; set
+    /// by [`Hierarchy::smooth`]).
+    vertex_radiance: Vec<[Rgb; 3]>,
 }
 
 fn luminance(c: Rgb) -> f32 {
@@ -159,6 +162,7 @@ impl Hierarchy {
             steps: 0,
             notes: Vec::new(),
             budget_spent: false,
+            vertex_radiance: Vec::new(),
         };
         if specular > 0 {
             h.notes.push(format!(
@@ -396,9 +400,34 @@ impl Hierarchy {
         radiance
     }
 
-    /// The leaf of scene triangle `triangle` at its barycentrics (b1, b2),
-    /// with its element.
-    pub fn leaf_at(&self, triangle: usize, b1: f32, b2: f32) -> Option<(Rgb, &Element)> {
+    /// Computes the leaves' vertex radiance for the smooth display.
+    pub fn smooth(&mut self) {
+        let leaves = self
+            .nodes
+            .iter()
+            .filter(|n| n.children == NONE)
+            .map(|n| (&n.element, n.radiance));
+        let averaged = super::mesh::vertex_average(leaves);
+        let mut per_node = vec![[Rgb::ZERO; 3]; self.nodes.len()];
+        let leaf_nodes = self
+            .nodes
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| n.children == NONE);
+        for ((k, _), v) in leaf_nodes.zip(averaged) {
+            per_node[k] = v;
+        }
+        self.vertex_radiance = per_node;
+    }
+
+    /// The leaf of scene triangle `triangle` at its barycentrics (b1, b2):
+    /// its radiance, element, and vertex radiance once [`Hierarchy::smooth`] ran.
+    pub fn leaf_at(
+        &self,
+        triangle: usize,
+        b1: f32,
+        b2: f32,
+    ) -> Option<(Rgb, &Element, Option<[Rgb; 3]>)> {
         let mut k = *self.roots.get(triangle)?;
         if k == NONE {
             return None;
@@ -417,7 +446,11 @@ impl Hierarchy {
             k = self.nodes[k as usize].children + child as u32;
         }
         let n = &self.nodes[k as usize];
-        Some((n.radiance, &n.element))
+        Some((
+            n.radiance,
+            &n.element,
+            self.vertex_radiance.get(k as usize).copied(),
+        ))
     }
 
     /// Per leaf, the sum of the form factors over its links and its

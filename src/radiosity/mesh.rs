@@ -155,34 +155,9 @@ impl Mesh {
         Ok(mesh)
     }
 
-    /// Per element, the radiance at its three vertices: the area-weighted
-    /// mean of `radiance` over the elements that share the vertex (same
-    /// position, exactly: midpoints are computed alike on both sides of an
-    /// edge) and lie in the same plane, so that walls meeting at a corner
-    /// keep their own values.
+    /// Per element, the radiance at its three vertices ([`vertex_average`]).
     pub fn vertex_average(&self, radiance: &[Rgb]) -> Vec<[Rgb; 3]> {
-        use std::collections::HashMap;
-        let key = |v: Vec3A, n: Vec3A| {
-            let q = |x: f32| (x * 1024.0).round() as i32;
-            (v.to_array().map(f32::to_bits), [q(n.x), q(n.y), q(n.z)])
-        };
-        let mut sums: HashMap<_, (Rgb, f32)> = HashMap::with_capacity(self.elements.len() * 2);
-        for (e, l) in self.elements.iter().zip(radiance) {
-            for v in e.vertices {
-                let entry = sums.entry(key(v, e.normal)).or_insert((Rgb::ZERO, 0.0));
-                entry.0 += *l * e.area;
-                entry.1 += e.area;
-            }
-        }
-        self.elements
-            .iter()
-            .map(|e| {
-                e.vertices.map(|v| {
-                    let (sum, area) = sums[&key(v, e.normal)];
-                    sum / area
-                })
-            })
-            .collect()
+        vertex_average(self.elements.iter().zip(radiance.iter().copied()))
     }
 
     /// The element of scene triangle `triangle` that contains the point at
@@ -209,6 +184,38 @@ impl Mesh {
         }
         Some(first as usize + index)
     }
+}
+
+/// Per element, the radiance at its three vertices: the area-weighted mean
+/// of the radiance of the elements that share the vertex (same position,
+/// exactly: midpoints are computed alike on both sides of an edge) and lie
+/// in the same plane, so that walls meeting at a corner keep their own
+/// values. A vertex in the middle of a coarser neighbour's edge (a
+/// T-vertex of a hierarchy) averages only the elements that have it.
+pub fn vertex_average<'a>(
+    elements: impl Iterator<Item = (&'a Element, Rgb)> + Clone,
+) -> Vec<[Rgb; 3]> {
+    use std::collections::HashMap;
+    let key = |v: Vec3A, n: Vec3A| {
+        let q = |x: f32| (x * 1024.0).round() as i32;
+        (v.to_array().map(f32::to_bits), [q(n.x), q(n.y), q(n.z)])
+    };
+    let mut sums: HashMap<_, (Rgb, f32)> = HashMap::new();
+    for (e, l) in elements.clone() {
+        for v in e.vertices {
+            let entry = sums.entry(key(v, e.normal)).or_insert((Rgb::ZERO, 0.0));
+            entry.0 += l * e.area;
+            entry.1 += e.area;
+        }
+    }
+    elements
+        .map(|(e, _)| {
+            e.vertices.map(|v| {
+                let (sum, area) = sums[&key(v, e.normal)];
+                sum / area
+            })
+        })
+        .collect()
 }
 
 /// Calls `emit` for the 4^depth children of triangle `v` in the order
