@@ -265,3 +265,39 @@ fn the_lab_tab_runs_every_experiment_live_and_cancels() {
     harness.get_by_label("Renderer").click();
     step_until(&mut harness, "the render", finished);
 }
+
+#[test]
+fn radiosity_controls_drive_the_solver() {
+    let dir = temp_dir("viewer-radiosity");
+    let mut harness = Harness::builder()
+        .with_size(SIZE)
+        .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 4)));
+    click(&mut harness, "Radiosity");
+    click(&mut harness, "hierarchical");
+    click(&mut harness, "flat");
+    let options = harness.state().app.settings.a.integrator;
+    assert_eq!(options.kind, IntegratorKind::Radiosity);
+    assert_eq!(
+        options.radiosity_solver,
+        tracelab::radiosity::RadiositySolver::Hierarchical
+    );
+    // The solver runs its steps (the target of 4 "spp" is 4 steps here) and
+    // the statistics line counts its elements and links.
+    step_until(&mut harness, "the hierarchical solution", finished);
+    let frame = harness.state().app.frame();
+    let solver = frame.views[0].stats.solver.expect("a solver's progress");
+    assert!(
+        solver.steps >= 1 && solver.elements > 32 && solver.links > solver.elements,
+        "{solver:?}"
+    );
+    harness.get_by_label_contains("links");
+    // Another solver restarts from its own mesh (a coarse one, for time).
+    harness.state_mut().app.settings.a.integrator.patch_size = 0.3;
+    click(&mut harness, "progressive");
+    let ambient = harness.state().app.settings.a.integrator.radiosity_ambient;
+    click(&mut harness, "Ambient term");
+    step_until(&mut harness, "the progressive solution", finished);
+    let options = harness.state().app.settings.a.integrator;
+    assert_eq!(options.radiosity_ambient, !ambient);
+    assert_eq!(options.radiosity_solver, tracelab::radiosity::RadiositySolver::Progressive);
+}

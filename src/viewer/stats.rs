@@ -22,6 +22,19 @@ pub fn stats_panel(ui: &mut egui::Ui, app: &mut ViewerApp) {
             egui::Label::new(egui::RichText::new(view_summary(name, view, app)).monospace())
                 .truncate(),
         );
+        // A solver's own counters, on a line of their own (the summary
+        // above is cut at the panel's width).
+        if let Some(solver) = view.stats.solver
+            && solver.elements > 0
+        {
+            ui.label(
+                egui::RichText::new(format!(
+                    "{name} solver: {} steps, {} elements, {} links, residual {:.3e}",
+                    solver.steps, solver.elements, solver.links, solver.residual
+                ))
+                .monospace(),
+            );
+        }
         if !view.shortcuts.is_empty() {
             let text = format!("{name} shortcuts: {}", view.shortcuts.join(" | "));
             ui.add(egui::Label::new(egui::RichText::new(text).weak()).truncate())
