@@ -118,8 +118,9 @@ fn metric(p: &ErrorPoint, use_rmse: bool) -> Option<f64> {
     (v.is_finite() && v > 0.0).then_some(v)
 }
 
+/// Seconds, or progress: samples per pixel, a solver's steps.
 fn abscissa(p: &ErrorPoint, time: bool) -> Option<f64> {
-    let x = if time { p.seconds } else { f64::from(p.spp) };
+    let x = if time { p.seconds } else { p.progress as f64 };
     (x > 0.0).then_some(x)
 }
 
@@ -141,7 +142,7 @@ pub fn convergence_plot(ui: &mut egui::Ui, app: &mut ViewerApp) {
         } else {
             "Estimated RMSE (film variance; load a reference for the true RMSE)"
         });
-        ui.radio_value(&mut app.settings.display.plot_time, false, "vs spp");
+        ui.radio_value(&mut app.settings.display.plot_time, false, "vs spp / steps");
         ui.radio_value(&mut app.settings.display.plot_time, true, "vs time");
         if ui.button("Clear old curves").clicked() {
             app.curves.clear();
@@ -181,7 +182,7 @@ pub fn convergence_plot(ui: &mut egui::Ui, app: &mut ViewerApp) {
     Plot::new("convergence")
         .height(height)
         .legend(Legend::default())
-        .x_axis_label(if time { "seconds" } else { "spp" })
+        .x_axis_label(if time { "seconds" } else { "spp (solvers: steps)" })
         .x_axis_formatter(ten_to)
         .y_axis_formatter(ten_to)
         .x_grid_spacer(log_grid)
