@@ -299,5 +299,8 @@ fn radiosity_controls_drive_the_solver() {
     step_until(&mut harness, "the progressive solution", finished);
     let options = harness.state().app.settings.a.integrator;
     assert_eq!(options.radiosity_ambient, !ambient);
-    assert_eq!(options.radiosity_solver, tracelab::radiosity::RadiositySolver::Progressive);
+    assert_eq!(
+        options.radiosity_solver,
+        tracelab::radiosity::RadiositySolver::Progressive
+    );
 }

@@ -182,7 +182,11 @@ pub fn convergence_plot(ui: &mut egui::Ui, app: &mut ViewerApp) {
     Plot::new("convergence")
         .height(height)
         .legend(Legend::default())
-        .x_axis_label(if time { "seconds" } else { "spp (solvers: steps)" })
+        .x_axis_label(if time {
+            "seconds"
+        } else {
+            "spp (solvers: steps)"
+        })
         .x_axis_formatter(ten_to)
         .y_axis_formatter(ten_to)
         .x_grid_spacer(log_grid)
