@@ -4,7 +4,7 @@
 //! RMSE against the reference with and without the pixels that see lights)
 //! and writes them as CSV and a plot.
 
-use super::render::override_resolution;
+use super::render::{drive_solver, override_resolution};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -198,13 +198,7 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
         "steps", "elements", "links", "rays M", "seconds", "residual", "RMSE", "masked RMSE"
     );
     let mut rows = Vec::new();
-    let mut k = 1;
-    loop {
-        if !session.render_pass(k) {
-            break;
-        }
-        let stats = session.stats();
-        let Some(progress) = stats.solver else { break };
+    drive_solver(&session, |stats, progress| {
         let (all, masked, _) = rmse(&session.snapshot().image, &reference, args.mask_above);
         let seconds = stats.render_time.as_secs_f64();
         println!(
@@ -228,14 +222,7 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
             all,
             masked,
         ));
-        if progress.converged {
-            break;
-        }
-        k = (progress.steps as u32).max(1);
-    }
-    if let Some(e) = session.failure() {
-        return Err(e);
-    }
+    })?;
     if options.radiosity_solver != RadiositySolver::Hierarchical
         && let Some(last) = rows.last()
     {

@@ -13,7 +13,7 @@ use tracelab::film::{EXTREME_LUMINANCE, FinalImage, FlaggedPixel};
 use tracelab::image::check_writable;
 use tracelab::integrator::{
     CameraIntegrator, GlassShadows, Integrator, IntegratorKind, IntegratorOptions, MisHeuristic,
-    Strategy,
+    SolverProgress, Strategy,
 };
 use tracelab::math::OffsetMode;
 use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
@@ -429,9 +429,12 @@ pub(crate) fn progress_bar(len: u64, unit: &str) -> ProgressBar {
 }
 
 /// Runs a solver's steps until it converges (or reaches its step limit),
-/// in passes of 1, 2, 4, ... steps, each followed by an image of the solution.
-fn render_solver(session: &Session) -> Result<RenderStats> {
-    let bar = progress_bar(1, "steps");
+/// in passes of 1, 2, 4, ... steps, each followed by an image of the
+/// solution; `after_pass` sees the statistics after each pass.
+pub(crate) fn drive_solver(
+    session: &Session,
+    mut after_pass: impl FnMut(&RenderStats, &SolverProgress),
+) -> Result<RenderStats> {
     let mut steps = 1;
     loop {
         if !session.render_pass(steps) {
@@ -439,8 +442,7 @@ fn render_solver(session: &Session) -> Result<RenderStats> {
         }
         let stats = session.stats();
         let Some(progress) = stats.solver else { break };
-        bar.set_message(format!("residual {:.2e}", progress.residual));
-        bar.set_position(progress.steps);
+        after_pass(&stats, &progress);
         if progress.converged {
             break;
         }
@@ -449,11 +451,21 @@ fn render_solver(session: &Session) -> Result<RenderStats> {
         // takes thousands of shots).
         steps = steps.saturating_mul(2);
     }
-    bar.finish_and_clear();
     if let Some(e) = session.failure() {
         return Err(e);
     }
     Ok(session.stats())
+}
+
+/// [`drive_solver`] with a progress bar.
+fn render_solver(session: &Session) -> Result<RenderStats> {
+    let bar = progress_bar(1, "steps");
+    let stats = drive_solver(session, |_, progress| {
+        bar.set_message(format!("residual {:.2e}", progress.residual));
+        bar.set_position(progress.steps);
+    });
+    bar.finish_and_clear();
+    stats
 }
 
 /// Renders exactly `spp` samples per pixel in passes small enough for a live progress bar.

@@ -268,12 +268,13 @@ impl Solver for Radiosity {
                 Model::Hierarchical(h) => h.smooth(),
             }
         }
+        let (elements, links) = state.counts();
         SolverProgress {
             steps: state.steps,
             residual: state.residual,
             converged: state.steps >= limit || state.residual <= CONVERGED,
-            elements: state.counts().0 as u64,
-            links: state.counts().1 as u64,
+            elements: elements as u64,
+            links: links as u64,
         }
     }
 
