@@ -119,6 +119,23 @@ pub struct CameraConnection {
 }
 
 impl Camera {
+    /// Density wrt. solid angle with which camera rays over the whole film
+    /// take the direction `w` (unit): the film at unit distance has area
+    /// A, so p = 1 / (A cos^3) inside the field of view (for a thin lens,
+    /// given the lens point). Bidirectional estimators weigh strategies
+    /// with it; one sample per pixel over W x H pixels is one sample of
+    /// this density.
+    #[inline]
+    pub fn pdf_direction(&self, w: Vec3A) -> f32 {
+        let cos = w.dot(self.forward);
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        let aspect = self.width as f32 / self.height as f32;
+        let film_area = 4.0 * self.tan_half_fov_y * self.tan_half_fov_y * aspect;
+        1.0 / (film_area * cos * cos * cos)
+    }
+
     /// Connects `point` to a point on the lens chosen with `u_lens` (pbrt-v4's
     /// `PerspectiveCamera::SampleWi`). A box-filtered pixel of area A (on the
     /// image plane at unit distance) has importance We = 1 / (A A_lens cos^4),

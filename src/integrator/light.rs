@@ -81,6 +81,7 @@ impl SplattingEstimator for LightTracer {
     fn trace(
         &self,
         scene: &Scene,
+        _pixel: (u32, u32),
         sampler: &mut Sampler,
         counts: &mut RayCounts,
         mut splat: impl FnMut(Splat),
@@ -188,7 +189,7 @@ impl SplattingEstimator for LightTracer {
 /// Casts the connection from a surface point to the lens point (a shadow
 /// ray, counted) and says whether nothing is in between.
 #[inline]
-fn sees_lens(
+pub(super) fn sees_lens(
     scene: &Scene,
     point: Vec3A,
     error: Vec3A,
@@ -213,7 +214,7 @@ fn sees_lens(
 /// The sample weight f cos / p in importance transport: as for radiance,
 /// except that refraction does not scale by (eta_i / eta_t)^2.
 #[inline]
-fn importance_weight(bsdf: Bsdf, wo: Vec3A, wi: Vec3A, radiance_weight: Rgb) -> Rgb {
+pub(super) fn importance_weight(bsdf: Bsdf, wo: Vec3A, wi: Vec3A, radiance_weight: Rgb) -> Rgb {
     match bsdf {
         Bsdf::Dielectric { tint, .. } if wo.z * wi.z < 0.0 => tint,
         _ => radiance_weight,

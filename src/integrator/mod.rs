@@ -18,6 +18,7 @@
 //! one line in that list and its controls; `docs/design.md` lists the files.
 
 pub mod ambient_occlusion;
+pub mod bdpt;
 pub mod light;
 pub mod mcrt;
 pub mod mis;
@@ -26,6 +27,7 @@ pub mod path;
 pub mod radiosity;
 pub mod whitted;
 
+pub use bdpt::Bdpt;
 pub use light::{LightTracer, Splat};
 pub use mcrt::McRayTracer;
 pub use mis::MisHeuristic;
@@ -136,11 +138,13 @@ pub trait CameraEstimator: Technique {
 /// An estimator whose paths start at the lights and whose contributions
 /// land anywhere on the film.
 pub trait SplattingEstimator: Technique {
-    /// Traces one path and hands each contribution that reaches the film to
+    /// Traces one path for a sample of pixel `pixel` (which a light path
+    /// may ignore) and hands each contribution that reaches the film to
     /// `splat`, not yet divided by the number of paths of the pass.
     fn trace(
         &self,
         scene: &Scene,
+        pixel: (u32, u32),
         sampler: &mut Sampler,
         counts: &mut RayCounts,
         splat: impl FnMut(Splat),
@@ -382,11 +386,12 @@ macro_rules! register_techniques {
             pub fn trace(
                 &self,
                 scene: &Scene,
+                pixel: (u32, u32),
                 sampler: &mut Sampler,
                 counts: &mut RayCounts,
                 splat: impl FnMut(Splat),
             ) {
-                match self { $(SplattingIntegrator::$sv(e) => e.trace(scene, sampler, counts, splat),)* }
+                match self { $(SplattingIntegrator::$sv(e) => e.trace(scene, pixel, sampler, counts, splat),)* }
             }
 
             fn kind(&self) -> IntegratorKind {
@@ -570,6 +575,7 @@ register_techniques! {
     }
     splatting {
         Light(LightTracer) = "light", "Light tracing";
+        Bdpt(Bdpt) = "bdpt", "Bidirectional path tracing";
     }
     multi_pass {}
     solver {

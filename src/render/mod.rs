@@ -474,7 +474,7 @@ impl Session {
                         let (x, y) = (x0 + i % tile_width, y0 + i / tile_width);
                         for s in first..first + spp {
                             sampler.start(y * width + x, s);
-                            estimator.trace(scene, &mut sampler, &mut counts, |splat| {
+                            estimator.trace(scene, (x, y), &mut sampler, &mut counts, |splat| {
                                 if !splats.add(splat.film, splat.value) {
                                     non_finite += 1;
                                 }

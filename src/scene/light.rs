@@ -426,6 +426,10 @@ pub struct EmissionSample {
     pub two_sided: bool,
     /// p_select p_area for area lights, p_select for point lights.
     pub pdf_position: f32,
+    /// Density of `direction` wrt. solid angle.
+    pub pdf_direction: f32,
+    /// Which light ([`Lights::sample_emission`] sets it).
+    pub light: u32,
 }
 
 impl EmissionSample {
@@ -522,6 +526,8 @@ impl Light {
                     emitted: intensity,
                     two_sided: true,
                     pdf_position: 1.0,
+                    pdf_direction: 1.0 / (4.0 * PI),
+                    light: 0,
                 });
             }
         };
@@ -539,6 +545,8 @@ impl Light {
             emitted: radiance,
             two_sided,
             pdf_position: 1.0 / area,
+            pdf_direction,
+            light: 0,
         })
     }
 }
@@ -634,6 +642,7 @@ impl Lights {
         s.throughput /= pmf;
         s.error = self.offset.spawn_error(s.error, s.normal);
         s.pdf_position *= pmf;
+        s.light = index as u32;
         (s.throughput.is_finite() && s.pdf_position > 0.0).then_some(s)
     }
 
@@ -649,5 +658,33 @@ impl Lights {
             }
             None => 0.0,
         }
+    }
+
+    /// Densities with which [`Lights::sample_emission`] makes a particle
+    /// leave light `light` at a point of normal `normal` in direction `w`:
+    /// by area (including the light's selection; for point lights the
+    /// selection alone, a discrete probability) and by solid angle.
+    #[inline]
+    pub fn emission_pdf(&self, light: u32, normal: Vec3A, w: Vec3A) -> (f32, f32) {
+        let Some(table) = &self.selection else {
+            return (0.0, 0.0);
+        };
+        let pmf = table.pmf(light as usize);
+        let (area, two_sided) = match self.lights[light as usize] {
+            Light::Triangle(p) | Light::Parallelogram(p) => (p.area, p.two_sided),
+            Light::Sphere {
+                radius, two_sided, ..
+            } => (4.0 * PI * radius * radius, two_sided),
+            Light::Point { .. } => return (pmf, 1.0 / (4.0 * PI)),
+        };
+        // Cosine-weighted about the normal, on one side or on each side
+        // with probability 1/2 (see `emission_direction`).
+        let cos = normal.dot(w);
+        let pdf_direction = if two_sided {
+            0.5 * cos.abs() * std::f32::consts::FRAC_1_PI
+        } else {
+            cos.max(0.0) * std::f32::consts::FRAC_1_PI
+        };
+        (pmf / area, pdf_direction)
     }
 }

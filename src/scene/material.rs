@@ -255,6 +255,24 @@ impl Bsdf {
         }
     }
 
+    /// The factor (eta_i / eta_t)^2 that [`Bsdf::sample`]'s weight applies
+    /// to radiance carried from `wi` to `wo` (directions on opposite sides
+    /// of a dielectric), else 1. Roulette divides it out: radiance inside
+    /// glass is smaller by 1/eta^2 without the path being worth less.
+    #[inline]
+    pub fn refraction_scale(&self, wo: Vec3A, wi: Vec3A) -> f32 {
+        match *self {
+            Bsdf::Dielectric { eta, .. } if wo.z * wi.z < 0.0 => {
+                if wo.z > 0.0 {
+                    1.0 / (eta * eta)
+                } else {
+                    eta * eta
+                }
+            }
+            _ => 1.0,
+        }
+    }
+
     /// Directional albedo hint used to pick lobes and to weigh Russian roulette.
     pub fn max_reflectance(&self) -> f32 {
         match *self {

@@ -188,6 +188,10 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
             seen_emitters(ui, &mut options.exact_seen_emitters);
         }
         IntegratorKind::Light => roulette(ui, &mut options.russian_roulette, &mut options.rr_depth),
+        IntegratorKind::Bdpt => {
+            mis_heuristic(ui, &mut options.mis);
+            roulette(ui, &mut options.russian_roulette, &mut options.rr_depth);
+        }
         IntegratorKind::AmbientOcclusion => {
             let mut limited = options.ao_distance > 0.0;
             ui.checkbox(&mut limited, "Distance limit").on_hover_text(

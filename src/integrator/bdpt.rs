@@ -1,0 +1,867 @@
+//! Bidirectional path tracing (Veach 1997, ch. 10; Lafortune & Willems
+//! 1993): per sample, a camera subpath z_0 .. z_{t-1} and a light subpath
+//! y_0 .. y_{s-1}, and every way (s, t) of joining them into a full path:
+//!
+//! - s = 0: the camera subpath hits a light by itself;
+//! - s = 1: its vertex z_{t-1} samples a point on a light (next-event
+//!   estimation, with the path tracer's light sampling);
+//! - t = 1: the light vertex y_{s-1} is connected to the lens and lands
+//!   anywhere on the film (light tracing);
+//! - otherwise y_{s-1} and z_{t-1} are joined by a shadow ray.
+//!
+//! A path of k bounces can be made by k + 2 strategies (fewer where a vertex
+//! is specular, which no connection can reach); they are combined by
+//! multiple importance sampling. The weight of strategy s is
+//! 1 / sum_i (p_i / p_s)^beta, and the ratios p_i / p_s are walked vertex by
+//! vertex from each subpath's stored forward and reverse densities (area
+//! measure), which stays finite for long paths where products of densities
+//! would not (the ratio walk of pbrt-v4's `MISWeight`; Georgiev's recursive
+//! quantities compute the same sums). The weights only have to sum to one
+//! over the strategies that can make a path, so strategy s = 1 is weighted
+//! with the density of choosing its light point by area, as the light
+//! subpath chooses it, even where light sampling picks it by solid angle.
+//!
+//! One light subpath per camera sample: over a pass of W x H pixels at n
+//! samples each, the camera sees every pixel n times and the film receives
+//! N = W H n light paths, so the film-wide camera density
+//! ([`crate::camera::Camera::pdf_direction`]) is the right one to weigh
+//! t = 1 against the others. Every contribution is a splat of the session's
+//! splatting pass, which divides by N: a camera strategy's estimate for its
+//! own pixel is multiplied by W H.
+
+use super::light::{importance_weight, sees_lens};
+use super::{IntegratorOptions, MisHeuristic, RayCounts, Splat, SplattingEstimator, Technique};
+use crate::accel::{NO_LIGHT, SurfaceHit};
+use crate::math::{Frame, Ray, Rgb, ray_between};
+use crate::sampling::{Domain, Sampler};
+use crate::scene::Scene;
+use crate::scene::material::Bsdf;
+use glam::{Vec2, Vec3A};
+
+/// The deepest path bidirectional path tracing makes: subpaths live in
+/// fixed arrays on the stack, so that a sample allocates nothing.
+pub const MAX_BOUNCES: u32 = 32;
+const MAX_VERTICES: usize = MAX_BOUNCES as usize + 2;
+
+/// Settings of the bidirectional path tracer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bdpt {
+    /// Bounces of a full path (1 = direct lighting), as for path tracing;
+    /// at most [`MAX_BOUNCES`].
+    pub max_depth: u32,
+    /// Roulette on both subpaths after this many bounces of each.
+    pub rr_depth: u32,
+    pub russian_roulette: bool,
+    /// How the strategies are combined (balance or power).
+    pub mis: MisHeuristic,
+    /// For tests only: the strategy (s, t) whose MIS weight is replaced by
+    /// 1, so that its paths are counted twice, as a bug would count them.
+    pub faulty_strategy: Option<(u32, u32)>,
+}
+
+impl Default for Bdpt {
+    fn default() -> Self {
+        Bdpt {
+            max_depth: 8,
+            rr_depth: 5,
+            russian_roulette: true,
+            mis: MisHeuristic::Power,
+            faulty_strategy: None,
+        }
+    }
+}
+
+impl Technique for Bdpt {
+    const SUMMARY: &'static str = "Bidirectional path tracing: camera and light subpaths joined by \
+         every strategy, weighted by multiple importance sampling.";
+
+    fn from_options(options: &IntegratorOptions) -> Self {
+        Bdpt {
+            max_depth: options.max_depth.min(MAX_BOUNCES),
+            rr_depth: options.rr_depth,
+            russian_roulette: options.russian_roulette,
+            mis: options.combining_heuristic(),
+            faulty_strategy: None,
+        }
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "bdpt (max depth {}, mis {:?}, rr {})",
+            self.max_depth,
+            self.mis,
+            if self.russian_roulette {
+                format!("from {}", self.rr_depth)
+            } else {
+                "off".into()
+            }
+        )
+    }
+}
+
+/// What kind of point a subpath vertex is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    /// The lens point z_0.
+    Camera,
+    /// A point on a light, y_0 (or the light point sampled for s = 1).
+    Light,
+    /// A surface the subpath hit.
+    Surface,
+}
+
+/// A subpath vertex: where it is, what the subpath carries to it, and the
+/// densities (area measure) of sampling it from either side.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    kind: Kind,
+    point: Vec3A,
+    error: Vec3A,
+    /// Geometric normal; zero for a pinhole or a point light, which have
+    /// no surface to project densities on.
+    normal: Vec3A,
+    /// Unit direction towards the previous vertex of its subpath.
+    wo: Vec3A,
+    bsdf: Bsdf,
+    /// The subpath's weight up to here: the product of f cos / p, with the
+    /// emission (light) or importance (camera) it started with.
+    beta: Rgb,
+    /// Density of this vertex when sampled from the previous one of its
+    /// own subpath, and when sampled from the next one (the other way).
+    pdf_fwd: f32,
+    pdf_rev: f32,
+    /// The vertex scattered specularly: no connection can reach it.
+    delta: bool,
+    /// A point light: no subpath can hit it.
+    delta_light: bool,
+    /// The light the point lies on (light vertices and emitting surfaces),
+    /// else [`NO_LIGHT`].
+    light: u32,
+    /// Radiance emitted towards `wo` (surfaces); Le (or a point light's
+    /// intensity) and its sidedness for light vertices.
+    emitted: Rgb,
+    two_sided: bool,
+    /// Random numbers reserved for this vertex's connection: a light
+    /// choice and point (camera subpath), a lens point (light subpath).
+    u_select: f32,
+    u_connect: Vec2,
+}
+
+impl Vertex {
+    const EMPTY: Vertex = Vertex {
+        kind: Kind::Surface,
+        point: Vec3A::ZERO,
+        error: Vec3A::ZERO,
+        normal: Vec3A::ZERO,
+        wo: Vec3A::ZERO,
+        bsdf: Bsdf::Diffuse { albedo: Rgb::ZERO },
+        beta: Rgb::ZERO,
+        pdf_fwd: 0.0,
+        pdf_rev: 0.0,
+        delta: false,
+        delta_light: false,
+        light: NO_LIGHT,
+        emitted: Rgb::ZERO,
+        two_sided: false,
+        u_select: 0.0,
+        u_connect: Vec2::ZERO,
+    };
+
+    /// f(wo -> w) at a surface, or the emitted radiance towards `w` at a
+    /// light vertex (whose beta is 1 / p_position); `w` is a unit vector.
+    #[inline]
+    fn scatter(&self, w: Vec3A) -> Rgb {
+        match self.kind {
+            Kind::Surface => {
+                let frame = Frame::from_normal(self.normal);
+                self.bsdf.eval(frame.to_local(self.wo), frame.to_local(w))
+            }
+            Kind::Light => {
+                if self.normal == Vec3A::ZERO || self.two_sided || self.normal.dot(w) > 0.0 {
+                    self.emitted
+                } else {
+                    Rgb::ZERO
+                }
+            }
+            Kind::Camera => Rgb::ZERO,
+        }
+    }
+
+    /// |cos| between the normal and the unit vector `w` (1 without a normal).
+    #[inline]
+    fn cos(&self, w: Vec3A) -> f32 {
+        if self.normal == Vec3A::ZERO {
+            1.0
+        } else {
+            self.normal.dot(w).abs()
+        }
+    }
+
+    /// A density wrt. solid angle at this vertex turned into one wrt. area
+    /// at `next`.
+    #[inline]
+    fn to_area(&self, pdf_direction: f32, next: &Vertex) -> f32 {
+        let d = next.point - self.point;
+        let dist2 = d.length_squared();
+        if !(dist2 > 0.0) {
+            return 0.0;
+        }
+        pdf_direction * next.cos(d / dist2.sqrt()) / dist2
+    }
+}
+
+/// A subpath: its vertices in order, in a fixed array.
+struct Subpath {
+    vertices: [Vertex; MAX_VERTICES],
+    len: usize,
+}
+
+impl Subpath {
+    fn new() -> Self {
+        Subpath {
+            vertices: [Vertex::EMPTY; MAX_VERTICES],
+            len: 0,
+        }
+    }
+
+    fn as_slice(&self) -> &[Vertex] {
+        &self.vertices[..self.len]
+    }
+}
+
+/// One contribution of one strategy: where it lands on the film, and its
+/// value with and without the MIS weight (not yet divided by the number of
+/// light paths of the pass).
+#[derive(Clone, Copy, Debug)]
+pub struct Contribution {
+    pub s: u32,
+    pub t: u32,
+    pub film: Vec2,
+    pub weighted: Rgb,
+    pub unweighted: Rgb,
+}
+
+/// Which way a subpath carries its weight: radiance towards the camera
+/// (refraction scales by (eta_i / eta_t)^2) or importance towards the lights
+/// (it does not; Veach's thesis, 5.2).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Transport {
+    Radiance,
+    Importance,
+}
+
+impl SplattingEstimator for Bdpt {
+    fn trace(
+        &self,
+        scene: &Scene,
+        pixel: (u32, u32),
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+        mut splat: impl FnMut(Splat),
+    ) {
+        self.trace_strategies(scene, pixel, sampler, counts, |c| {
+            splat(Splat {
+                film: c.film,
+                value: c.weighted,
+            })
+        });
+    }
+}
+
+impl Bdpt {
+    /// Traces one sample of pixel `pixel` and hands every strategy's
+    /// contribution to `contribute` (the strategy images read them all).
+    pub fn trace_strategies(
+        &self,
+        scene: &Scene,
+        (x, y): (u32, u32),
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+        mut contribute: impl FnMut(Contribution),
+    ) {
+        let camera = &scene.camera;
+        let ray = crate::render::camera_ray(scene, sampler, x, y, false, false);
+        let time = ray.time;
+        counts.camera += 1;
+        let film = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+        // A camera strategy's value is its pixel's estimate; the splat
+        // buffer divides by W H n, the pixel's samples are n.
+        let pixel_scale = camera.width as f32 * camera.height as f32;
+
+        let max_depth = self.max_depth.min(MAX_BOUNCES) as usize;
+        let mut camera_path = Subpath::new();
+        camera_path.vertices[0] = Vertex {
+            kind: Kind::Camera,
+            point: ray.origin,
+            beta: Rgb::ONE,
+            pdf_fwd: 1.0,
+            ..Vertex::EMPTY
+        };
+        camera_path.len = 1;
+        let pdf_direction = camera.pdf_direction(ray.direction);
+        self.random_walk(
+            scene,
+            ray,
+            Rgb::ONE,
+            pdf_direction,
+            Transport::Radiance,
+            max_depth + 2,
+            sampler,
+            counts,
+            &mut camera_path,
+        );
+
+        let mut light_path = Subpath::new();
+        let u_select = sampler.next_1d_for(Domain::Light);
+        let u_position = sampler.next_2d_for(Domain::Light);
+        let u_direction = sampler.next_2d_for(Domain::Light);
+        let u_lens = sampler.next_2d_for(Domain::Lens);
+        if let Some(emission) = scene
+            .lights
+            .sample_emission(u_select, u_position, u_direction)
+        {
+            light_path.vertices[0] = Vertex {
+                kind: Kind::Light,
+                point: emission.point,
+                error: emission.error,
+                normal: emission.normal,
+                beta: Rgb::splat(1.0 / emission.pdf_position),
+                pdf_fwd: emission.pdf_position,
+                delta_light: emission.normal == Vec3A::ZERO,
+                light: emission.light,
+                emitted: emission.emitted,
+                two_sided: emission.two_sided,
+                u_connect: u_lens,
+                ..Vertex::EMPTY
+            };
+            light_path.len = 1;
+            let ray = Ray::new(
+                crate::math::offset_ray_origin(
+                    emission.point,
+                    emission.error,
+                    emission.normal,
+                    emission.direction,
+                ),
+                emission.direction,
+            )
+            .at_time(time);
+            counts.bounce += 1;
+            self.random_walk(
+                scene,
+                ray,
+                emission.throughput,
+                emission.pdf_direction,
+                Transport::Importance,
+                max_depth + 1,
+                sampler,
+                counts,
+                &mut light_path,
+            );
+        }
+
+        let (cam, light) = (camera_path.as_slice(), light_path.as_slice());
+        for t in 1..=cam.len() {
+            for s in 0..=light.len() {
+                if s + t < 2 || s + t - 2 > max_depth {
+                    continue;
+                }
+                let Some((value, film_at, sampled)) =
+                    self.connect(scene, cam, light, s, t, time, counts)
+                else {
+                    continue;
+                };
+                let weight = if self.faulty_strategy == Some((s as u32, t as u32)) {
+                    1.0
+                } else {
+                    self.mis_weight(scene, cam, light, s, t, &sampled)
+                };
+                let (film, scale) = match film_at {
+                    Some(f) => (f, 1.0),
+                    None => (film, pixel_scale),
+                };
+                contribute(Contribution {
+                    s: s as u32,
+                    t: t as u32,
+                    film,
+                    weighted: value * (weight * scale),
+                    unweighted: value * scale,
+                });
+            }
+        }
+    }
+
+    /// Extends `path` (which holds its first vertex) by tracing `ray` and
+    /// sampling BSDFs, up to `max_vertices` vertices. `beta`: the weight the
+    /// first ray carries; `pdf_direction`: the density of its direction.
+    #[allow(clippy::too_many_arguments)]
+    fn random_walk(
+        &self,
+        scene: &Scene,
+        mut ray: Ray,
+        mut beta: Rgb,
+        mut pdf_direction: f32,
+        transport: Transport,
+        max_vertices: usize,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+        path: &mut Subpath,
+    ) {
+        // What the subpath carries relative to where it started, with the
+        // radiance scaling of refraction divided out: roulette reads it, so
+        // that neither a light's units nor a stay inside glass decide how
+        // long a path lives.
+        let mut relative = Rgb::ONE;
+        let mut bounces = 0;
+        while path.len < max_vertices {
+            let u_lobe = sampler.next_1d_for(Domain::Bsdf);
+            let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
+            let u_roulette = sampler.next_1d_for(Domain::Other);
+            let (u_select, u_connect) = match transport {
+                Transport::Radiance => (
+                    sampler.next_1d_for(Domain::Light),
+                    sampler.next_2d_for(Domain::Light),
+                ),
+                Transport::Importance => (0.0, sampler.next_2d_for(Domain::Lens)),
+            };
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                break;
+            };
+            let material = &scene.materials[hit.material as usize];
+            let wo_world = -ray.direction;
+            let index = path.len;
+            let previous = path.vertices[index - 1];
+            let mut vertex = surface_vertex(&hit, material.bsdf, wo_world, beta);
+            if hit.light != NO_LIGHT {
+                vertex.light = hit.light;
+                vertex.emitted = material.emitted(hit.normal, wo_world);
+            }
+            vertex.u_select = u_select;
+            vertex.u_connect = u_connect;
+            vertex.pdf_fwd = previous.to_area(pdf_direction, &vertex);
+            path.vertices[index] = vertex;
+            path.len += 1;
+            if path.len >= max_vertices || material.bsdf.is_black() {
+                break;
+            }
+
+            let frame = Frame::from_normal(hit.normal);
+            let wo = frame.to_local(wo_world);
+            let bsdf = material.bsdf;
+            let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
+                break;
+            };
+            let weight = match transport {
+                Transport::Radiance => {
+                    relative /= bsdf.refraction_scale(wo, sample.wi);
+                    sample.weight
+                }
+                Transport::Importance => importance_weight(bsdf, wo, sample.wi, sample.weight),
+            };
+            let (pdf_fwd, pdf_rev) = if sample.specular {
+                (0.0, 0.0)
+            } else {
+                (sample.pdf, bsdf.pdf(sample.wi, wo))
+            };
+            let vertex = &mut path.vertices[index];
+            vertex.delta = sample.specular;
+            beta *= weight;
+            relative *= weight;
+            let vertex = *vertex;
+            path.vertices[index - 1].pdf_rev = vertex.to_area(pdf_rev, &previous);
+            bounces += 1;
+            if self.russian_roulette && bounces > self.rr_depth {
+                let q = relative.max_element().min(0.95);
+                if u_roulette >= q {
+                    break;
+                }
+                beta /= q;
+                relative /= q;
+            }
+            if !(beta.max_element() > 0.0) {
+                break;
+            }
+            pdf_direction = pdf_fwd;
+            ray = hit.spawn_ray(frame.to_world(sample.wi));
+            counts.bounce += 1;
+        }
+    }
+
+    /// The unweighted contribution of strategy (s, t), the film position
+    /// where it lands when that is not the sample's pixel (t = 1), and the
+    /// vertex the strategy sampled for itself (the light point of s = 1,
+    /// the lens point of t = 1), which the MIS weight needs.
+    #[allow(clippy::too_many_arguments)]
+    fn connect(
+        &self,
+        scene: &Scene,
+        cam: &[Vertex],
+        light: &[Vertex],
+        s: usize,
+        t: usize,
+        time: f32,
+        counts: &mut RayCounts,
+    ) -> Option<(Rgb, Option<Vec2>, Vertex)> {
+        if s == 0 {
+            // The camera subpath found a light by itself.
+            let pt = &cam[t - 1];
+            if pt.light == NO_LIGHT || pt.kind != Kind::Surface {
+                return None;
+            }
+            let value = pt.beta * pt.emitted;
+            return (value.max_element() > 0.0).then_some((value, None, Vertex::EMPTY));
+        }
+        if t == 1 {
+            // The light vertex seen by the camera: a splat where it lands.
+            let qs = &light[s - 1];
+            if qs.delta {
+                return None;
+            }
+            let c = scene.camera.connect(qs.point, qs.u_connect)?;
+            let value = qs.beta * qs.scatter(c.wi) * (qs.cos(c.wi) * c.weight);
+            if !(value.max_element() > 0.0)
+                || !sees_lens(scene, qs.point, qs.error, qs.normal, &c, time, counts)
+            {
+                return None;
+            }
+            let lens = Vertex {
+                kind: Kind::Camera,
+                point: c.lens_point,
+                ..Vertex::EMPTY
+            };
+            return Some((value, Some(c.film), lens));
+        }
+        let pt = &cam[t - 1];
+        if pt.delta || pt.kind != Kind::Surface {
+            return None;
+        }
+        if s == 1 {
+            // Next-event estimation from z_{t-1}.
+            let ls = scene.lights.sample(pt.point, pt.u_select, pt.u_connect)?;
+            let f = pt.scatter(ls.wi);
+            let value = pt.beta * f * ls.radiance * (pt.cos(ls.wi) / ls.pdf);
+            if !(value.max_element() > 0.0) {
+                return None;
+            }
+            counts.shadow += 1;
+            let shadow = ray_between(
+                pt.point, pt.error, pt.normal, ls.point, ls.error, ls.normal,
+            )
+            .at_time(time);
+            if scene.geometry.occluded(&shadow) {
+                return None;
+            }
+            let (pdf_position, _) = scene.lights.emission_pdf(ls.light, ls.normal, -ls.wi);
+            let (emitted, two_sided) = emission_of(scene, ls.light);
+            let sampled = Vertex {
+                kind: Kind::Light,
+                point: ls.point,
+                error: ls.error,
+                normal: ls.normal,
+                pdf_fwd: pdf_position,
+                delta_light: ls.delta,
+                light: ls.light,
+                emitted,
+                two_sided,
+                ..Vertex::EMPTY
+            };
+            return Some((value, None, sampled));
+        }
+        // Both subpaths end on surfaces: a shadow ray joins them.
+        let qs = &light[s - 1];
+        if qs.delta {
+            return None;
+        }
+        let d = pt.point - qs.point;
+        let dist2 = d.length_squared();
+        if !(dist2 > 0.0) {
+            return None;
+        }
+        let w = d / dist2.sqrt();
+        let g = qs.cos(w) * pt.cos(w) / dist2;
+        let value = qs.beta * qs.scatter(w) * pt.scatter(-w) * pt.beta * g;
+        if !(value.max_element() > 0.0) {
+            return None;
+        }
+        counts.shadow += 1;
+        let shadow = ray_between(qs.point, qs.error, qs.normal, pt.point, pt.error, pt.normal)
+            .at_time(time);
+        if scene.geometry.occluded(&shadow) {
+            return None;
+        }
+        Some((value, None, Vertex::EMPTY))
+    }
+
+    /// The MIS weight of strategy (s, t) for the path it made: the
+    /// densities at the two connection vertices and their predecessors are
+    /// those of the joined path (computed here), the rest are stored.
+    fn mis_weight(
+        &self,
+        scene: &Scene,
+        cam: &[Vertex],
+        light: &[Vertex],
+        s: usize,
+        t: usize,
+        sampled: &Vertex,
+    ) -> f32 {
+        // The connection's end points: a vertex a strategy sampled itself
+        // replaces the subpath's own.
+        let qs = if s == 1 && t > 1 {
+            Some(sampled)
+        } else if s > 0 {
+            Some(&light[s - 1])
+        } else {
+            None
+        };
+        let pt = if t == 1 { sampled } else { &cam[t - 1] };
+        let qs_minus = if s > 1 { Some(&light[s - 2]) } else { None };
+        let pt_minus = if t > 1 { Some(&cam[t - 2]) } else { None };
+
+        // Reverse densities of the four vertices next to the connection.
+        let pt_rev = match qs {
+            Some(qs) => pdf(scene, qs, qs_minus, pt),
+            None => scene.lights.emission_pdf(pt.light, pt.normal, pt.wo).0,
+        };
+        let pt_minus_rev = pt_minus.map_or(0.0, |pm| match qs {
+            Some(qs) => pdf(scene, pt, Some(qs), pm),
+            None => light_direction_pdf(scene, pt, pm),
+        });
+        let qs_rev = qs.map_or(0.0, |qs| pdf(scene, pt, pt_minus, qs));
+        let qs_minus_rev = match (qs, qs_minus) {
+            (Some(qs), Some(qm)) => pdf(scene, qs, Some(pt), qm),
+            _ => 0.0,
+        };
+
+        let remap = |p: f32| if p != 0.0 { p } else { 1.0 };
+        let power = |r: f32| match self.mis {
+            MisHeuristic::Balance => r,
+            _ => r * r,
+        };
+        let mut sum = 0.0f32;
+        // Strategies with fewer camera vertices: z_i made by the light side.
+        let mut ratio = 1.0f32;
+        for i in (1..t).rev() {
+            let (v, rev, delta) = if i == t - 1 {
+                (pt, pt_rev, false)
+            } else if i + 2 == t {
+                (&cam[i], pt_minus_rev, cam[i].delta)
+            } else {
+                (&cam[i], cam[i].pdf_rev, cam[i].delta)
+            };
+            ratio *= remap(rev) / remap(v.pdf_fwd);
+            if !delta && !cam[i - 1].delta {
+                sum += power(ratio);
+            }
+        }
+        // Strategies with fewer light vertices: y_i made by the camera side.
+        let mut ratio = 1.0f32;
+        for i in (0..s).rev() {
+            let (v, rev, delta) = if i == s - 1 {
+                (qs.unwrap_or(&light[i]), qs_rev, false)
+            } else if i + 2 == s {
+                (&light[i], qs_minus_rev, light[i].delta)
+            } else {
+                (&light[i], light[i].pdf_rev, light[i].delta)
+            };
+            ratio *= remap(rev) / remap(v.pdf_fwd);
+            let previous_delta = if i > 0 {
+                light[i - 1].delta
+            } else {
+                v.delta_light
+            };
+            if !delta && !previous_delta {
+                sum += power(ratio);
+            }
+        }
+        let weight = 1.0 / (1.0 + sum);
+
+        if weight.is_finite() { weight } else { 0.0 }
+    }
+}
+
+/// The density (area, at `next`) with which vertex `v`, reached from
+/// `previous`, samples `next`.
+#[inline]
+fn pdf(scene: &Scene, v: &Vertex, previous: Option<&Vertex>, next: &Vertex) -> f32 {
+    let d = next.point - v.point;
+    let dist = d.length();
+    if !(dist > 0.0) {
+        return 0.0;
+    }
+    let w = d / dist;
+    let pdf_direction = match v.kind {
+        Kind::Camera => scene.camera.pdf_direction(w),
+        Kind::Light => return light_direction_pdf(scene, v, next),
+        Kind::Surface => {
+            let wo = previous.map_or(v.wo, |p| (p.point - v.point).normalize_or_zero());
+            let frame = Frame::from_normal(v.normal);
+            v.bsdf.pdf(frame.to_local(wo), frame.to_local(w))
+        }
+    };
+    v.to_area(pdf_direction, next)
+}
+
+/// The density (area, at `next`) with which a particle leaving the light
+/// point `v` heads for `next`.
+#[inline]
+fn light_direction_pdf(scene: &Scene, v: &Vertex, next: &Vertex) -> f32 {
+    let w = (next.point - v.point).normalize_or_zero();
+    let (_, pdf_direction) = scene.lights.emission_pdf(v.light, v.normal, w);
+    v.to_area(pdf_direction, next)
+}
+
+/// A light's emitted radiance (or intensity) and sidedness.
+fn emission_of(scene: &Scene, light: u32) -> (Rgb, bool) {
+    use crate::scene::light::Light;
+    match scene.lights.as_slice()[light as usize] {
+        Light::Triangle(p) | Light::Parallelogram(p) => (p.radiance, p.two_sided),
+        Light::Sphere {
+            radiance,
+            two_sided,
+            ..
+        } => (radiance, two_sided),
+        Light::Point { intensity, .. } => (intensity, true),
+    }
+}
+
+#[inline]
+fn surface_vertex(hit: &SurfaceHit, bsdf: Bsdf, wo: Vec3A, beta: Rgb) -> Vertex {
+    Vertex {
+        kind: Kind::Surface,
+        point: hit.point,
+        error: hit.error,
+        normal: hit.normal,
+        wo,
+        bsdf,
+        beta,
+        ..Vertex::EMPTY
+    }
+}
+
+/// The images of every strategy (s, t) of one render: Veach's pyramid.
+/// Index `strategy_index(s, t)`; each image is linear RGB, row-major.
+pub struct StrategyImages {
+    pub width: u32,
+    pub height: u32,
+    pub max_depth: u32,
+    /// MIS-weighted contributions: they sum to the image.
+    pub weighted: Vec<Vec<[f32; 3]>>,
+    /// The same paths without weights: each alone estimates its share of
+    /// the light (where its strategy can make the paths at all).
+    pub unweighted: Vec<Vec<[f32; 3]>>,
+}
+
+/// Where strategy (s, t) is stored in [`StrategyImages`]: row by row of
+/// bounces k = s + t - 2, then by s.
+pub fn strategy_index(s: u32, t: u32) -> usize {
+    let k = (s + t - 2) as usize;
+    k * (k + 3) / 2 + s as usize
+}
+
+/// Number of strategies of paths up to `max_depth` bounces (t >= 1).
+pub fn strategy_count(max_depth: u32) -> usize {
+    strategy_index(max_depth + 1, 1) + 1
+}
+
+impl StrategyImages {
+    /// Bytes the images of a render at `width` x `height` up to `max_depth`
+    /// take, to refuse a request before allocating.
+    pub fn memory_estimate(width: u32, height: u32, max_depth: u32) -> u64 {
+        2 * strategy_count(max_depth) as u64 * u64::from(width) * u64::from(height) * 12
+    }
+
+    /// Renders `spp` samples per pixel of `scene` with `bdpt` on one thread
+    /// per row band (`threads` bands), keeping every strategy apart.
+    pub fn render(
+        scene: &Scene,
+        bdpt: &Bdpt,
+        sampler: &Sampler,
+        spp: u32,
+    ) -> (StrategyImages, RayCounts) {
+        let (width, height) = (scene.camera.width, scene.camera.height);
+        let max_depth = bdpt.max_depth.min(MAX_BOUNCES);
+        let count = strategy_count(max_depth);
+        let pixels = (width * height) as usize;
+        let mut weighted = vec![vec![[0.0f64; 3]; pixels]; count];
+        let mut unweighted = vec![vec![[0.0f64; 3]; pixels]; count];
+        let mut counts = RayCounts::default();
+        let mut sampler = sampler.clone();
+        for y in 0..height {
+            for x in 0..width {
+                for sample in 0..spp {
+                    sampler.start(y * width + x, sample);
+                    bdpt.trace_strategies(scene, (x, y), &mut sampler, &mut counts, |c| {
+                        let (px, py) = (c.film.x as u32, c.film.y as u32);
+                        if px >= width || py >= height {
+                            return;
+                        }
+                        let i = strategy_index(c.s, c.t);
+                        let p = (py * width + px) as usize;
+                        for k in 0..3 {
+                            weighted[i][p][k] += f64::from(c.weighted[k]);
+                            unweighted[i][p][k] += f64::from(c.unweighted[k]);
+                        }
+                    });
+                }
+            }
+        }
+        let n = f64::from(width) * f64::from(height) * f64::from(spp);
+        let finish = |images: Vec<Vec<[f64; 3]>>| -> Vec<Vec<[f32; 3]>> {
+            images
+                .into_iter()
+                .map(|image| {
+                    image
+                        .into_iter()
+                        .map(|p| p.map(|v| (v / n) as f32))
+                        .collect()
+                })
+                .collect()
+        };
+        (
+            StrategyImages {
+                width,
+                height,
+                max_depth,
+                weighted: finish(weighted),
+                unweighted: finish(unweighted),
+            },
+            counts,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::SamplerKind;
+
+    #[test]
+    fn strategy_indices_are_dense() {
+        let mut seen = vec![false; strategy_count(4)];
+        for k in 0..=4u32 {
+            for s in 0..=k + 1 {
+                let i = strategy_index(s, k + 2 - s);
+                assert!(!seen[i]);
+                seen[i] = true;
+            }
+        }
+        assert!(seen.iter().all(|&b| b));
+    }
+
+    #[test]
+    #[ignore]
+    fn debug_means() {
+        let mut scene =
+            Scene::load(std::path::Path::new("scenes/cornell_box.toml")).unwrap();
+        scene.set_resolution(32, 32);
+        let bdpt = Bdpt { max_depth: 1, ..Bdpt::default() };
+        let sampler = Sampler::new(SamplerKind::Independent, 1, 64);
+        let (images, _) = StrategyImages::render(&scene, &bdpt, &sampler, 64);
+        for k in 0..=1u32 {
+            for s in 0..=k + 1 {
+                let i = strategy_index(s, k + 2 - s);
+                let mean = |im: &Vec<[f32; 3]>| im.iter().map(|p| p[0] as f64).sum::<f64>() / im.len() as f64;
+                println!("s {s} t {} weighted {:.5} unweighted {:.5}", k + 2 - s, mean(&images.weighted[i]), mean(&images.unweighted[i]));
+            }
+        }
+    }
+}
