@@ -10,8 +10,9 @@
 //! counts. The image mean must agree within 4 standard errors of the mean.
 //!
 //! Every unbiased estimator must pass: path tracing with each strategy, MC
-//! ray tracing without branching, and light tracing (rendered in 1-spp passes,
-//! for which its film's standard error is exact).
+//! ray tracing without branching, light tracing and bidirectional path
+//! tracing (splatting estimators, rendered in 1-spp passes, for which their
+//! film's standard error is exact).
 
 use crate::common::{cornell_box, mean_and_standard_error, reference, render_adaptive};
 use tracelab::integrator::{IntegratorKind, IntegratorOptions, Strategy};
@@ -37,7 +38,7 @@ fn check_adaptive_against_reference(
     reference_name: &str,
     variance_name: &str,
 ) -> f64 {
-    let pass = if options.kind == IntegratorKind::Light {
+    let pass = if matches!(options.kind, IntegratorKind::Light | IntegratorKind::Bdpt) {
         1
     } else {
         8
@@ -156,6 +157,15 @@ fn mc_ray_tracing_without_branching_matches_mitsuba() {
 fn light_tracing_matches_mitsuba_on_the_cornell_box() {
     check_against_reference(
         options(IntegratorKind::Light, 8),
+        "cornell_box_path_ref.exr",
+        "cornell_box_path_ref_var.exr",
+    );
+}
+
+#[test]
+fn bidirectional_path_tracing_matches_mitsuba_on_the_cornell_box() {
+    check_against_reference(
+        options(IntegratorKind::Bdpt, 8),
         "cornell_box_path_ref.exr",
         "cornell_box_path_ref_var.exr",
     );

@@ -17,7 +17,7 @@ use tracelab::integrator::{Integrator, MisHeuristic, PathTracer};
 use tracelab::sampling::SamplerKind;
 use tracelab::scene::Scene;
 
-const SIZE: u32 = 64;
+pub(crate) const SIZE: u32 = 64;
 const BLOCK: u32 = 8;
 
 fn render_small(tracer: PathTracer, spp: u32, seed: u64) -> FilmSnapshot {
@@ -38,7 +38,7 @@ fn render_scene(mut scene: Scene, tracer: PathTracer, spp: u32, seed: u64) -> Fi
 }
 
 /// Block means and their squared standard errors.
-fn blocks(s: &FilmSnapshot) -> Vec<([f64; 3], [f64; 3])> {
+pub(crate) fn blocks(s: &FilmSnapshot) -> Vec<([f64; 3], [f64; 3])> {
     let per_side = SIZE / BLOCK;
     let mut out = vec![([0.0; 3], [0.0; 3]); (per_side * per_side) as usize];
     for y in 0..SIZE {
@@ -57,7 +57,8 @@ fn blocks(s: &FilmSnapshot) -> Vec<([f64; 3], [f64; 3])> {
         .collect()
 }
 
-fn assert_agree(name: &str, a: &FilmSnapshot, b: &FilmSnapshot) {
+/// The largest |z| of the block differences of two 64x64 renders.
+pub(crate) fn largest_block_z(a: &FilmSnapshot, b: &FilmSnapshot) -> f64 {
     let mut worst = 0.0f64;
     for (ba, bb) in blocks(a).iter().zip(blocks(b).iter()) {
         for c in 0..3 {
@@ -65,6 +66,11 @@ fn assert_agree(name: &str, a: &FilmSnapshot, b: &FilmSnapshot) {
             worst = worst.max(z.abs());
         }
     }
+    worst
+}
+
+pub(crate) fn assert_agree(name: &str, a: &FilmSnapshot, b: &FilmSnapshot) {
+    let worst = largest_block_z(a, b);
     eprintln!("{name}: largest block z-score {worst:.2}");
     assert!(
         worst < 4.5,

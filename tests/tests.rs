@@ -21,6 +21,8 @@ mod estimators;
 mod ambient_occlusion;
 // NEE on/off and MIS variants converge to the same image.
 mod strategies;
+// Bidirectional path tracing: strategy images, agreement, a wrong weight caught.
+mod bidirectional;
 // Same seed, same film, whatever the thread count or pass split.
 mod determinism;
 // Motion blur: a moving occluder against a case solved by hand.
