@@ -90,6 +90,9 @@ struct ViewArgs {
     /// Start a side-by-side comparison (B = A with the Sobol sampler).
     #[arg(long)]
     compare: bool,
+    /// Start a side-by-side comparison at equal time, B rendered by this technique.
+    #[arg(long, value_enum, conflicts_with = "compare")]
+    compare_with: Option<IntegratorArg>,
     /// Start with adaptive sampling by noise on (after 4 spp everywhere).
     #[arg(long)]
     distribute: bool,
@@ -129,6 +132,7 @@ pub fn run(cli: Cli) -> Result<()> {
             screenshot: None,
             after_spp: 64,
             compare: false,
+            compare_with: None,
             distribute: false,
             show: None,
             threads: 0,
@@ -176,6 +180,7 @@ fn view(args: ViewArgs) -> Result<()> {
         screenshot: args.screenshot,
         after_spp: args.after_spp,
         compare: args.compare,
+        compare_with: args.compare_with.map(integrator_kind),
         distribute: args.distribute,
         show: args.show.map(|s| match s {
             ShowArg::Image => tracelab::viewer::ViewMode::Image,

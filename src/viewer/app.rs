@@ -149,6 +149,12 @@ impl ViewerApp {
                 ..settings.a
             };
         }
+        if let Some(kind) = launch.compare_with {
+            settings.compare = true;
+            settings.lock = crate::live::Lock::EqualTime;
+            settings.b = settings.a;
+            settings.b.integrator.kind = kind;
+        }
         if let Some(dir) = &launch.export_dir {
             settings.export_dir = dir.to_string_lossy().into_owned();
         }

@@ -18,6 +18,8 @@ pub struct Launch {
     pub after_spp: u32,
     /// Open a side-by-side comparison (A as given, B with the Sobol sampler).
     pub compare: bool,
+    /// Open a comparison at equal time with B rendered by this technique.
+    pub compare_with: Option<IntegratorKind>,
     /// Start with adaptive sampling by noise on.
     pub distribute: bool,
     /// Start in this view mode.
