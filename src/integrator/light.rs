@@ -122,6 +122,9 @@ impl SplattingEstimator for LightTracer {
         }
 
         let mut beta = emission.throughput;
+        // Roulette reads beta relative to the particle's starting weight
+        // (whose size is the light's power in the scene's units).
+        let roulette_scale = 1.0 / emission.throughput.max_element();
         let mut ray = Ray::new(
             offset_ray_origin(
                 emission.point,
@@ -172,7 +175,7 @@ impl SplattingEstimator for LightTracer {
             bounces += 1;
             if self.russian_roulette
                 && bounces > self.rr_depth
-                && !survives_roulette(&mut beta, u_roulette)
+                && !survives_roulette(&mut beta, roulette_scale, u_roulette)
             {
                 break;
             }

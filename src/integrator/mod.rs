@@ -58,12 +58,15 @@ impl RayCounts {
 }
 
 /// Russian roulette (after the first `rr_depth` bounces): the path survives
-/// with probability q = min(max(beta), 0.95) (Mitsuba's choice) and is
-/// reweighted by 1/q, which keeps the estimate unbiased while paths that
-/// carry little energy end early. Returns false when the path ends.
+/// with probability q = min(max(beta) * scale, 0.95) (Mitsuba's choice) and
+/// is reweighted by 1/q, which keeps the estimate unbiased while paths that
+/// carry little energy end early. `scale` takes out of beta what does not
+/// make a path worth less: the 1/eta^2 of radiance inside glass (Mitsuba
+/// multiplies by eta^2), or a light path's starting power, so that the
+/// scene's units do not decide. Returns false when the path ends.
 #[inline]
-pub(crate) fn survives_roulette(beta: &mut Rgb, u: f32) -> bool {
-    let q = beta.max_element().min(0.95);
+pub(crate) fn survives_roulette(beta: &mut Rgb, scale: f32, u: f32) -> bool {
+    let q = (beta.max_element() * scale).min(0.95);
     if u >= q {
         return false;
     }

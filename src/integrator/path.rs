@@ -249,6 +249,9 @@ impl PathTracer {
     ) -> Rgb {
         let mut radiance = Rgb::ZERO;
         let mut beta = Rgb::ONE;
+        // 1 / the (eta_i / eta_t)^2 factors in beta: roulette reads beta
+        // without them, as if the path were outside the glass.
+        let mut eta_scale = 1.0f32;
         // The camera ray behaves like a specular bounce: emission it finds is
         // counted in full because no light sample could have found it.
         let mut specular_bounce = true;
@@ -361,14 +364,17 @@ impl PathTracer {
                 observer.bsdf_sample(&sample);
                 beta *= sample.weight;
                 specular_bounce = !DIFFUSE_ONLY && sample.specular;
+                if specular_bounce {
+                    eta_scale /= bsdf.refraction_scale(wo, sample.wi);
+                }
                 prev_bsdf_pdf = sample.pdf;
                 prev_point = hit.point;
                 bounces += 1;
 
                 if self.russian_roulette && bounces > self.rr_depth {
-                    let q = beta.max_element().min(0.95);
+                    let q = (beta.max_element() * eta_scale).min(0.95);
                     let u_roulette = sampler.get_1d_for(vertex_dim + 4, Domain::Other);
-                    let survived = survives_roulette(&mut beta, u_roulette);
+                    let survived = survives_roulette(&mut beta, eta_scale, u_roulette);
                     observer.roulette(q, survived);
                     if !survived {
                         break 'next None;
