@@ -141,6 +141,17 @@ pub struct RenderArgs {
     /// scene's bounding-box diagonal (0: no limit).
     #[arg(long, default_value_t = 0.1)]
     ao_distance: f32,
+    /// Photon mapping: photons per iteration (0: one per pixel).
+    #[arg(long, default_value_t = 0)]
+    photons: u32,
+    /// Photon mapping: gather radius of the first iteration, as a fraction
+    /// of the scene's bounding-box diagonal.
+    #[arg(long, default_value_t = 0.002)]
+    radius: f32,
+    /// Photon mapping: the radius shrinks as r_i^2 = r_1^2 i^(alpha - 1)
+    /// (0 < alpha <= 1; 1 keeps it fixed, a biased estimate).
+    #[arg(long, default_value_t = 2.0 / 3.0)]
+    alpha: f32,
     #[command(flatten)]
     pub(crate) radiosity: RadiosityFlags,
     /// Path tracing and Whitted: run the general code, not the code
@@ -523,6 +534,15 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
         )));
     }
     args.radiosity.check()?;
+    if !(args.radius > 0.0 && args.radius < 1.0) {
+        return Err(Error::new(format!(
+            "--radius {} is not a fraction in (0, 1) of the scene's size",
+            args.radius
+        )));
+    }
+    if !(args.alpha > 0.0 && args.alpha <= 1.0) {
+        return Err(Error::new(format!("--alpha {} is not in (0, 1]", args.alpha)));
+    }
     if integrator_kind(args.integrator) == IntegratorKind::Mcrt
         && args.shadow_rays + args.glossy_rays == 0
     {
@@ -550,6 +570,9 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
         general: args.general,
         exact_seen_emitters: args.seen_emitters == SeenEmittersArg::Exact,
         ao_distance: args.ao_distance,
+        photons: args.photons,
+        photon_radius: args.radius,
+        photon_alpha: args.alpha,
         ..args.radiosity.options()
     })
 }

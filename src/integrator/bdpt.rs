@@ -832,7 +832,6 @@ impl StrategyImages {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::SamplerKind;
 
     #[test]
     fn strategy_indices_are_dense() {
@@ -845,23 +844,5 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&b| b));
-    }
-
-    #[test]
-    #[ignore]
-    fn debug_means() {
-        let mut scene =
-            Scene::load(std::path::Path::new("scenes/cornell_box.toml")).unwrap();
-        scene.set_resolution(32, 32);
-        let bdpt = Bdpt { max_depth: 1, ..Bdpt::default() };
-        let sampler = Sampler::new(SamplerKind::Independent, 1, 64);
-        let (images, _) = StrategyImages::render(&scene, &bdpt, &sampler, 64);
-        for k in 0..=1u32 {
-            for s in 0..=k + 1 {
-                let i = strategy_index(s, k + 2 - s);
-                let mean = |im: &Vec<[f32; 3]>| im.iter().map(|p| p[0] as f64).sum::<f64>() / im.len() as f64;
-                println!("s {s} t {} weighted {:.5} unweighted {:.5}", k + 2 - s, mean(&images.weighted[i]), mean(&images.unweighted[i]));
-            }
-        }
     }
 }

@@ -24,6 +24,7 @@ pub mod mcrt;
 pub mod mis;
 pub mod options;
 pub mod path;
+pub mod photon;
 pub mod radiosity;
 pub mod whitted;
 
@@ -580,7 +581,9 @@ register_techniques! {
         Light(LightTracer) = "light", "Light tracing";
         Bdpt(Bdpt) = "bdpt", "Bidirectional path tracing";
     }
-    multi_pass {}
+    multi_pass {
+        Sppm(photon::PhotonMapper) = "sppm", "Progressive photon mapping";
+    }
     solver {
         Radiosity(radiosity::Radiosity) = "radiosity", "Radiosity";
     }

@@ -60,6 +60,11 @@ pub struct IntegratorOptions {
     pub radiosity_iterations: u32,
     pub radiosity_display: RadiosityDisplay,
     pub radiosity_epsilon: f32,
+    /// Photon mapping: photons per iteration (0: one per pixel), the first
+    /// iteration's radius (fraction of the scene's diagonal) and alpha.
+    pub photons: u32,
+    pub photon_radius: f32,
+    pub photon_alpha: f32,
 }
 
 impl Default for IntegratorOptions {
@@ -86,6 +91,9 @@ impl Default for IntegratorOptions {
             radiosity_iterations: 0,
             radiosity_display: RadiosityDisplay::Gather,
             radiosity_epsilon: 1e-4,
+            photons: 0,
+            photon_radius: 0.002,
+            photon_alpha: 2.0 / 3.0,
         }
     }
 }

@@ -192,6 +192,22 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
             mis_heuristic(ui, &mut options.mis);
             roulette(ui, &mut options.russian_roulette, &mut options.rr_depth);
         }
+        IntegratorKind::Sppm => {
+            ui.add(
+                egui::Slider::new(&mut options.photons, 0..=4_000_000)
+                    .logarithmic(true)
+                    .text("Photons per iteration (0: one per pixel)"),
+            );
+            ui.add(
+                egui::Slider::new(&mut options.photon_radius, 1e-4..=0.05)
+                    .logarithmic(true)
+                    .text("First radius (of the scene's diagonal)"),
+            );
+            ui.add(
+                egui::Slider::new(&mut options.photon_alpha, 0.05..=1.0)
+                    .text("Alpha (1: fixed radius, biased)"),
+            );
+        }
         IntegratorKind::AmbientOcclusion => {
             let mut limited = options.ao_distance > 0.0;
             ui.checkbox(&mut limited, "Distance limit").on_hover_text(
