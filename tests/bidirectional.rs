@@ -1,6 +1,7 @@
 //! Bidirectional path tracing: its strategies add up to its image, it agrees
 //! with path tracing and light tracing on the Cornell box, the caustic scene
-//! and the indirectly lit room, and a wrong MIS weight is caught.
+//! and the indirectly lit room, and a wrong MIS weight is caught. Progressive
+//! photon mapping converges to path tracing's image as its radius shrinks.
 //!
 //! Agreement is the block z-test of `strategies.rs` (8x8 blocks of a 64x64
 //! render, |z| < 4.5 over 192 block-channels). Splatting estimators render
@@ -125,4 +126,54 @@ fn a_wrong_strategy_weight_is_caught() {
     let wrong = render(scene("cornell_box.toml"), Integrator::from(faulty), 256, 1);
     let worst = largest_block_z(&reference, &wrong);
     assert!(worst > 4.5, "a wrong weight went unnoticed (largest z {worst:.2})");
+}
+
+#[test]
+fn photon_mapping_converges_as_its_radius_shrinks() {
+    use std::sync::Arc;
+    use tracelab::integrator::photon::PhotonMapper;
+    use tracelab::render::{RenderSettings, Session};
+    let small = || {
+        let mut scene = cornell_box();
+        scene.set_resolution(32, 32);
+        scene
+    };
+    let (reference, _) = render_with(
+        small(),
+        Integrator::from(PathTracer::default()),
+        SamplerKind::Independent,
+        4096,
+        1,
+        0,
+        256,
+    );
+    let sppm = PhotonMapper {
+        photons: 20_000,
+        ..PhotonMapper::default()
+    };
+    let settings = RenderSettings {
+        integrator: Integrator::MultiPass(tracelab::integrator::MultiPassIntegrator::Sppm(sppm)),
+        sampler: SamplerKind::Independent,
+        seed: 3,
+        planned_spp: 0,
+        threads: 0,
+        adaptive: None,
+        domains: Default::default(),
+        clamp: None,
+    };
+    let session = Session::new(Arc::new(small()), settings).expect("session starts");
+    let mut rmse = Vec::new();
+    for iterations in [8, 128] {
+        while session.stats().spp < iterations {
+            assert!(session.render_pass(8));
+        }
+        rmse.push(session.snapshot().image.compare(&reference.image).unwrap().rmse);
+    }
+    // Bias (~ r^2) and variance (~ 1 / (r^2 N)) both fall as N^(-1/3) in
+    // RMSE for alpha = 2/3; 16 times the iterations should divide the error
+    // by 2.5. A fixed radius would stall at its bias, and a wrong
+    // normalisation would not converge to path tracing at all.
+    let slope = (rmse[1] / rmse[0]).ln() / 16f64.ln();
+    eprintln!("photon mapping RMSE {:.5} -> {:.5} over 8 -> 128 iterations: slope {slope:.3}", rmse[0], rmse[1]);
+    assert!(slope < -0.2, "RMSE {rmse:?}: log-log slope {slope:.3}");
 }

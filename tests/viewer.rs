@@ -304,3 +304,29 @@ fn radiosity_controls_drive_the_solver() {
         tracelab::radiosity::RadiositySolver::Progressive
     );
 }
+
+#[test]
+fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
+    let dir = temp_dir("viewer-bdpt");
+    let mut harness = Harness::builder()
+        .with_size(SIZE)
+        .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 2)));
+    click(&mut harness, "Bidirectional path tracing");
+    click(&mut harness, "Balance");
+    let options = harness.state().app.settings.a.integrator;
+    assert_eq!(options.kind, IntegratorKind::Bdpt);
+    assert_eq!(options.mis, tracelab::integrator::MisHeuristic::Balance);
+    step_until(&mut harness, "2 spp of BDPT", finished);
+    assert!(harness.state().app.frame().views[0].stats.spp >= 2);
+
+    click(&mut harness, "Progressive photon mapping");
+    harness
+        .get_by_label("Alpha (1: fixed radius, biased)")
+        .set_value_accesskit(1.0);
+    harness.run_steps(2);
+    let options = harness.state().app.settings.a.integrator;
+    assert_eq!(options.kind, IntegratorKind::Sppm);
+    assert_eq!(options.photon_alpha, 1.0);
+    step_until(&mut harness, "2 iterations of photon mapping", finished);
+    assert!(harness.state().app.frame().views[0].stats.spp >= 2);
+}

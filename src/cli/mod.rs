@@ -5,6 +5,7 @@ mod bench;
 mod lab;
 mod radiosity;
 mod render;
+mod strategies;
 mod stress;
 
 use clap::{Parser, Subcommand, ValueEnum};

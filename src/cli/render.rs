@@ -13,7 +13,7 @@ use tracelab::film::{EXTREME_LUMINANCE, FinalImage, FlaggedPixel};
 use tracelab::image::check_writable;
 use tracelab::integrator::{
     CameraIntegrator, GlassShadows, Integrator, IntegratorKind, IntegratorOptions, MisHeuristic,
-    SolverProgress, Strategy,
+    SolverProgress, SplattingIntegrator, Strategy,
 };
 use tracelab::math::OffsetMode;
 use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
@@ -216,8 +216,13 @@ pub struct RenderArgs {
     /// index), printing its path's vertices, pdfs and weights.
     #[arg(long, value_parser = parse_debug_sample)]
     debug_sample: Option<(u32, u32, u32)>,
+    /// Bidirectional path tracing: write every strategy's image, weighted
+    /// and unweighted, and two PNG sheets of the (s, t) pyramid into this
+    /// folder instead of one image (one thread, --spp samples).
+    #[arg(long)]
+    strategies: Option<PathBuf>,
     /// Output file: .exr (linear float32) or .png (tone-mapped sRGB).
-    #[arg(long, short, required_unless_present = "debug_sample")]
+    #[arg(long, short, required_unless_present_any = ["debug_sample", "strategies"])]
     out: Option<PathBuf>,
 }
 
@@ -301,6 +306,15 @@ pub fn render(args: &RenderArgs) -> Result<()> {
 
     let integrator = integrator_options(args)?.build();
     let sampler = args.sampler.kind();
+    if let Some(dir) = &args.strategies {
+        let Integrator::Splatting(SplattingIntegrator::Bdpt(bdpt)) = integrator else {
+            return Err(Error::new("--strategies needs --integrator bdpt"));
+        };
+        let spp = args.spp.unwrap_or(16);
+        let sampler = tracelab::sampling::Sampler::new(sampler, args.seed, spp)
+            .with_domains(args.domains.unwrap_or_default());
+        return super::strategies::write(&scene, &bdpt, &sampler, spp, dir);
+    }
     if let Some(a) = args.adaptive
         && !(a.is_finite() && a > 0.0)
     {
