@@ -321,7 +321,7 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
 
     click(&mut harness, "Progressive photon mapping");
     harness
-        .get_by_label("Alpha (1: fixed radius, biased)")
+        .get_by_role_and_label(egui::accesskit::Role::Slider, "Alpha (1: fixed radius, biased)")
         .set_value_accesskit(1.0);
     harness.run_steps(2);
     let options = harness.state().app.settings.a.integrator;

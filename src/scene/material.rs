@@ -139,6 +139,39 @@ impl Bsdf {
         }
     }
 
+    /// f(wo, wi) with the densities of sampling `wi` from `wo` and `wo`
+    /// from `wi`, in one evaluation: what a bidirectional connection needs
+    /// at each end. Equals `(eval(wo, wi), pdf(wo, wi), pdf(wi, wo))`; the
+    /// Phong lobe's cos^n is symmetric in the two directions and computed
+    /// once.
+    #[inline]
+    pub fn eval_with_pdfs(&self, wo: Vec3A, wi: Vec3A) -> (Rgb, f32, f32) {
+        match *self {
+            Bsdf::Glossy {
+                diffuse,
+                specular,
+                exponent,
+                diffuse_probability,
+            } => {
+                let (wo, wi) = to_upper_side(wo, wi);
+                if wo.z <= 0.0 || wi.z <= 0.0 {
+                    return (Rgb::ZERO, 0.0, 0.0);
+                }
+                let cos_alpha = reflect(wo, Vec3A::Z).dot(wi).max(0.0);
+                let lobe = if cos_alpha > 0.0 {
+                    cos_alpha.powf(exponent)
+                } else {
+                    0.0
+                };
+                let f = diffuse * FRAC_1_PI + specular * ((exponent + 2.0) / (2.0 * PI) * lobe);
+                let phong = (1.0 - diffuse_probability) * (exponent + 1.0) / (2.0 * PI) * lobe;
+                let pdf = |w: Vec3A| diffuse_probability * cosine_hemisphere_pdf(w) + phong;
+                (f, pdf(wi), pdf(wo))
+            }
+            _ => (self.eval(wo, wi), self.pdf(wo, wi), self.pdf(wi, wo)),
+        }
+    }
+
     /// Density wrt. solid angle with which [`Bsdf::sample`] picks `wi`; zero for specular BSDFs.
     #[inline]
     pub fn pdf(&self, wo: Vec3A, wi: Vec3A) -> f32 {
