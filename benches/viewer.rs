@@ -3,7 +3,8 @@
 //! setting change to the first image of the new settings, CPU-time fairness
 //! of an equal-time comparison, memory over a long session, and UI frame
 //! times in the MC lab tab while its experiments run
-//! (`TRACELAB_BENCH_ONLY=lab` measures only those).
+//! (`TRACELAB_BENCH_ONLY=lab` measures only those;
+//! `TRACELAB_BENCH_ONLY=transport` only BDPT's and photon mapping's frames).
 //!
 //! `cargo bench --bench viewer` (TRACELAB_SOAK_SECONDS=600 for the 10-minute
 //! memory figure). Prints a table; asserts nothing.
@@ -83,14 +84,43 @@ fn lab_frames(h: &mut Harness<'static, Window>) {
     h.state_mut().app.settings.tab = Tab::Renderer;
 }
 
+/// UI frame times while bidirectional path tracing and photon mapping
+/// render (their passes splat or build a photon map over the whole film).
+fn transport_frames(h: &mut Harness<'static, Window>) {
+    for kind in [IntegratorKind::Bdpt, IntegratorKind::Sppm] {
+        h.state_mut().app.settings.a.integrator.kind = kind;
+        let mut frames = Vec::new();
+        let until = Instant::now() + Duration::from_secs(8);
+        while Instant::now() < until {
+            frames.push(frame(h).as_secs_f64() * 1e3);
+        }
+        println!(
+            "UI frame time while {} renders: median {:.2} ms, p95 {:.2} ms, max {:.2} ms ({} frames, {} spp)",
+            kind.name(),
+            percentile(frames.clone(), 0.5),
+            percentile(frames.clone(), 0.95),
+            percentile(frames.clone(), 1.0),
+            frames.len(),
+            h.state().app.frame().views[0].stats.spp
+        );
+    }
+    h.state_mut().app.settings.a.integrator.kind = IntegratorKind::Path;
+}
+
 fn main() {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
         "viewer responsiveness, 512x512 Cornell box, {cores} cores, kittest (no GPU painting)"
     );
     let mut h = harness();
-    lab_frames(&mut h);
-    if std::env::var("TRACELAB_BENCH_ONLY").is_ok_and(|v| v == "lab") {
+    let only = std::env::var("TRACELAB_BENCH_ONLY").unwrap_or_default();
+    if only.is_empty() || only == "lab" {
+        lab_frames(&mut h);
+    }
+    if only.is_empty() || only == "transport" {
+        transport_frames(&mut h);
+    }
+    if !only.is_empty() {
         return;
     }
     let rss_start = resident_memory_mib().unwrap_or(f64::NAN);

@@ -131,7 +131,7 @@ fn a_wrong_strategy_weight_is_caught() {
 #[test]
 fn photon_mapping_converges_as_its_radius_shrinks() {
     use std::sync::Arc;
-    use tracelab::integrator::photon::PhotonMapper;
+    use tracelab::integrator::sppm::PhotonMapper;
     use tracelab::render::{RenderSettings, Session};
     let small = || {
         let mut scene = cornell_box();

@@ -152,6 +152,13 @@ pub struct RenderArgs {
     /// (0 < alpha <= 1; 1 keeps it fixed, a biased estimate).
     #[arg(long, default_value_t = 2.0 / 3.0)]
     alpha: f32,
+    /// Photon mapping (Jensen): photons per density estimate (1 to 256).
+    #[arg(long, default_value_t = 50)]
+    k: u32,
+    /// Photon mapping (Jensen): the largest gather radius, as a fraction of
+    /// the scene's bounding-box diagonal.
+    #[arg(long, default_value_t = 0.05)]
+    gather_radius: f32,
     #[command(flatten)]
     pub(crate) radiosity: RadiosityFlags,
     /// Path tracing and Whitted: run the general code, not the code
@@ -554,6 +561,15 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
             args.radius
         )));
     }
+    if !(1..=256).contains(&args.k) {
+        return Err(Error::new(format!("--k {} is not in 1..=256", args.k)));
+    }
+    if !(args.gather_radius > 0.0 && args.gather_radius < 1.0) {
+        return Err(Error::new(format!(
+            "--gather-radius {} is not a fraction in (0, 1) of the scene's size",
+            args.gather_radius
+        )));
+    }
     if !(args.alpha > 0.0 && args.alpha <= 1.0) {
         return Err(Error::new(format!("--alpha {} is not in (0, 1]", args.alpha)));
     }
@@ -587,6 +603,8 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
         photons: args.photons,
         photon_radius: args.radius,
         photon_alpha: args.alpha,
+        photon_k: args.k,
+        gather_radius: args.gather_radius,
         ..args.radiosity.options()
     })
 }

@@ -63,8 +63,10 @@ pub fn write(scene: &Scene, bdpt: &Bdpt, sampler: &Sampler, spp: u32, dir: &Path
     } else {
         0.0
     };
-    for (name, tiles) in [("weighted", &images.weighted), ("unweighted", &images.unweighted)] {
-        sheet(&images, tiles).write_png(&dir.join(format!("strategies_{name}.png")), exposure)?;
+    for (name, weighted) in [("weighted", true), ("unweighted", false)] {
+        images
+            .sheet(weighted, SHEET_BOUNCES + 1)
+            .write_png(&dir.join(format!("strategies_{name}.png")), exposure)?;
     }
     println!(
         "wrote {} strategies (weighted and unweighted EXR), sum.exr and two PNG sheets to {}",
@@ -72,23 +74,4 @@ pub fn write(scene: &Scene, bdpt: &Bdpt, sampler: &Sampler, spp: u32, dir: &Path
         dir.display()
     );
     Ok(())
-}
-
-/// The pyramid: row k holds s = 0 .. k + 1, left to right.
-fn sheet(images: &StrategyImages, tiles: &[Vec<[f32; 3]>]) -> Image {
-    let rows = images.max_depth.min(SHEET_BOUNCES) + 1;
-    let (w, h) = (images.width, images.height);
-    let mut sheet = Image::new(w * (rows + 1), h * rows);
-    for k in 0..rows {
-        for s in 0..=k + 1 {
-            let tile = &tiles[strategy_index(s, k + 2 - s)];
-            for y in 0..h {
-                for x in 0..w {
-                    let to = ((k * h + y) * sheet.width + s * w + x) as usize;
-                    sheet.pixels[to] = tile[(y * w + x) as usize];
-                }
-            }
-        }
-    }
-    sheet
 }

@@ -859,6 +859,50 @@ impl StrategyImages {
     }
 }
 
+impl StrategyImages {
+    /// Veach's pyramid as one image: row k holds the strategies of paths of
+    /// k bounces (k = 0 ..= `rows` - 1), s = 0 .. k + 1 from the left.
+    pub fn sheet(&self, weighted: bool, rows: u32) -> crate::image::Image {
+        let tiles = if weighted {
+            &self.weighted
+        } else {
+            &self.unweighted
+        };
+        let rows = rows.min(self.max_depth + 1).max(1);
+        let (w, h) = (self.width, self.height);
+        let mut sheet = crate::image::Image::new(w * (rows + 1), h * rows);
+        for k in 0..rows {
+            for s in 0..=k + 1 {
+                let tile = &tiles[strategy_index(s, k + 2 - s)];
+                for y in 0..h {
+                    let to = ((k * h + y) * sheet.width + s * w) as usize;
+                    let from = (y * w) as usize;
+                    sheet.pixels[to..to + w as usize].copy_from_slice(&tile[from..from + w as usize]);
+                }
+            }
+        }
+        sheet
+    }
+
+    /// Folds `batch` (of the same size and depth) into a running mean of
+    /// which `self` holds `batches` batches so far.
+    pub fn accumulate(&mut self, batch: &StrategyImages, batches: u32) {
+        let t = 1.0 / (batches + 1) as f32;
+        for (mine, theirs) in self
+            .weighted
+            .iter_mut()
+            .chain(self.unweighted.iter_mut())
+            .zip(batch.weighted.iter().chain(&batch.unweighted))
+        {
+            for (a, b) in mine.iter_mut().zip(theirs) {
+                for c in 0..3 {
+                    a[c] += (b[c] - a[c]) * t;
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -25,7 +25,9 @@ pub mod mis;
 pub mod options;
 pub mod path;
 pub mod photon;
+pub mod photon_map;
 pub mod radiosity;
+pub mod sppm;
 pub mod whitted;
 
 pub use bdpt::Bdpt;
@@ -582,7 +584,8 @@ register_techniques! {
         Bdpt(Bdpt) = "bdpt", "Bidirectional path tracing";
     }
     multi_pass {
-        Sppm(photon::PhotonMapper) = "sppm", "Progressive photon mapping";
+        Photon(photon::PhotonMap2Pass) = "photon", "Photon mapping (Jensen)";
+        Sppm(sppm::PhotonMapper) = "sppm", "Progressive photon mapping";
     }
     solver {
         Radiosity(radiosity::Radiosity) = "radiosity", "Radiosity";

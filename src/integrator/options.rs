@@ -65,6 +65,10 @@ pub struct IntegratorOptions {
     pub photons: u32,
     pub photon_radius: f32,
     pub photon_alpha: f32,
+    /// Jensen's photon map: photons per density estimate, and the largest
+    /// gather radius (fraction of the scene's diagonal).
+    pub photon_k: u32,
+    pub gather_radius: f32,
 }
 
 impl Default for IntegratorOptions {
@@ -94,6 +98,8 @@ impl Default for IntegratorOptions {
             photons: 0,
             photon_radius: 0.002,
             photon_alpha: 2.0 / 3.0,
+            photon_k: 50,
+            gather_radius: 0.05,
         }
     }
 }

@@ -116,6 +116,8 @@ pub struct ViewerApp {
     pub scene_field: String,
     /// The Monte Carlo lab tab.
     pub lab: LabState,
+    /// BDPT's live strategy images.
+    pub strategy_grid: super::strategies::StrategyGrid,
 }
 
 impl ViewerApp {
@@ -206,6 +208,7 @@ impl ViewerApp {
             capture_requested: false,
             sheet_mode: false,
             lab,
+            strategy_grid: Default::default(),
         };
         let scene_path = resolve_scene_path(&app.settings.scene_path);
         app.load_scene(&scene_path);

@@ -17,6 +17,7 @@ pub mod launch;
 pub mod panel;
 pub mod settings;
 pub mod stats;
+pub mod strategies;
 pub mod view_transform;
 
 pub use app::ViewerApp;
@@ -89,13 +90,18 @@ impl eframe::App for Window {
             lab_layout(ui, app);
         } else {
             layout(ui, app, &mut self.editing);
+            strategy_grid(&ctx, app);
         }
         toasts(&ctx, app);
         if app.settings.show_help {
             help_window(&ctx, app);
         }
         app.record_frame_time(start.elapsed().as_secs_f32());
-        if app.live().is_rendering() || app.capture.is_some() || app.lab.is_running() {
+        if app.live().is_rendering()
+            || app.capture.is_some()
+            || app.lab.is_running()
+            || app.strategy_grid.open
+        {
             ctx.request_repaint_after(Duration::from_millis(30));
         }
     }
@@ -114,6 +120,19 @@ impl eframe::App for Window {
     fn on_exit(&mut self) {
         self.app.shutdown();
     }
+}
+
+/// BDPT's strategy images, while A is bidirectional and the window open.
+fn strategy_grid(ctx: &egui::Context, app: &mut ViewerApp) {
+    use crate::integrator::{Bdpt, IntegratorKind, Technique};
+    let a = app.settings.a;
+    if a.integrator.kind != IntegratorKind::Bdpt {
+        app.strategy_grid.open = false;
+    }
+    let scene = app.scene().cloned();
+    app.strategy_grid
+        .update(scene.as_ref(), Bdpt::from_options(&a.integrator), a.sampler);
+    app.strategy_grid.show(ctx);
 }
 
 /// The tabs, the scene's name and the view modes (renderer) or nothing more (lab).

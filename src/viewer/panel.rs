@@ -32,6 +32,13 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing)
             &mut app.settings.a
         };
         estimator_section(ui, config);
+        if app.settings.a.integrator.kind == IntegratorKind::Bdpt {
+            ui.checkbox(&mut app.strategy_grid.open, "Strategy images (s, t)")
+                .on_hover_text(
+                    "Veach's pyramid: each strategy's share of the image, filling in live \
+                     (a small copy of the scene on its own thread)",
+                );
+        }
         ui.separator();
         samples_section(ui, app);
         ui.separator();
@@ -191,6 +198,19 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
         IntegratorKind::Bdpt => {
             mis_heuristic(ui, &mut options.mis);
             roulette(ui, &mut options.russian_roulette, &mut options.rr_depth);
+        }
+        IntegratorKind::Photon => {
+            ui.add(
+                egui::Slider::new(&mut options.photons, 0..=4_000_000)
+                    .logarithmic(true)
+                    .text("Photons per map (0: one per pixel)"),
+            );
+            ui.add(egui::Slider::new(&mut options.photon_k, 1..=256).text("k (photons per estimate)"));
+            ui.add(
+                egui::Slider::new(&mut options.gather_radius, 1e-3..=0.2)
+                    .logarithmic(true)
+                    .text("Largest radius (of the scene's diagonal)"),
+            );
         }
         IntegratorKind::Sppm => {
             ui.add(

@@ -1,0 +1,377 @@
+//! Photons and the map that finds them, shared by the photon mappers
+//! (`photon.rs`, Jensen's two-pass method; `sppm.rs`, progressive).
+//!
+//! Photons are found through a hash grid of cells of side 2R built once per
+//! map (a counting sort of photon indices by cell), R the largest radius a
+//! lookup may use: a query sphere then touches at most 2 x 2 x 2 cells.
+//! Every lookup of an iteration has the same largest radius and the map is
+//! rebuilt every iteration, so a k-d tree's balancing and general
+//! nearest-neighbour machinery (kiddo, rstar) buy nothing here; SmallVCM's
+//! hash grid works the same way.
+
+use super::RayCounts;
+use super::light::importance_weight;
+use crate::math::{Frame, Ray, Rgb, offset_ray_origin};
+use crate::sampling::hash::hash_combine;
+use crate::sampling::{Domain, Sampler, SamplerKind};
+use crate::scene::Scene;
+use glam::Vec3A;
+use rayon::prelude::*;
+
+/// A photon: where it landed, where it came from, and what it carries.
+#[derive(Clone, Copy, Debug)]
+pub struct Photon {
+    pub point: Vec3A,
+    /// Unit direction back towards where the photon came from.
+    pub wi: Vec3A,
+    /// The surface's normal on the side the photon arrived, so that photons
+    /// on the far side of a thin wall do not count.
+    pub normal: Vec3A,
+    /// Its weight (flux) after N photons were shot: divide by N.
+    pub power: Rgb,
+}
+
+/// How a photon got where it is: bounces since the light, and whether
+/// every one of them was specular (a caustic photon, L S+ D).
+#[derive(Clone, Copy, Debug)]
+pub struct PhotonPath {
+    pub bounces: u32,
+    pub specular_only: bool,
+}
+
+/// The largest k of a k-nearest lookup.
+pub const MAX_K: usize = 256;
+
+/// Photons in a hash grid.
+pub struct PhotonMap {
+    photons: Vec<Photon>,
+    /// Photon indices sorted by cell hash; `starts[h]..starts[h + 1]`
+    /// are those of hash h.
+    order: Vec<u32>,
+    starts: Vec<u32>,
+    cell: f32,
+    /// The largest lookup radius.
+    radius: f32,
+}
+
+impl PhotonMap {
+    /// A map of `photons` for lookups of radius at most `radius`.
+    pub fn build(photons: Vec<Photon>, radius: f32) -> PhotonMap {
+        let buckets = photons.len().next_power_of_two().max(1);
+        let mut map = PhotonMap {
+            order: vec![0; photons.len()],
+            starts: vec![0; buckets + 1],
+            photons: Vec::new(),
+            cell: 2.0 * radius,
+            radius,
+        };
+        let hashes: Vec<usize> = photons
+            .iter()
+            .map(|p| map.hash(map.cell_of(p.point)))
+            .collect();
+        for &h in &hashes {
+            map.starts[h + 1] += 1;
+        }
+        for i in 1..map.starts.len() {
+            map.starts[i] += map.starts[i - 1];
+        }
+        let mut next = map.starts.clone();
+        for (i, &h) in hashes.iter().enumerate() {
+            map.order[next[h] as usize] = i as u32;
+            next[h] += 1;
+        }
+        map.photons = photons;
+        map
+    }
+
+    fn hash(&self, c: [i32; 3]) -> usize {
+        let h = (c[0] as u32).wrapping_mul(73856093)
+            ^ (c[1] as u32).wrapping_mul(19349663)
+            ^ (c[2] as u32).wrapping_mul(83492791);
+        h as usize % (self.starts.len() - 1)
+    }
+
+    fn cell_of(&self, p: Vec3A) -> [i32; 3] {
+        let c = (p / self.cell).floor();
+        [c.x as i32, c.y as i32, c.z as i32]
+    }
+
+    /// Photons stored.
+    pub fn len(&self) -> usize {
+        self.photons.len()
+    }
+
+    /// True when no photon was stored.
+    pub fn is_empty(&self) -> bool {
+        self.photons.is_empty()
+    }
+
+    /// The largest lookup radius.
+    pub fn radius(&self) -> f32 {
+        self.radius
+    }
+
+    /// Calls `visit` with every photon within the map's radius of `point`
+    /// on the side of the surface that `normal` faces.
+    #[inline]
+    pub fn for_each_near(&self, point: Vec3A, normal: Vec3A, mut visit: impl FnMut(&Photon)) {
+        self.visit_near(point, normal, |_, p| visit(p));
+    }
+
+    /// [`PhotonMap::for_each_near`] with each photon's index.
+    #[inline]
+    fn visit_near(&self, point: Vec3A, normal: Vec3A, mut visit: impl FnMut(u32, &Photon)) {
+        if self.photons.is_empty() {
+            return;
+        }
+        // The 2 x 2 x 2 cells nearest the point cover its sphere.
+        let base = (point / self.cell - Vec3A::splat(0.5)).floor();
+        let r2 = self.radius * self.radius;
+        let mut seen = [usize::MAX; 8];
+        for k in 0..8 {
+            let c = [
+                base.x as i32 + (k & 1),
+                base.y as i32 + ((k >> 1) & 1),
+                base.z as i32 + ((k >> 2) & 1),
+            ];
+            let h = self.hash(c);
+            // Two cells may share a hash; visit each bucket once.
+            if seen[..k as usize].contains(&h) {
+                continue;
+            }
+            seen[k as usize] = h;
+            for &i in &self.order[self.starts[h] as usize..self.starts[h + 1] as usize] {
+                let p = &self.photons[i as usize];
+                if (p.point - point).length_squared() <= r2 && p.normal.dot(normal) > 0.0 {
+                    visit(i, p);
+                }
+            }
+        }
+    }
+
+    /// The `k` photons nearest `point` within the map's radius (Jensen's
+    /// lookup), in `nearest`, sorted by distance; returns how many were
+    /// found and the squared radius of the disc that holds them (the map's
+    /// radius when fewer than `k` were found).
+    pub fn nearest(
+        &self,
+        point: Vec3A,
+        normal: Vec3A,
+        k: usize,
+        nearest: &mut [(f32, u32); MAX_K],
+    ) -> (usize, f32) {
+        let k = k.clamp(1, MAX_K);
+        let mut found = 0usize;
+        self.visit_near(point, normal, |index, p| {
+            let d2 = (p.point - point).length_squared();
+            if found == k && d2 >= nearest[k - 1].0 {
+                return;
+            }
+            // Insertion into the sorted prefix.
+            let mut i = found.min(k - 1);
+            while i > 0 && nearest[i - 1].0 > d2 {
+                nearest[i] = nearest[i - 1];
+                i -= 1;
+            }
+            nearest[i] = (d2, index);
+            found = (found + 1).min(k);
+        });
+        let r2 = if found == k {
+            nearest[k - 1].0
+        } else {
+            self.radius * self.radius
+        };
+        (found, r2)
+    }
+
+    /// The photon at `index` (from [`PhotonMap::nearest`]).
+    pub fn photon(&self, index: u32) -> &Photon {
+        &self.photons[index as usize]
+    }
+}
+
+/// Shoots `count` photons (randomness from `key` and each photon's index,
+/// so the maps do not depend on the schedule), following each for up to
+/// `max_bounces` bounces, and sorts the photons that land on non-specular
+/// surfaces into two lists by `keep`: (first list, second list).
+pub fn shoot(
+    scene: &Scene,
+    count: u32,
+    key: u64,
+    max_bounces: u32,
+    keep: impl Fn(PhotonPath) -> (bool, bool) + Sync,
+    counts: &mut RayCounts,
+) -> (Vec<Photon>, Vec<Photon>) {
+    const CHUNK: u32 = 4096;
+    let chunks = count.div_ceil(CHUNK);
+    let key = hash_combine(key, 0x5048_4f54_4f4e);
+    let results: Vec<(Vec<Photon>, Vec<Photon>, u64)> = (0..chunks)
+        .into_par_iter()
+        .map(|chunk| {
+            let mut sampler = Sampler::new(SamplerKind::Independent, key, 0);
+            let (mut first, mut second) = (Vec::new(), Vec::new());
+            let mut rays = RayCounts::default();
+            let end = ((chunk + 1) * CHUNK).min(count);
+            for index in chunk * CHUNK..end {
+                sampler.start(index, 0);
+                trace_photon(scene, &mut sampler, max_bounces, &mut rays, |photon, path| {
+                    let (a, b) = keep(path);
+                    if a {
+                        first.push(photon);
+                    }
+                    if b {
+                        second.push(photon);
+                    }
+                });
+            }
+            (first, second, rays.bounce)
+        })
+        .collect();
+    let (mut first, mut second) = (Vec::new(), Vec::new());
+    for (a, b, rays) in results {
+        first.extend(a);
+        second.extend(b);
+        counts.bounce += rays;
+    }
+    (first, second)
+}
+
+/// Traces one photon from the lights and hands every landing on a
+/// non-specular surface to `store`, with how it got there.
+fn trace_photon(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    max_bounces: u32,
+    counts: &mut RayCounts,
+    mut store: impl FnMut(Photon, PhotonPath),
+) {
+    let u_select = sampler.next_1d_for(Domain::Light);
+    let u_position = sampler.next_2d_for(Domain::Light);
+    let u_direction = sampler.next_2d_for(Domain::Light);
+    let Some(emission) = scene
+        .lights
+        .sample_emission(u_select, u_position, u_direction)
+    else {
+        return;
+    };
+    let roulette_scale = 1.0 / emission.throughput.max_element();
+    let mut beta = emission.throughput;
+    let mut ray = Ray::new(
+        offset_ray_origin(
+            emission.point,
+            emission.error,
+            emission.normal,
+            emission.direction,
+        ),
+        emission.direction,
+    )
+    .at_time(scene.camera.shutter_open);
+    counts.bounce += 1;
+    let mut specular_only = true;
+    for bounces in 0..=max_bounces {
+        let Some(hit) = scene.geometry.intersect(&ray) else {
+            break;
+        };
+        let bsdf = scene.materials[hit.material as usize].bsdf;
+        if bsdf.is_black() {
+            break;
+        }
+        let frame = Frame::from_normal(hit.normal);
+        let wo = frame.to_local(-ray.direction);
+        let u_lobe = sampler.next_1d_for(Domain::Bsdf);
+        let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
+        let u_roulette = sampler.next_1d();
+        if !bsdf.is_specular() {
+            let facing = if wo.z > 0.0 { hit.normal } else { -hit.normal };
+            store(
+                Photon {
+                    point: hit.point,
+                    wi: -ray.direction,
+                    normal: facing,
+                    power: beta,
+                },
+                PhotonPath {
+                    bounces,
+                    specular_only,
+                },
+            );
+            specular_only = false;
+        }
+        if bounces == max_bounces {
+            break;
+        }
+        let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
+            break;
+        };
+        beta *= importance_weight(bsdf, wo, sample.wi, sample.weight);
+        // Roulette from the first bounce: a photon is cheap and the map
+        // only needs its density right.
+        if !super::survives_roulette(&mut beta, roulette_scale, u_roulette) {
+            break;
+        }
+        ray = hit.spawn_ray(frame.to_world(sample.wi));
+        counts.bounce += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cloud() -> Vec<Photon> {
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        (0..5000)
+            .map(|_| Photon {
+                point: Vec3A::new(next(), next(), next()) * 3.0 - Vec3A::ONE,
+                wi: Vec3A::Z,
+                normal: Vec3A::Z,
+                power: Rgb::ONE,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_grid_finds_exactly_the_photons_within_the_radius() {
+        let photons = cloud();
+        let radius = 0.13;
+        let map = PhotonMap::build(photons.clone(), radius);
+        for q in photons.iter().step_by(25).map(|p| p.point + Vec3A::splat(0.01)) {
+            let mut found = 0;
+            map.for_each_near(q, Vec3A::Z, |_| found += 1);
+            let expected = photons
+                .iter()
+                .filter(|p| (p.point - q).length_squared() <= radius * radius)
+                .count();
+            assert_eq!(found, expected, "at {q:?}");
+        }
+    }
+
+    #[test]
+    fn nearest_finds_the_k_closest() {
+        let photons = cloud();
+        let map = PhotonMap::build(photons.clone(), 0.3);
+        let mut nearest = [(0.0f32, 0u32); MAX_K];
+        for q in photons.iter().step_by(97).map(|p| p.point) {
+            let (found, r2) = map.nearest(q, Vec3A::Z, 10, &mut nearest);
+            let mut d: Vec<f32> = photons
+                .iter()
+                .map(|p| (p.point - q).length_squared())
+                .filter(|&d| d <= 0.09)
+                .collect();
+            d.sort_by(f32::total_cmp);
+            assert_eq!(found, d.len().min(10));
+            if found == 10 {
+                assert_eq!(r2, d[9]);
+            }
+            for (i, n) in nearest[..found].iter().enumerate() {
+                assert_eq!(n.0, d[i]);
+            }
+        }
+    }
+}
