@@ -318,6 +318,24 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
     assert_eq!(options.mis, tracelab::integrator::MisHeuristic::Balance);
     step_until(&mut harness, "2 spp of BDPT", finished);
     assert!(harness.state().app.frame().views[0].stats.spp >= 2);
+    // The strategy images fill in on their own thread.
+    click(&mut harness, "Strategy images (s, t)");
+    step_until(&mut harness, "the strategy images", |w| {
+        w.app.strategy_grid.spp().is_some_and(|spp| spp >= 2)
+    });
+    harness.get_by_label_contains("spp at 96 pixels wide");
+
+    click(&mut harness, "Photon mapping (Jensen)");
+    harness.run_steps(2);
+    harness
+        .get_by_role_and_label(egui::accesskit::Role::Slider, "k (photons per estimate)")
+        .set_value_accesskit(20.0);
+    harness.run_steps(2);
+    let options = harness.state().app.settings.a.integrator;
+    assert_eq!(options.kind, IntegratorKind::Photon);
+    assert_eq!(options.photon_k, 20);
+    assert!(!harness.state().app.strategy_grid.open, "the grid closes with BDPT");
+    step_until(&mut harness, "2 iterations of Jensen's photon mapping", finished);
 
     click(&mut harness, "Progressive photon mapping");
     harness

@@ -112,6 +112,9 @@ struct ViewArgs {
     /// Open the Monte Carlo lab tab on this experiment.
     #[arg(long, value_enum)]
     lab: Option<lab::ExperimentArg>,
+    /// Open BDPT's live strategy images (with --integrator bdpt).
+    #[arg(long)]
+    strategy_grid: bool,
 }
 
 /// Runs the parsed command line.
@@ -140,6 +143,7 @@ pub fn run(cli: Cli) -> Result<()> {
             fresh: false,
             export_dir: None,
             lab: None,
+            strategy_grid: false,
         }),
         #[cfg(not(feature = "viewer"))]
         None => {
@@ -192,6 +196,7 @@ fn view(args: ViewArgs) -> Result<()> {
         }),
         threads: args.threads,
         lab: args.lab.map(|e| e.0),
+        strategy_grid: args.strategy_grid,
         export_dir: args.export_dir,
     })
 }

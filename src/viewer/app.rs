@@ -124,6 +124,7 @@ impl ViewerApp {
     /// Builds the app: restores saved settings (unless `launch.fresh`), applies
     /// the launch options, loads the scene and starts rendering.
     pub fn new(launch: Launch) -> Self {
+        let strategy_grid = launch.strategy_grid;
         let mut settings: Settings = match settings_file() {
             Some(path) if !launch.fresh => load_settings(&path),
             _ => Settings::default(),
@@ -208,7 +209,7 @@ impl ViewerApp {
             capture_requested: false,
             sheet_mode: false,
             lab,
-            strategy_grid: Default::default(),
+            strategy_grid: super::strategies::StrategyGrid::new(strategy_grid),
         };
         let scene_path = resolve_scene_path(&app.settings.scene_path);
         app.load_scene(&scene_path);
@@ -637,6 +638,8 @@ impl ViewerApp {
                         .views
                         .iter()
                         .all(|v| v.done || v.stats.spp >= self.launch.after_spp)
+                    && (!self.strategy_grid.open
+                        || self.strategy_grid.spp().is_some_and(|spp| spp >= self.launch.after_spp))
                     && self
                         .shown
                         .as_ref()

@@ -29,6 +29,8 @@ pub struct Launch {
     /// Start from default settings instead of the saved ones.
     pub fresh: bool,
     pub export_dir: Option<PathBuf>,
+    /// Open BDPT's strategy images window.
+    pub strategy_grid: bool,
     /// Open the Monte Carlo lab on this experiment.
     pub lab: Option<Experiment>,
 }

@@ -57,6 +57,15 @@ impl Drop for Worker {
 }
 
 impl StrategyGrid {
+    /// A grid showing the weighted images, its window open or not.
+    pub fn new(open: bool) -> Self {
+        StrategyGrid {
+            open,
+            weighted: true,
+            ..Default::default()
+        }
+    }
+
     /// Starts (or restarts, when the scene or the settings changed) the
     /// worker while the window is open; stops it when it is closed.
     pub fn update(&mut self, scene: Option<&Arc<Scene>>, bdpt: Bdpt, sampler: SamplerKind) {
@@ -116,8 +125,10 @@ impl StrategyGrid {
             }
         }
         let mut open = self.open;
+        // Over the image, not the controls.
         egui::Window::new("Strategy images (s, t)")
             .open(&mut open)
+            .anchor(egui::Align2::RIGHT_TOP, egui::vec2(-12.0, 40.0))
             .default_width(560.0)
             .show(ctx, |ui| {
                 ui.horizontal(|ui| {
