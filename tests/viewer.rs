@@ -334,12 +334,22 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
     let options = harness.state().app.settings.a.integrator;
     assert_eq!(options.kind, IntegratorKind::Photon);
     assert_eq!(options.photon_k, 20);
-    assert!(!harness.state().app.strategy_grid.open, "the grid closes with BDPT");
-    step_until(&mut harness, "2 iterations of Jensen's photon mapping", finished);
+    assert!(
+        !harness.state().app.strategy_grid.open,
+        "the grid closes with BDPT"
+    );
+    step_until(
+        &mut harness,
+        "2 iterations of Jensen's photon mapping",
+        finished,
+    );
 
     click(&mut harness, "Progressive photon mapping");
     harness
-        .get_by_role_and_label(egui::accesskit::Role::Slider, "Alpha (1: fixed radius, biased)")
+        .get_by_role_and_label(
+            egui::accesskit::Role::Slider,
+            "Alpha (1: fixed radius, biased)",
+        )
         .set_value_accesskit(1.0);
     harness.run_steps(2);
     let options = harness.state().app.settings.a.integrator;

@@ -571,7 +571,10 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
         )));
     }
     if !(args.alpha > 0.0 && args.alpha <= 1.0) {
-        return Err(Error::new(format!("--alpha {} is not in (0, 1]", args.alpha)));
+        return Err(Error::new(format!(
+            "--alpha {} is not in (0, 1]",
+            args.alpha
+        )));
     }
     if integrator_kind(args.integrator) == IntegratorKind::Mcrt
         && args.shadow_rays + args.glossy_rays == 0

@@ -555,10 +555,8 @@ impl Bdpt {
                 return None;
             }
             counts.shadow += 1;
-            let shadow = ray_between(
-                pt.point, pt.error, pt.normal, ls.point, ls.error, ls.normal,
-            )
-            .at_time(time);
+            let shadow = ray_between(pt.point, pt.error, pt.normal, ls.point, ls.error, ls.normal)
+                .at_time(time);
             if scene.geometry.occluded(&shadow) {
                 return None;
             }
@@ -610,8 +608,8 @@ impl Bdpt {
             return None;
         }
         counts.shadow += 1;
-        let shadow = ray_between(qs.point, qs.error, qs.normal, pt.point, pt.error, pt.normal)
-            .at_time(time);
+        let shadow =
+            ray_between(qs.point, qs.error, qs.normal, pt.point, pt.error, pt.normal).at_time(time);
         if scene.geometry.occluded(&shadow) {
             return None;
         }
@@ -877,7 +875,8 @@ impl StrategyImages {
                 for y in 0..h {
                     let to = ((k * h + y) * sheet.width + s * w) as usize;
                     let from = (y * w) as usize;
-                    sheet.pixels[to..to + w as usize].copy_from_slice(&tile[from..from + w as usize]);
+                    sheet.pixels[to..to + w as usize]
+                        .copy_from_slice(&tile[from..from + w as usize]);
                 }
             }
         }

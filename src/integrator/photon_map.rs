@@ -214,15 +214,21 @@ pub fn shoot(
             let end = ((chunk + 1) * CHUNK).min(count);
             for index in chunk * CHUNK..end {
                 sampler.start(index, 0);
-                trace_photon(scene, &mut sampler, max_bounces, &mut rays, |photon, path| {
-                    let (a, b) = keep(path);
-                    if a {
-                        first.push(photon);
-                    }
-                    if b {
-                        second.push(photon);
-                    }
-                });
+                trace_photon(
+                    scene,
+                    &mut sampler,
+                    max_bounces,
+                    &mut rays,
+                    |photon, path| {
+                        let (a, b) = keep(path);
+                        if a {
+                            first.push(photon);
+                        }
+                        if b {
+                            second.push(photon);
+                        }
+                    },
+                );
             }
             (first, second, rays.bounce)
         })
@@ -341,7 +347,11 @@ mod tests {
         let photons = cloud();
         let radius = 0.13;
         let map = PhotonMap::build(photons.clone(), radius);
-        for q in photons.iter().step_by(25).map(|p| p.point + Vec3A::splat(0.01)) {
+        for q in photons
+            .iter()
+            .step_by(25)
+            .map(|p| p.point + Vec3A::splat(0.01))
+        {
             let mut found = 0;
             map.for_each_near(q, Vec3A::Z, |_| found += 1);
             let expected = photons

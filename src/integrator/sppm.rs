@@ -111,7 +111,6 @@ impl PhotonMapper {
     pub fn radius_at(&self, pass: u32) -> f32 {
         self.radius * ((pass + 1) as f32).powf((self.alpha - 1.0) * 0.5)
     }
-
 }
 
 impl MultiPassEstimator for PhotonMapper {

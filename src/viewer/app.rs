@@ -639,7 +639,10 @@ impl ViewerApp {
                         .iter()
                         .all(|v| v.done || v.stats.spp >= self.launch.after_spp)
                     && (!self.strategy_grid.open
-                        || self.strategy_grid.spp().is_some_and(|spp| spp >= self.launch.after_spp))
+                        || self
+                            .strategy_grid
+                            .spp()
+                            .is_some_and(|spp| spp >= self.launch.after_spp))
                     && self
                         .shown
                         .as_ref()

@@ -205,7 +205,9 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                     .logarithmic(true)
                     .text("Photons per map (0: one per pixel)"),
             );
-            ui.add(egui::Slider::new(&mut options.photon_k, 1..=256).text("k (photons per estimate)"));
+            ui.add(
+                egui::Slider::new(&mut options.photon_k, 1..=256).text("k (photons per estimate)"),
+            );
             ui.add(
                 egui::Slider::new(&mut options.gather_radius, 1e-3..=0.2)
                     .logarithmic(true)
