@@ -663,3 +663,85 @@ fn radiosity_reports_rows_and_refuses_bad_input() {
     ]);
     assert_fails(&o, 1, &["--patch-size"]);
 }
+
+#[test]
+fn bidirectional_and_photon_settings_are_checked() {
+    let scene = repo_path("scenes/cornell_box.toml");
+    let s = scene.to_str().unwrap();
+    let dir = temp_dir("cli-strategies");
+    let strategies = dir.join("pyramid");
+    assert_fails(
+        &tracelab(&["render", s, "--strategies", strategies.to_str().unwrap()]),
+        1,
+        &["--strategies needs --integrator bdpt"],
+    );
+    assert_fails(
+        &tracelab(&[
+            "render",
+            s,
+            "--integrator",
+            "photon",
+            "--k",
+            "0",
+            "--out",
+            "x.exr",
+        ]),
+        1,
+        &["--k 0 is not in 1..=256"],
+    );
+    assert_fails(
+        &tracelab(&[
+            "render",
+            s,
+            "--integrator",
+            "sppm",
+            "--alpha",
+            "1.5",
+            "--out",
+            "x.exr",
+        ]),
+        1,
+        &["--alpha 1.5 is not in (0, 1]"],
+    );
+    assert_fails(
+        &tracelab(&[
+            "render",
+            s,
+            "--integrator",
+            "sppm",
+            "--radius",
+            "0",
+            "--out",
+            "x.exr",
+        ]),
+        1,
+        &["--radius 0 is not a fraction"],
+    );
+    // The pyramid: every strategy of up to 2 bounces and the sheets.
+    let o = tracelab(&[
+        "render",
+        s,
+        "--integrator",
+        "bdpt",
+        "--max-depth",
+        "2",
+        "--spp",
+        "1",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--strategies",
+        strategies.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for file in [
+        "s0_t2.exr",
+        "s2_t2_unweighted.exr",
+        "s3_t1.exr",
+        "sum.exr",
+        "strategies_weighted.png",
+    ] {
+        assert!(strategies.join(file).is_file(), "{file} missing");
+    }
+}

@@ -38,10 +38,21 @@ fn step_until(harness: &mut Harness<'_, Window>, what: &str, done: impl Fn(&Wind
         if done(harness.state()) {
             return;
         }
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "timed out waiting for {what}"
-        );
+        if start.elapsed() > Duration::from_secs(120) {
+            let w = harness.state();
+            let frame = w.app.frame();
+            let views: Vec<_> = frame
+                .views
+                .iter()
+                .map(|v| (v.stats.spp, v.done, v.settings.integrator.name()))
+                .collect();
+            panic!(
+                "timed out waiting for {what}: generation {} of {}, views (spp, done, technique) {views:?}, errors {:?}",
+                frame.generation,
+                w.app.live().generation(),
+                w.app.errors
+            );
+        }
         std::thread::sleep(Duration::from_millis(5));
     }
 }
@@ -123,7 +134,7 @@ fn controls_drive_the_renderer_and_export_writes_files() {
     });
 
     // Start a side-by-side comparison: B is A with the other sampler.
-    harness.get_by_label("Side-by-side comparison").click();
+    click(&mut harness, "Side-by-side comparison");
     step_until(&mut harness, "two views", |w| {
         finished(w) && w.app.frame().views.len() == 2
     });
