@@ -201,7 +201,7 @@ impl Vertex {
     /// A density wrt. solid angle at this vertex turned into one wrt. area
     /// at `next`.
     #[inline]
-    fn to_area(&self, pdf_direction: f32, next: &Vertex) -> f32 {
+    fn area_density_at(&self, pdf_direction: f32, next: &Vertex) -> f32 {
         let d = next.point - self.point;
         let dist2 = d.length_squared();
         if !(dist2 > 0.0) {
@@ -429,7 +429,7 @@ impl Bdpt {
             }
             vertex.u_select = u_select;
             vertex.u_connect = u_connect;
-            vertex.pdf_fwd = previous.to_area(pdf_direction, &vertex);
+            vertex.pdf_fwd = previous.area_density_at(pdf_direction, &vertex);
             path.push(vertex);
             if path.len() >= max_vertices || material.bsdf.is_black() {
                 break;
@@ -456,7 +456,7 @@ impl Bdpt {
             path[index].delta = sample.specular;
             beta *= weight;
             relative *= weight;
-            path[index - 1].pdf_rev = path[index].to_area(pdf_rev, &previous);
+            path[index - 1].pdf_rev = path[index].area_density_at(pdf_rev, &previous);
             bounces += 1;
             if self.russian_roulette && bounces > self.rr_depth {
                 let q = relative.max_element().min(0.95);
@@ -578,8 +578,8 @@ impl Bdpt {
             return Some(Connection {
                 value,
                 film: None,
-                pt_rev: sampled.to_area(pdf_emission, pt),
-                pt_minus_rev: pt.to_area(pdf_reverse, pm),
+                pt_rev: sampled.area_density_at(pdf_emission, pt),
+                pt_minus_rev: pt.area_density_at(pdf_reverse, pm),
                 qs_rev: pdf(scene, pt, Some(pm), &sampled),
                 qs_minus_rev: 0.0,
                 sampled: Some(sampled),
@@ -617,10 +617,10 @@ impl Bdpt {
             value,
             film: None,
             sampled: None,
-            pt_rev: qs.to_area(pdf_qs, pt),
-            pt_minus_rev: pt.to_area(pdf_pt_reverse, pm),
-            qs_rev: pt.to_area(pdf_pt, qs),
-            qs_minus_rev: qs.to_area(pdf_qs_reverse, &light[s - 2]),
+            pt_rev: qs.area_density_at(pdf_qs, pt),
+            pt_minus_rev: pt.area_density_at(pdf_pt_reverse, pm),
+            qs_rev: pt.area_density_at(pdf_pt, qs),
+            qs_minus_rev: qs.area_density_at(pdf_qs_reverse, &light[s - 2]),
         })
     }
 
@@ -725,7 +725,7 @@ fn pdf(scene: &Scene, v: &Vertex, previous: Option<&Vertex>, next: &Vertex) -> f
             v.bsdf.pdf(frame.to_local(wo), frame.to_local(w))
         }
     };
-    v.to_area(pdf_direction, next)
+    v.area_density_at(pdf_direction, next)
 }
 
 /// The density (area, at `next`) with which a particle leaving the light
@@ -734,7 +734,7 @@ fn pdf(scene: &Scene, v: &Vertex, previous: Option<&Vertex>, next: &Vertex) -> f
 fn light_direction_pdf(scene: &Scene, v: &Vertex, next: &Vertex) -> f32 {
     let w = (next.point - v.point).normalize_or_zero();
     let (_, pdf_direction) = scene.lights.emission_pdf(v.light, v.normal, w);
-    v.to_area(pdf_direction, next)
+    v.area_density_at(pdf_direction, next)
 }
 
 /// A light's emitted radiance (or intensity) and sidedness.
