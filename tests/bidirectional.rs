@@ -9,9 +9,13 @@
 
 use crate::common::{cornell_box, render_with, repo_path};
 use crate::strategies::{SIZE, assert_agree, blocks, largest_block_z};
+use std::sync::Arc;
 use tracelab::film::FilmSnapshot;
-use tracelab::integrator::bdpt::{StrategyImages, strategy_index};
-use tracelab::integrator::{Bdpt, Integrator, LightTracer, PathTracer};
+use tracelab::integrator::photon::PhotonMap2Pass;
+use tracelab::integrator::sppm::PhotonMapper;
+use tracelab::integrator::strategy_images::{StrategyImages, strategy_index};
+use tracelab::integrator::{Bdpt, Integrator, LightTracer, MultiPassIntegrator, PathTracer};
+use tracelab::render::{RenderSettings, Session};
 use tracelab::sampling::{Sampler, SamplerKind};
 use tracelab::scene::Scene;
 
@@ -163,11 +167,8 @@ fn a_wrong_strategy_weight_is_caught() {
     );
 }
 
-#[test]
-fn photon_mapping_converges_as_its_radius_shrinks() {
-    use std::sync::Arc;
-    use tracelab::integrator::sppm::PhotonMapper;
-    use tracelab::render::{RenderSettings, Session};
+/// A 32x32 Cornell box, and path tracing's image of it at 4096 spp.
+fn small_cornell_and_reference() -> (impl Fn() -> Scene, FilmSnapshot) {
     let small = || {
         let mut scene = cornell_box();
         scene.set_resolution(32, 32);
@@ -182,21 +183,32 @@ fn photon_mapping_converges_as_its_radius_shrinks() {
         0,
         256,
     );
-    let sppm = PhotonMapper {
-        photons: 20_000,
-        ..PhotonMapper::default()
-    };
+    (small, reference)
+}
+
+/// A session of a multi-pass technique on `scene`.
+fn multi_pass_session(scene: Scene, technique: MultiPassIntegrator, seed: u64) -> Session {
     let settings = RenderSettings {
-        integrator: Integrator::MultiPass(tracelab::integrator::MultiPassIntegrator::Sppm(sppm)),
+        integrator: Integrator::MultiPass(technique),
         sampler: SamplerKind::Independent,
-        seed: 3,
+        seed,
         planned_spp: 0,
         threads: 0,
         adaptive: None,
         domains: Default::default(),
         clamp: None,
     };
-    let session = Session::new(Arc::new(small()), settings).expect("session starts");
+    Session::new(Arc::new(scene), settings).expect("session starts")
+}
+
+#[test]
+fn photon_mapping_converges_as_its_radius_shrinks() {
+    let (small, reference) = small_cornell_and_reference();
+    let sppm = PhotonMapper {
+        photons: 20_000,
+        ..PhotonMapper::default()
+    };
+    let session = multi_pass_session(small(), MultiPassIntegrator::Sppm(sppm), 3);
     let mut rmse = Vec::new();
     for iterations in [8, 128] {
         while session.stats().spp < iterations {
@@ -225,21 +237,7 @@ fn photon_mapping_converges_as_its_radius_shrinks() {
 
 #[test]
 fn jensens_photon_map_bias_shrinks_with_the_photon_count() {
-    use tracelab::integrator::photon::PhotonMap2Pass;
-    let small = || {
-        let mut scene = cornell_box();
-        scene.set_resolution(32, 32);
-        scene
-    };
-    let (reference, _) = render_with(
-        small(),
-        Integrator::from(PathTracer::default()),
-        SamplerKind::Independent,
-        4096,
-        1,
-        0,
-        256,
-    );
+    let (small, reference) = small_cornell_and_reference();
     let reference_red = reference.image.mean()[0];
     // The image's mean red, relative to path tracing's, after 64 iterations
     // of fresh maps: the average over maps leaves the density estimate's
@@ -250,20 +248,7 @@ fn jensens_photon_map_bias_shrinks_with_the_photon_count() {
             photons,
             ..PhotonMap2Pass::default()
         };
-        let settings = tracelab::render::RenderSettings {
-            integrator: Integrator::MultiPass(tracelab::integrator::MultiPassIntegrator::Photon(
-                jensen,
-            )),
-            sampler: SamplerKind::Independent,
-            seed: 5,
-            planned_spp: 0,
-            threads: 0,
-            adaptive: None,
-            domains: Default::default(),
-            clamp: None,
-        };
-        let session = tracelab::render::Session::new(std::sync::Arc::new(small()), settings)
-            .expect("session starts");
+        let session = multi_pass_session(small(), MultiPassIntegrator::Photon(jensen), 5);
         assert!(session.render_pass(64));
         session.snapshot().image.mean()[0] / reference_red - 1.0
     };

@@ -5,7 +5,8 @@
 
 use std::path::Path;
 use tracelab::image::Image;
-use tracelab::integrator::bdpt::{Bdpt, StrategyImages, strategy_index};
+use tracelab::integrator::bdpt::Bdpt;
+use tracelab::integrator::strategy_images::{StrategyImages, strategy_index};
 use tracelab::sampling::Sampler;
 use tracelab::scene::Scene;
 use tracelab::{Error, Result};
@@ -70,7 +71,7 @@ pub fn write(scene: &Scene, bdpt: &Bdpt, sampler: &Sampler, spp: u32, dir: &Path
     }
     println!(
         "wrote {} strategies (weighted and unweighted EXR), sum.exr and two PNG sheets to {}",
-        tracelab::integrator::bdpt::strategy_count(images.max_depth),
+        tracelab::integrator::strategy_images::strategy_count(images.max_depth),
         dir.display()
     );
     Ok(())

@@ -28,6 +28,7 @@ pub mod photon;
 pub mod photon_map;
 pub mod radiosity;
 pub mod sppm;
+pub mod strategy_images;
 pub mod whitted;
 
 pub use bdpt::Bdpt;

@@ -21,8 +21,7 @@
 
 use super::photon_map::{self, MAX_K, PhotonMap};
 use super::{IntegratorOptions, MultiPassEstimator, RayCounts, Technique};
-use crate::accel::NO_LIGHT;
-use crate::math::{Frame, Ray, Rgb, ray_between};
+use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
@@ -223,91 +222,49 @@ impl MultiPassEstimator for PhotonMap2Pass {
         &self,
         scene: &Scene,
         maps: &Maps,
-        mut ray: Ray,
+        ray: Ray,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
-        let mut beta = Rgb::ONE;
-        let mut radiance = Rgb::ZERO;
         // Mirrors and glass from the camera; emission seen through them
         // counts in full.
-        for _ in 0..=self.max_depth {
-            let Some(hit) = scene.geometry.intersect(&ray) else {
-                break;
-            };
-            let material = &scene.materials[hit.material as usize];
-            let wo_world = -ray.direction;
-            if hit.light != NO_LIGHT {
-                radiance += beta * material.emitted(hit.normal, wo_world);
-            }
-            let bsdf = material.bsdf;
-            if bsdf.is_black() {
-                break;
-            }
-            let frame = Frame::from_normal(hit.normal);
-            let wo = frame.to_local(wo_world);
-            let u_lobe = sampler.next_1d_for(Domain::Bsdf);
-            let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
-            if bsdf.is_specular() {
-                let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
-                    break;
-                };
-                beta *= sample.weight;
-                ray = hit.spawn_ray(frame.to_world(sample.wi));
-                counts.bounce += 1;
-                continue;
-            }
-            if self.max_depth == 0 {
-                break;
-            }
-            // Direct light: one light sample.
-            let u_select = sampler.next_1d_for(Domain::Light);
-            let u_light = sampler.next_2d_for(Domain::Light);
-            if let Some(ls) = scene.lights.sample(hit.point, u_select, u_light) {
-                let wi = frame.to_local(ls.wi);
-                let f = bsdf.eval(wo, wi);
-                if f.max_element() > 0.0 {
-                    counts.shadow += 1;
-                    let shadow = ray_between(
-                        hit.point, hit.error, hit.normal, ls.point, ls.error, ls.normal,
-                    )
-                    .at_time(hit.time);
-                    if !scene.geometry.occluded(&shadow) {
-                        radiance += beta * f * ls.radiance * (wi.z.abs() / ls.pdf);
-                    }
-                }
-            }
-            // Caustics: the caustic map at x.
-            let facing = if wo.z > 0.0 { hit.normal } else { -hit.normal };
-            radiance += beta
-                * self.density_estimate(&maps.caustic, hit.point, facing, &frame, &bsdf, wo)
-                * maps.per_photon;
-            // Indirect light: a final gather ray reads the global map at x'.
-            if self.max_depth > 1
-                && let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf)
-                && !sample.specular
+        let (emitted, at) =
+            photon_map::camera_to_diffuse(scene, ray, self.max_depth, sampler, counts);
+        let Some(x) = at else {
+            return emitted;
+        };
+        if self.max_depth == 0 {
+            return emitted;
+        }
+        let mut radiance = emitted + x.direct_light(scene, sampler, counts);
+        // Caustics: the caustic map at x.
+        radiance += x.beta
+            * self.density_estimate(
+                &maps.caustic,
+                x.hit.point,
+                x.facing,
+                &x.frame,
+                &x.bsdf,
+                x.wo,
+            )
+            * maps.per_photon;
+        // Indirect light: a final gather ray reads the global map at x'.
+        if self.max_depth > 1
+            && let Some(sample) = x.bsdf.sample(x.wo, x.u_lobe, x.u_bsdf)
+            && !sample.specular
+        {
+            counts.bounce += 1;
+            let gather = x.hit.spawn_ray(x.frame.to_world(sample.wi));
+            if let Some((y, arrived, chain)) = self.through_specular(scene, gather, sampler, counts)
             {
-                counts.bounce += 1;
-                let gather = hit.spawn_ray(frame.to_world(sample.wi));
-                if let Some((x, arrived, chain)) =
-                    self.through_specular(scene, gather, sampler, counts)
-                {
-                    let bsdf_x = scene.materials[x.material as usize].bsdf;
-                    let frame_x = Frame::from_normal(x.normal);
-                    let wo_x = frame_x.to_local(-arrived);
-                    let facing_x = if wo_x.z > 0.0 { x.normal } else { -x.normal };
-                    let reflected = self.density_estimate(
-                        &maps.global,
-                        x.point,
-                        facing_x,
-                        &frame_x,
-                        &bsdf_x,
-                        wo_x,
-                    );
-                    radiance += beta * sample.weight * chain * reflected * maps.per_photon;
-                }
+                let bsdf_y = scene.materials[y.material as usize].bsdf;
+                let frame_y = Frame::from_normal(y.normal);
+                let wo_y = frame_y.to_local(-arrived);
+                let facing_y = if wo_y.z > 0.0 { y.normal } else { -y.normal };
+                let reflected =
+                    self.density_estimate(&maps.global, y.point, facing_y, &frame_y, &bsdf_y, wo_y);
+                radiance += x.beta * sample.weight * chain * reflected * maps.per_photon;
             }
-            break;
         }
         radiance
     }

@@ -11,11 +11,13 @@
 
 use super::RayCounts;
 use super::light::importance_weight;
-use crate::math::{Frame, Ray, Rgb, offset_ray_origin};
+use crate::accel::{NO_LIGHT, SurfaceHit};
+use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Sampler, SamplerKind};
 use crate::scene::Scene;
-use glam::Vec3A;
+use crate::scene::material::Bsdf;
+use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
 
 /// A photon: where it landed, where it came from, and what it carries.
@@ -317,6 +319,108 @@ fn trace_photon(
         }
         ray = hit.spawn_ray(frame.to_world(sample.wi));
         counts.bounce += 1;
+    }
+}
+
+/// Where a camera ray of a photon mapper is estimated: its first diffuse
+/// or glossy hit, reached through mirrors and glass.
+pub struct DiffuseHit {
+    pub hit: SurfaceHit,
+    /// The weight of the chain of mirrors and glass before it.
+    pub beta: Rgb,
+    pub bsdf: Bsdf,
+    pub frame: Frame,
+    /// Direction to the camera side, local.
+    pub wo: Vec3A,
+    /// The normal on the side the ray arrived from.
+    pub facing: Vec3A,
+    /// Random numbers for a BSDF sample at the hit.
+    pub u_lobe: f32,
+    pub u_bsdf: Vec2,
+}
+
+/// Follows a camera ray through mirrors and glass (a chain of at most
+/// `max_depth` bounces) to its first diffuse or glossy hit; returns the
+/// emission seen on the way and the hit, if the ray got there.
+pub fn camera_to_diffuse(
+    scene: &Scene,
+    mut ray: Ray,
+    max_depth: u32,
+    sampler: &mut Sampler,
+    counts: &mut RayCounts,
+) -> (Rgb, Option<DiffuseHit>) {
+    let mut beta = Rgb::ONE;
+    let mut emitted = Rgb::ZERO;
+    for _ in 0..=max_depth {
+        let Some(hit) = scene.geometry.intersect(&ray) else {
+            break;
+        };
+        let material = &scene.materials[hit.material as usize];
+        let wo_world = -ray.direction;
+        if hit.light != NO_LIGHT {
+            emitted += beta * material.emitted(hit.normal, wo_world);
+        }
+        let bsdf = material.bsdf;
+        if bsdf.is_black() {
+            break;
+        }
+        let frame = Frame::from_normal(hit.normal);
+        let wo = frame.to_local(wo_world);
+        let u_lobe = sampler.next_1d_for(Domain::Bsdf);
+        let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
+        if !bsdf.is_specular() {
+            let facing = if wo.z > 0.0 { hit.normal } else { -hit.normal };
+            let diffuse = DiffuseHit {
+                hit,
+                beta,
+                bsdf,
+                frame,
+                wo,
+                facing,
+                u_lobe,
+                u_bsdf,
+            };
+            return (emitted, Some(diffuse));
+        }
+        let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
+            break;
+        };
+        beta *= sample.weight;
+        ray = hit.spawn_ray(frame.to_world(sample.wi));
+        counts.bounce += 1;
+    }
+    (emitted, None)
+}
+
+impl DiffuseHit {
+    /// Direct light at the hit by one light sample (next-event
+    /// estimation), times the chain's weight.
+    pub fn direct_light(
+        &self,
+        scene: &Scene,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
+        let u_select = sampler.next_1d_for(Domain::Light);
+        let u_light = sampler.next_2d_for(Domain::Light);
+        let hit = &self.hit;
+        let Some(ls) = scene.lights.sample(hit.point, u_select, u_light) else {
+            return Rgb::ZERO;
+        };
+        let wi = self.frame.to_local(ls.wi);
+        let f = self.bsdf.eval(self.wo, wi);
+        if !(f.max_element() > 0.0) {
+            return Rgb::ZERO;
+        }
+        counts.shadow += 1;
+        let shadow = ray_between(
+            hit.point, hit.error, hit.normal, ls.point, ls.error, ls.normal,
+        )
+        .at_time(hit.time);
+        if scene.geometry.occluded(&shadow) {
+            return Rgb::ZERO;
+        }
+        self.beta * f * ls.radiance * (wi.z.abs() / ls.pdf)
     }
 }
 

@@ -20,10 +20,9 @@
 
 use super::photon_map::{self, PhotonMap};
 use super::{IntegratorOptions, MultiPassEstimator, RayCounts, Technique};
-use crate::accel::NO_LIGHT;
-use crate::math::{Frame, Ray, Rgb, ray_between};
+use crate::math::{Ray, Rgb};
+use crate::sampling::Sampler;
 use crate::sampling::hash::hash_combine;
-use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use std::f32::consts::PI;
 
@@ -138,69 +137,26 @@ impl MultiPassEstimator for PhotonMapper {
         &self,
         scene: &Scene,
         iteration: &Iteration,
-        mut ray: Ray,
+        ray: Ray,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
-        let mut beta = Rgb::ONE;
-        let mut radiance = Rgb::ZERO;
         // Mirrors and glass are followed from the camera; their chain
         // counts against the depth like any bounce.
-        for _ in 0..=self.max_depth {
-            let Some(hit) = scene.geometry.intersect(&ray) else {
-                break;
-            };
-            let material = &scene.materials[hit.material as usize];
-            let wo_world = -ray.direction;
-            if hit.light != NO_LIGHT {
-                radiance += beta * material.emitted(hit.normal, wo_world);
-            }
-            let bsdf = material.bsdf;
-            if bsdf.is_black() {
-                break;
-            }
-            let frame = Frame::from_normal(hit.normal);
-            let wo = frame.to_local(wo_world);
-            let u_lobe = sampler.next_1d_for(Domain::Bsdf);
-            let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
-            let u_select = sampler.next_1d_for(Domain::Light);
-            let u_light = sampler.next_2d_for(Domain::Light);
-            if bsdf.is_specular() {
-                let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
-                    break;
-                };
-                beta *= sample.weight;
-                ray = hit.spawn_ray(frame.to_world(sample.wi));
-                counts.bounce += 1;
-                continue;
-            }
-            // Direct light: one light sample.
-            if self.max_depth > 0
-                && let Some(ls) = scene.lights.sample(hit.point, u_select, u_light)
-            {
-                let wi = frame.to_local(ls.wi);
-                let f = bsdf.eval(wo, wi);
-                if f.max_element() > 0.0 {
-                    counts.shadow += 1;
-                    let shadow = ray_between(
-                        hit.point, hit.error, hit.normal, ls.point, ls.error, ls.normal,
-                    )
-                    .at_time(hit.time);
-                    if !scene.geometry.occluded(&shadow) {
-                        radiance += beta * f * ls.radiance * (wi.z.abs() / ls.pdf);
-                    }
-                }
-            }
-            // Everything after a bounce: the density estimate.
-            let facing = if wo.z > 0.0 { hit.normal } else { -hit.normal };
-            let mut sum = Rgb::ZERO;
-            iteration.map.for_each_near(hit.point, facing, |p| {
-                sum += bsdf.eval(wo, frame.to_local(p.wi)) * p.power;
-            });
-            radiance += beta * sum * iteration.normalisation;
-            break;
+        let (emitted, at) =
+            photon_map::camera_to_diffuse(scene, ray, self.max_depth, sampler, counts);
+        let Some(x) = at else {
+            return emitted;
+        };
+        if self.max_depth == 0 {
+            return emitted;
         }
-        radiance
+        // Everything after a bounce: the density estimate.
+        let mut sum = Rgb::ZERO;
+        iteration.map.for_each_near(x.hit.point, x.facing, |p| {
+            sum += x.bsdf.eval(x.wo, x.frame.to_local(p.wi)) * p.power;
+        });
+        emitted + x.direct_light(scene, sampler, counts) + x.beta * sum * iteration.normalisation
     }
 }
 

@@ -6,7 +6,7 @@
 
 use crate::image::Image;
 use crate::integrator::Bdpt;
-use crate::integrator::bdpt::StrategyImages;
+use crate::integrator::strategy_images::StrategyImages;
 use crate::sampling::{Sampler, SamplerKind};
 use crate::scene::Scene;
 use eframe::egui::{self, ColorImage, TextureHandle, TextureOptions};
