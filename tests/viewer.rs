@@ -301,6 +301,9 @@ fn radiosity_controls_drive_the_solver() {
         solver.steps >= 1 && solver.elements > 32 && solver.links > solver.elements,
         "{solver:?}"
     );
+    // The statistics line shows the frame drawn: one more frame or two
+    // for the last one to reach the screen.
+    harness.run_steps(2);
     harness.get_by_label_contains("links");
     // Another solver restarts from its own mesh (a coarse one, for time).
     harness.state_mut().app.settings.a.integrator.patch_size = 0.3;
