@@ -37,6 +37,8 @@ mod scenes;
 mod fuzz_regressions;
 // The command line: renders, comparisons and every kind of bad input.
 mod cli;
+// The command line of the lab, radiosity, BDPT's strategies and photon mapping.
+mod cli_techniques;
 // The viewer driven through egui_kittest (needs the default `viewer` feature).
 #[cfg(feature = "viewer")]
 mod viewer;
