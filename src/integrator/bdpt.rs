@@ -327,16 +327,7 @@ impl Bdpt {
                 u_connect: u_lens,
                 ..Vertex::EMPTY
             });
-            let ray = Ray::new(
-                crate::math::offset_ray_origin(
-                    emission.point,
-                    emission.error,
-                    emission.normal,
-                    emission.direction,
-                ),
-                emission.direction,
-            )
-            .at_time(time);
+            let ray = emission.ray().at_time(time);
             counts.bounce += 1;
             self.random_walk(
                 scene,

@@ -18,7 +18,7 @@
 
 use super::{IntegratorOptions, RayCounts, SplattingEstimator, Technique, survives_roulette};
 use crate::camera::CameraConnection;
-use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
+use crate::math::{Frame, Rgb, ray_between};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
@@ -125,16 +125,7 @@ impl SplattingEstimator for LightTracer {
         // Roulette reads beta relative to the particle's starting weight
         // (whose size is the light's power in the scene's units).
         let roulette_scale = 1.0 / emission.throughput.max_element();
-        let mut ray = Ray::new(
-            offset_ray_origin(
-                emission.point,
-                emission.error,
-                emission.normal,
-                emission.direction,
-            ),
-            emission.direction,
-        )
-        .at_time(time);
+        let mut ray = emission.ray().at_time(time);
         counts.camera += 1;
         let mut bounces = 0;
         while bounces < self.max_depth {

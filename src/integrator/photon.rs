@@ -73,29 +73,15 @@ impl Technique for PhotonMap2Pass {
         format!(
             "photon map (max depth {}, {} photons, k {}, radius up to {:.3e})",
             self.max_depth,
-            if self.photons == 0 {
-                "one per pixel".to_string()
-            } else {
-                self.photons.to_string()
-            },
+            photon_map::describe_photons(self.photons),
             self.k,
             self.max_radius
         )
     }
 
     fn for_scene(self, scene: &Scene) -> Self {
-        let bounds = scene.geometry.bounds();
-        let diagonal = (bounds.max - bounds.min).length();
-        let photons = if self.photons == 0 {
-            scene.camera.width * scene.camera.height
-        } else {
-            self.photons
-        };
-        let max_radius = if diagonal.is_finite() && diagonal > 0.0 {
-            self.max_radius * diagonal
-        } else {
-            self.max_radius
-        };
+        let photons = photon_map::photons_per_iteration(scene, self.photons);
+        let max_radius = photon_map::of_diagonal(scene, self.max_radius);
         // Lookups search a disc that would hold 4k photons were they spread
         // evenly over every surface: where light is brighter the k nearest
         // lie closer, where it is dimmer the estimate keeps this radius. A

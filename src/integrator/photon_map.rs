@@ -12,7 +12,7 @@
 use super::RayCounts;
 use super::light::importance_weight;
 use crate::accel::{NO_LIGHT, SurfaceHit};
-use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
+use crate::math::{Frame, Ray, Rgb, ray_between};
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Sampler, SamplerKind};
 use crate::scene::Scene;
@@ -43,6 +43,37 @@ pub struct PhotonPath {
 
 /// The largest k of a k-nearest lookup.
 pub const MAX_K: usize = 256;
+
+/// `fraction` of the scene's bounding-box diagonal, in scene units (the
+/// fraction itself where the scene has no finite size), so that radii do
+/// not depend on the scene's units.
+pub fn of_diagonal(scene: &Scene, fraction: f32) -> f32 {
+    let bounds = scene.geometry.bounds();
+    let diagonal = (bounds.max - bounds.min).length();
+    if diagonal.is_finite() && diagonal > 0.0 {
+        fraction * diagonal
+    } else {
+        fraction
+    }
+}
+
+/// The photons to shoot per iteration: `photons`, or one per pixel for 0.
+pub fn photons_per_iteration(scene: &Scene, photons: u32) -> u32 {
+    if photons == 0 {
+        scene.camera.width * scene.camera.height
+    } else {
+        photons
+    }
+}
+
+/// Says how many photons an iteration shoots, for summaries.
+pub fn describe_photons(photons: u32) -> String {
+    if photons == 0 {
+        "one per pixel".to_string()
+    } else {
+        photons.to_string()
+    }
+}
 
 /// Photons in a hash grid.
 pub struct PhotonMap {
@@ -264,16 +295,7 @@ fn trace_photon(
     };
     let roulette_scale = 1.0 / emission.throughput.max_element();
     let mut beta = emission.throughput;
-    let mut ray = Ray::new(
-        offset_ray_origin(
-            emission.point,
-            emission.error,
-            emission.normal,
-            emission.direction,
-        ),
-        emission.direction,
-    )
-    .at_time(scene.camera.shutter_open);
+    let mut ray = emission.ray().at_time(scene.camera.shutter_open);
     counts.bounce += 1;
     let mut specular_only = true;
     for bounces in 0..=max_bounces {

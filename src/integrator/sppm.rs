@@ -68,31 +68,16 @@ impl Technique for PhotonMapper {
         format!(
             "photon mapping (max depth {}, {} photons per iteration, radius {:.3e}, alpha {:.2})",
             self.max_depth,
-            if self.photons == 0 {
-                "one per pixel".to_string()
-            } else {
-                self.photons.to_string()
-            },
+            photon_map::describe_photons(self.photons),
             self.radius,
             self.alpha
         )
     }
 
     fn for_scene(self, scene: &Scene) -> Self {
-        let bounds = scene.geometry.bounds();
-        let diagonal = (bounds.max - bounds.min).length();
-        let photons = if self.photons == 0 {
-            scene.camera.width * scene.camera.height
-        } else {
-            self.photons
-        };
         PhotonMapper {
-            radius: if diagonal.is_finite() && diagonal > 0.0 {
-                self.radius * diagonal
-            } else {
-                self.radius
-            },
-            photons,
+            radius: photon_map::of_diagonal(scene, self.radius),
+            photons: photon_map::photons_per_iteration(scene, self.photons),
             ..self
         }
     }

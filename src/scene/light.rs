@@ -443,6 +443,15 @@ impl EmissionSample {
         }
     }
 
+    /// The particle's first ray, leaving the light point off its surface.
+    #[inline]
+    pub fn ray(&self) -> crate::math::Ray {
+        crate::math::Ray::new(
+            crate::math::offset_ray_origin(self.point, self.error, self.normal, self.direction),
+            self.direction,
+        )
+    }
+
     /// |cos| between the light's normal and `w` (1 for point lights).
     #[inline]
     pub fn cos_at_light(&self, w: Vec3A) -> f32 {
