@@ -157,6 +157,20 @@ impl RadiosityState {
         }
     }
 
+    /// Every element (the hierarchy's leaves) with its radiance.
+    pub fn elements(&self) -> Vec<(Element, Rgb)> {
+        match &self.model {
+            Model::Matrix(m) => m
+                .mesh
+                .elements
+                .iter()
+                .copied()
+                .zip(m.solution.radiance.iter().copied())
+                .collect(),
+            Model::Hierarchical(h) => h.leaves().map(|(e, l)| (*e, l)).collect(),
+        }
+    }
+
     /// (elements, links): leaves and links, or elements and every ordered pair.
     pub fn counts(&self) -> (usize, usize) {
         match &self.model {
