@@ -12,7 +12,7 @@ use tracelab::image::{Image, check_writable};
 use tracelab::integrator::radiosity::RadiosityDisplay;
 use tracelab::integrator::{IntegratorKind, IntegratorOptions};
 use tracelab::plot::{PlotFormat, Series, SeriesStyle, log_log_plot};
-use tracelab::radiosity::{FormFactorMethod, FormFactors, RadiositySolver};
+use tracelab::radiosity::{FormFactorMethod, RadiositySolver};
 use tracelab::render::{RenderSettings, Session};
 use tracelab::sampling::SamplerKind;
 use tracelab::scene::{Limits, Scene};
@@ -73,6 +73,17 @@ pub struct RadiosityFlags {
     /// times visibility (`analytic`) or by point pairs (`ray-cast`).
     #[arg(long, value_enum, default_value = "analytic")]
     ff_method: FormFactorArg,
+    /// Radiosity, Jacobi, Gauss-Seidel or progressive: rounds of adaptive
+    /// subdivision after the first solve (split elements where neighbours differ).
+    #[arg(long, default_value_t = 0)]
+    adaptive_rounds: u32,
+    /// Radiosity: adaptive subdivision splits an element whose reflected
+    /// radiance differs from a neighbour's by more than this times the mean.
+    #[arg(long, default_value_t = 0.5)]
+    adaptive_tolerance: f32,
+    /// Radiosity: draw the elements' edges over the image, coloured by level.
+    #[arg(long)]
+    wireframe: bool,
 }
 
 impl RadiosityFlags {
@@ -94,6 +105,9 @@ impl RadiosityFlags {
             form_factor_samples: self.ff_rays,
             radiosity_ambient: self.ambient_term,
             radiosity_iterations: self.iterations,
+            adaptive_rounds: self.adaptive_rounds,
+            adaptive_tolerance: self.adaptive_tolerance,
+            radiosity_wireframe: self.wireframe,
             radiosity_display: match self.display {
                 DisplayArg::Flat => RadiosityDisplay::Flat,
                 DisplayArg::Smooth => RadiosityDisplay::Smooth,
@@ -109,6 +123,12 @@ impl RadiosityFlags {
             return Err(Error::new(format!(
                 "--epsilon must be positive, got {}",
                 self.epsilon
+            )));
+        }
+        if !(self.adaptive_tolerance > 0.0 && self.adaptive_tolerance.is_finite()) {
+            return Err(Error::new(format!(
+                "--adaptive-tolerance must be positive, got {}",
+                self.adaptive_tolerance
             )));
         }
         if !(self.patch_size > 0.0 && self.patch_size <= 1.0) || self.ff_rays == 0 {
@@ -194,19 +214,21 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
     };
     let session = Session::new(Arc::new(scene), settings)?;
     println!(
-        "{:>7} {:>9} {:>11} {:>9} {:>9} {:>11} {:>9} {:>13}",
-        "steps", "elements", "links", "rays M", "seconds", "residual", "RMSE", "masked RMSE"
+        "{:>7} {:>9} {:>11} {:>9} {:>9} {:>9} {:>11} {:>9} {:>13}",
+        "steps", "elements", "links", "rays M", "MB", "solve s", "residual", "RMSE", "masked RMSE"
     );
     let mut rows = Vec::new();
     drive_solver(&session, |stats, progress| {
         let (all, masked, _) = rmse(&session.snapshot().image, &reference, args.mask_above);
-        let seconds = stats.render_time.as_secs_f64();
+        // The solver's own time (form factors included), without drawing the image.
+        let seconds = progress.solve_seconds;
         println!(
-            "{:>7} {:>9} {:>11} {:>9.2} {:>9.3} {:>11.3e} {:>9.5} {:>13.5}",
+            "{:>7} {:>9} {:>11} {:>9.2} {:>9.1} {:>9.3} {:>11.3e} {:>9.5} {:>13.5}",
             progress.steps,
             progress.elements,
             progress.links,
             stats.rays.shadow as f64 * 1e-6,
+            progress.memory as f64 * 1e-6,
             seconds,
             progress.residual,
             all,
@@ -217,27 +239,20 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
             progress.elements,
             progress.links,
             stats.rays.shadow,
+            progress.memory,
             seconds,
             progress.residual,
             all,
             masked,
         ));
     })?;
-    if options.radiosity_solver != RadiositySolver::Hierarchical
-        && let Some(last) = rows.last()
-    {
-        println!(
-            "form factor matrix: {:.1} MB ({} elements, every pair a link)",
-            FormFactors::bytes(last.1 as usize) as f64 / 1e6,
-            last.1
-        );
-    }
     if let Some(path) = &args.csv {
-        let mut text =
-            String::from("steps,elements,links,shadow_rays,seconds,residual,rmse,masked_rmse\n");
-        for (steps, elements, links, rays, seconds, residual, all, masked) in &rows {
+        let mut text = String::from(
+            "steps,elements,links,shadow_rays,bytes,solve_seconds,residual,rmse,masked_rmse\n",
+        );
+        for (steps, elements, links, rays, bytes, seconds, residual, all, masked) in &rows {
             text.push_str(&format!(
-                "{steps},{elements},{links},{rays},{seconds},{residual},{all},{masked}\n"
+                "{steps},{elements},{links},{rays},{bytes},{seconds},{residual},{all},{masked}\n"
             ));
         }
         tracelab::image::write_atomically(path, |tmp| {
@@ -249,9 +264,9 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
         let series = [
             (
                 "masked RMSE",
-                rows.iter().map(|r| (r.0 as f64, r.7)).collect::<Vec<_>>(),
+                rows.iter().map(|r| (r.0 as f64, r.8)).collect::<Vec<_>>(),
             ),
-            ("residual", rows.iter().map(|r| (r.0 as f64, r.5)).collect()),
+            ("residual", rows.iter().map(|r| (r.0 as f64, r.6)).collect()),
         ];
         let series: Vec<Series> = series
             .iter()

@@ -220,6 +220,10 @@ pub struct SolverProgress {
     /// links), for reports; 0 where they mean nothing.
     pub elements: u64,
     pub links: u64,
+    /// Bytes the solver's model takes (elements, links, matrix).
+    pub memory: u64,
+    /// Seconds spent setting up and solving so far, without drawing images.
+    pub solve_seconds: f64,
 }
 
 /// What a session can say about a technique's error without a reference.

@@ -60,6 +60,13 @@ pub struct IntegratorOptions {
     pub radiosity_iterations: u32,
     pub radiosity_display: RadiosityDisplay,
     pub radiosity_epsilon: f32,
+    /// Radiosity (Jacobi, Gauss-Seidel, progressive): rounds of adaptive
+    /// subdivision after the first solve, splitting elements whose reflected
+    /// radiance differs from a neighbour's by more than the tolerance times
+    /// the mean; and the wireframe overlay of the elements.
+    pub adaptive_rounds: u32,
+    pub adaptive_tolerance: f32,
+    pub radiosity_wireframe: bool,
     /// Photon mapping: photons per iteration (0: one per pixel), the first
     /// iteration's radius (fraction of the scene's diagonal) and alpha.
     pub photons: u32,
@@ -95,6 +102,9 @@ impl Default for IntegratorOptions {
             radiosity_iterations: 0,
             radiosity_display: RadiosityDisplay::Gather,
             radiosity_epsilon: 1e-4,
+            adaptive_rounds: 0,
+            adaptive_tolerance: 0.5,
+            radiosity_wireframe: false,
             photons: 0,
             photon_radius: 0.002,
             photon_alpha: 2.0 / 3.0,

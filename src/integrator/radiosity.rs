@@ -54,6 +54,12 @@ pub struct Radiosity {
     pub display: RadiosityDisplay,
     /// Hierarchical: the BF oracle's threshold, relative to the emitted power.
     pub epsilon: f32,
+    /// Matrix solvers: rounds of adaptive subdivision, and its tolerance
+    /// (relative to the mean reflected radiance).
+    pub adaptive_rounds: u32,
+    pub adaptive_tolerance: f32,
+    /// Draw the elements' edges over the image, coloured by level.
+    pub wireframe: bool,
 }
 
 /// How the solution is shown.
@@ -98,12 +104,15 @@ impl Technique for Radiosity {
             iterations: options.radiosity_iterations,
             display: options.radiosity_display,
             epsilon: options.radiosity_epsilon,
+            adaptive_rounds: options.adaptive_rounds,
+            adaptive_tolerance: options.adaptive_tolerance,
+            wireframe: options.radiosity_wireframe,
         }
     }
 
     fn describe(&self) -> String {
         format!(
-            "radiosity ({}{}, patch size {}, form factors {:?} x {}, {} display)",
+            "radiosity ({}{}, patch size {}{}, form factors {:?} x {}, {} display)",
             self.solver.name(),
             if self.solver == RadiositySolver::Progressive && self.ambient {
                 " + ambient"
@@ -111,6 +120,14 @@ impl Technique for Radiosity {
                 ""
             },
             self.patch_size,
+            if self.adaptive_rounds > 0 && self.solver.matrix().is_some() {
+                format!(
+                    ", {} adaptive rounds at tolerance {}",
+                    self.adaptive_rounds, self.adaptive_tolerance
+                )
+            } else {
+                String::new()
+            },
             self.form_factors,
             self.form_factor_samples,
             self.display.name()
@@ -138,6 +155,11 @@ pub struct RadiosityState {
     pub model: Model,
     steps: u64,
     residual: f64,
+    /// Adaptive subdivision rounds done, and whether another would change nothing.
+    rounds: u32,
+    settled: bool,
+    /// Seconds spent setting up (form factors, initial links) and in steps.
+    solve_seconds: f64,
 }
 
 impl RadiosityState {
@@ -171,6 +193,18 @@ impl RadiosityState {
         }
     }
 
+    /// Bytes the model takes: elements and the form factor matrix, or the
+    /// hierarchy's nodes and links.
+    pub fn memory_bytes(&self) -> usize {
+        match &self.model {
+            Model::Matrix(m) => {
+                let n = m.mesh.elements.len();
+                FormFactors::bytes(n) + n * std::mem::size_of::<Element>()
+            }
+            Model::Hierarchical(h) => h.memory_bytes(),
+        }
+    }
+
     /// (elements, links): leaves and links, or elements and every ordered pair.
     pub fn counts(&self) -> (usize, usize) {
         match &self.model {
@@ -193,6 +227,45 @@ impl Solver for Radiosity {
     type State = RadiosityState;
 
     fn init(&self, scene: &Scene) -> crate::Result<RadiosityState> {
+        let start = std::time::Instant::now();
+        let mut state = self.build(scene)?;
+        state.solve_seconds = start.elapsed().as_secs_f64();
+        Ok(state)
+    }
+
+    fn step(
+        &self,
+        scene: &Scene,
+        state: &mut RadiosityState,
+        steps: u32,
+        counts: &mut RayCounts,
+    ) -> SolverProgress {
+        let start = std::time::Instant::now();
+        let mut progress = self.solve(scene, state, steps, counts);
+        state.solve_seconds += start.elapsed().as_secs_f64();
+        progress.solve_seconds = state.solve_seconds;
+        progress
+    }
+
+    fn radiance(
+        &self,
+        scene: &Scene,
+        state: &RadiosityState,
+        ray: Ray,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
+        self.display(scene, state, ray, sampler, counts)
+    }
+
+    fn display_spp(&self) -> u32 {
+        16
+    }
+}
+
+impl Radiosity {
+    /// The model: a mesh and its form factors, or the hierarchy.
+    fn build(&self, scene: &Scene) -> crate::Result<RadiosityState> {
         if self.solver.matrix().is_none() {
             let settings = HierarchySettings {
                 epsilon: self.epsilon,
@@ -206,6 +279,9 @@ impl Solver for Radiosity {
                 model: Model::Hierarchical(hierarchy),
                 steps: 0,
                 residual: 1.0,
+                rounds: 0,
+                settled: true,
+                solve_seconds: 0.0,
             });
         }
         let mesh = Mesh::build(scene, self.patch_size, MAX_ELEMENTS).map_err(crate::Error::new)?;
@@ -230,10 +306,14 @@ impl Solver for Radiosity {
             }),
             steps: 0,
             residual: 1.0,
+            rounds: 0,
+            settled: self.adaptive_rounds == 0,
+            solve_seconds: 0.0,
         })
     }
 
-    fn step(
+    /// Up to `steps` sweeps or shots, with adaptive rounds between solves.
+    fn solve(
         &self,
         scene: &Scene,
         state: &mut RadiosityState,
@@ -246,6 +326,9 @@ impl Solver for Radiosity {
             self.iterations as u64
         };
         for _ in 0..steps {
+            if state.residual <= CONVERGED && !state.settled {
+                self.subdivide(scene, state, counts);
+            }
             if state.steps >= limit || state.residual <= CONVERGED {
                 break;
             }
@@ -286,13 +369,66 @@ impl Solver for Radiosity {
         SolverProgress {
             steps: state.steps,
             residual: state.residual,
-            converged: state.steps >= limit || state.residual <= CONVERGED,
+            converged: state.steps >= limit || (state.residual <= CONVERGED && state.settled),
             elements: elements as u64,
             links: links as u64,
+            memory: state.memory_bytes() as u64,
+            solve_seconds: 0.0,
         }
     }
 
-    fn radiance(
+    /// One round of adaptive subdivision of a converged matrix model: the
+    /// elements [`Mesh::steep`] flags are split, the form factors of the new
+    /// mesh computed, and the solve goes on from the old solution (Jacobi,
+    /// Gauss-Seidel) or starts over (progressive, whose unshot light belongs
+    /// to the old form factors). Stops, with a note, where the new mesh
+    /// would exceed the matrix's budget.
+    fn subdivide(&self, scene: &Scene, state: &mut RadiosityState, counts: &mut RayCounts) {
+        let Model::Matrix(m) = &mut state.model else {
+            state.settled = true;
+            return;
+        };
+        let steep = m.mesh.steep(&m.solution.radiance, self.adaptive_tolerance);
+        let added = 3 * steep.iter().filter(|&&s| s).count();
+        if added == 0 {
+            state.settled = true;
+            return;
+        }
+        if m.mesh.elements.len() + added > MAX_ELEMENTS {
+            m.mesh.notes.push(format!(
+                "adaptive subdivision stopped after {} rounds: the next would make {} elements, \
+                 more than the {MAX_ELEMENTS} the form factor matrix fits in memory for",
+                state.rounds,
+                m.mesh.elements.len() + added
+            ));
+            state.settled = true;
+            return;
+        }
+        let (mesh, origin) = m.mesh.refine(&steep);
+        let form_factors = FormFactors::compute(
+            &scene.geometry,
+            &mesh,
+            self.form_factors,
+            self.form_factor_samples,
+        );
+        counts.shadow += form_factors.rays;
+        let mut solution = Solution::new(&mesh);
+        if self.solver != RadiositySolver::Progressive {
+            solution.radiance = origin
+                .iter()
+                .map(|&k| m.solution.radiance[k as usize])
+                .collect();
+        }
+        m.mesh = mesh;
+        m.form_factors = form_factors;
+        m.solution = solution;
+        state.rounds += 1;
+        state.residual = 1.0;
+        state.settled = state.rounds >= self.adaptive_rounds;
+    }
+
+    /// The display's radiance along a camera ray.
+    fn display(
         &self,
         scene: &Scene,
         state: &RadiosityState,
@@ -302,10 +438,12 @@ impl Solver for Radiosity {
     ) -> Rgb {
         let mut ray = ray;
         let mut weight = Rgb::ONE;
+        let mut travelled = 0.0;
         for depth in 0..=SPECULAR_DEPTH {
             let Some(hit) = scene.geometry.intersect(&ray) else {
                 return Rgb::ZERO;
             };
+            travelled += hit.t;
             if depth > 0 {
                 counts.bounce += 1;
             }
@@ -327,6 +465,9 @@ impl Solver for Radiosity {
                         return weight * material.emitted(hit.normal, -ray.direction);
                     };
                     let e = &surface.element;
+                    if self.wireframe && on_edge(scene, &surface, travelled) {
+                        return weight * level_colour(surface.level);
+                    }
                     let seen_emission = if e.normal.dot(ray.direction) < 0.0 {
                         e.emission
                     } else {
@@ -356,10 +497,6 @@ impl Solver for Radiosity {
         }
         Rgb::ZERO
     }
-
-    fn display_spp(&self) -> u32 {
-        16
-    }
 }
 
 /// What the solution says at a surface point.
@@ -372,6 +509,37 @@ struct Surface {
     /// Smooth display: the element's vertex radiance.
     vertices: Option<[Rgb; 3]>,
     ambient: Rgb,
+    /// Subdivision level of the element (0: the scene triangle).
+    level: u8,
+}
+
+/// Whether a point at `distance` from the camera lies within about a pixel
+/// of its element's edges (the wireframe overlay).
+fn on_edge(scene: &Scene, surface: &Surface, distance: f32) -> bool {
+    let camera = &scene.camera;
+    let pixel = distance * 2.0 * camera.tan_half_fov_y / camera.height.max(1) as f32;
+    let [a, b, c] = surface.element.vertices;
+    let bary = surface.barycentrics;
+    let weights = [1.0 - bary.x - bary.y, bary.x, bary.y];
+    // Distance to the edge opposite vertex k: b_k times the height on it.
+    let opposite = [(c - b).length(), (a - c).length(), (b - a).length()];
+    (0..3).any(|k| weights[k] * 2.0 * surface.element.area / opposite[k] < 0.6 * pixel)
+}
+
+/// The wireframe's colour for elements of subdivision `level`.
+fn level_colour(level: u8) -> Rgb {
+    const COLOURS: [[f32; 3]; 8] = [
+        [1.0, 1.0, 1.0],
+        [1.0, 0.9, 0.1],
+        [1.0, 0.5, 0.0],
+        [1.0, 0.1, 0.1],
+        [0.9, 0.1, 0.9],
+        [0.2, 0.3, 1.0],
+        [0.1, 0.9, 1.0],
+        [0.1, 1.0, 0.2],
+    ];
+    let [r, g, b] = COLOURS[level as usize % COLOURS.len()];
+    Rgb::new(r, g, b)
 }
 
 /// The element a hit lies in and its solution (None for spheres and
@@ -385,7 +553,7 @@ fn surface_at(
     let [a, b, c] = *scene.geometry.triangles().get(triangle)?;
     let (b1, b2) = barycentrics(hit.point, [a, b, c]);
     let (b1, b2) = (b1.clamp(0.0, 1.0), b2.clamp(0.0, 1.0 - b1.clamp(0.0, 1.0)));
-    let (radiance, element, vertices, ambient) = match &state.model {
+    let (radiance, element, vertices, ambient, level) = match &state.model {
         Model::Matrix(m) => {
             let k = m.mesh.element_at(triangle, b1, b2)?;
             (
@@ -393,11 +561,12 @@ fn surface_at(
                 m.mesh.elements[k],
                 m.vertex_radiance.get(k).copied(),
                 m.solution.ambient,
+                m.mesh.levels[k],
             )
         }
         Model::Hierarchical(h) => {
-            let (radiance, element, vertices) = h.leaf_at(triangle, b1, b2)?;
-            (radiance, *element, vertices, Rgb::ZERO)
+            let (radiance, element, vertices, level) = h.leaf_at(triangle, b1, b2)?;
+            (radiance, *element, vertices, Rgb::ZERO, level)
         }
     };
     let (e1, e2) = barycentrics(hit.point, element.vertices);
@@ -407,6 +576,7 @@ fn surface_at(
         barycentrics: glam::Vec2::new(e1, e2),
         vertices,
         ambient,
+        level,
     })
 }
 

@@ -249,19 +249,8 @@ impl Hierarchy {
             return None;
         }
         let parent = self.nodes[k as usize].clone();
-        let v = parent.element.vertices;
-        let m = [
-            0.5 * (v[1] + v[2]),
-            0.5 * (v[2] + v[0]),
-            0.5 * (v[0] + v[1]),
-        ];
         let first = self.nodes.len() as u32;
-        for vertices in [
-            [v[0], m[2], m[1]],
-            [m[2], v[1], m[0]],
-            [m[1], m[0], v[2]],
-            [m[0], m[1], m[2]],
-        ] {
+        for vertices in super::mesh::children(parent.element.vertices) {
             self.nodes.push(Node {
                 element: Element {
                     vertices,
@@ -421,28 +410,21 @@ impl Hierarchy {
     }
 
     /// The leaf of scene triangle `triangle` at its barycentrics (b1, b2):
-    /// its radiance, element, and vertex radiance once [`Hierarchy::smooth`] ran.
+    /// its radiance, element, vertex radiance once [`Hierarchy::smooth`] ran,
+    /// and depth in the patch's tree.
     pub fn leaf_at(
         &self,
         triangle: usize,
         b1: f32,
         b2: f32,
-    ) -> Option<(Rgb, &Element, Option<[Rgb; 3]>)> {
+    ) -> Option<(Rgb, &Element, Option<[Rgb; 3]>, u8)> {
         let mut k = *self.roots.get(triangle)?;
         if k == NONE {
             return None;
         }
         let mut b = [1.0 - b1 - b2, b1, b2];
         while self.nodes[k as usize].children != NONE {
-            let child = (0..3).find(|&c| b[c] >= 0.5).unwrap_or(3);
-            b = match child {
-                3 => [1.0 - 2.0 * b[0], 1.0 - 2.0 * b[1], 1.0 - 2.0 * b[2]],
-                c => {
-                    let mut d = [2.0 * b[0], 2.0 * b[1], 2.0 * b[2]];
-                    d[c] -= 1.0;
-                    d
-                }
-            };
+            let child = super::mesh::child_at(&mut b);
             k = self.nodes[k as usize].children + child as u32;
         }
         let n = &self.nodes[k as usize];
@@ -450,6 +432,7 @@ impl Hierarchy {
             n.radiance,
             &n.element,
             self.vertex_radiance.get(k as usize).copied(),
+            n.depth,
         ))
     }
 

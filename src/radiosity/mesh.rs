@@ -2,6 +2,9 @@
 //! split into elements by midpoint subdivision (4 children per level) until
 //! its longest edge is at most the target size. Sizes are fractions of the
 //! scene's bounding-box diagonal, so the mesh does not depend on units.
+//! Adaptive subdivision ([`Mesh::refine`]) splits elements further where
+//! the solution changes fast between neighbours, so each patch keeps a
+//! quadtree of its elements.
 
 use crate::math::Rgb;
 use crate::scene::Scene;
@@ -36,13 +39,25 @@ impl Element {
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     pub elements: Vec<Element>,
-    /// Per scene triangle: its first element and its subdivision depth
-    /// (`u32::MAX` where the triangle is not a patch).
-    first: Vec<u32>,
-    depth: Vec<u8>,
+    /// Per element, its subdivision level (0: the scene triangle itself).
+    pub levels: Vec<u8>,
+    /// Per scene triangle, its root cell (`NONE` where it is not a patch).
+    roots: Vec<u32>,
+    cells: Vec<Cell>,
     /// Triangles left out and why (mirrors and glass are traced through).
     pub notes: Vec<String>,
 }
+
+/// A node of a patch's quadtree.
+#[derive(Clone, Copy, Debug)]
+enum Cell {
+    /// An element (its index).
+    Leaf(u32),
+    /// The first of four consecutive child cells, numbered as [`subdivide`] does.
+    Inner(u32),
+}
+
+const NONE: u32 = u32::MAX;
 
 /// Deepest subdivision of one triangle (4^8 = 65 536 elements).
 const MAX_DEPTH: u8 = 8;
@@ -104,14 +119,14 @@ impl Mesh {
         }
         let mut mesh = Mesh {
             elements: Vec::with_capacity(total),
-            first: Vec::with_capacity(triangles.len()),
-            depth: Vec::with_capacity(triangles.len()),
+            levels: Vec::with_capacity(total),
+            roots: Vec::with_capacity(triangles.len()),
+            cells: Vec::new(),
             notes: Vec::new(),
         };
         for (i, (v, depth)) in triangles.iter().zip(depths).enumerate() {
             let Some(depth) = depth else {
-                mesh.first.push(u32::MAX);
-                mesh.depth.push(0);
+                mesh.roots.push(NONE);
                 continue;
             };
             let material = &scene.materials[geometry.triangle_material(i) as usize];
@@ -120,19 +135,17 @@ impl Mesh {
                 Bsdf::Glossy { diffuse, .. } => diffuse,
                 _ => Rgb::ZERO,
             };
-            mesh.first.push(mesh.elements.len() as u32);
-            mesh.depth.push(depth);
-            subdivide(*v, depth, &mut |vertices| {
-                let n = (vertices[1] - vertices[0]).cross(vertices[2] - vertices[0]);
-                mesh.elements.push(Element {
-                    triangle: i as u32,
-                    vertices,
-                    normal: n.normalize(),
-                    area: 0.5 * n.length(),
-                    reflectance,
-                    emission: material.emission,
-                });
-            });
+            let root = Element {
+                triangle: i as u32,
+                vertices: *v,
+                normal: Vec3A::ZERO,
+                area: 0.0,
+                reflectance,
+                emission: material.emission,
+            };
+            mesh.roots.push(mesh.cells.len() as u32);
+            mesh.cells.push(Cell::Leaf(NONE));
+            mesh.grow(mesh.roots[i], root, 0, depth);
         }
         if glossy > 0 {
             mesh.notes.push(format!(
@@ -155,6 +168,131 @@ impl Mesh {
         Ok(mesh)
     }
 
+    /// Fills `cell` with `element` split `depth` more levels below `level`.
+    fn grow(&mut self, cell: u32, element: Element, level: u8, depth: u8) {
+        if depth == 0 {
+            let [a, b, c] = element.vertices;
+            let n = (b - a).cross(c - a);
+            self.cells[cell as usize] = Cell::Leaf(self.elements.len() as u32);
+            self.elements.push(Element {
+                normal: n.normalize(),
+                area: 0.5 * n.length(),
+                ..element
+            });
+            self.levels.push(level);
+            return;
+        }
+        let first = self.cells.len() as u32;
+        self.cells[cell as usize] = Cell::Inner(first);
+        self.cells.extend([Cell::Leaf(NONE); 4]);
+        for (k, vertices) in children(element.vertices).into_iter().enumerate() {
+            let child = Element {
+                vertices,
+                ..element
+            };
+            self.grow(first + k as u32, child, level + 1, depth - 1);
+        }
+    }
+
+    /// A copy with each element for which `split` holds divided in four
+    /// (elements at the deepest level stay), and per new element the index
+    /// of the element it comes from.
+    pub fn refine(&self, split: &[bool]) -> (Mesh, Vec<u32>) {
+        let mut mesh = Mesh {
+            elements: Vec::with_capacity(self.elements.len()),
+            levels: Vec::with_capacity(self.elements.len()),
+            roots: Vec::with_capacity(self.roots.len()),
+            cells: Vec::with_capacity(self.cells.len()),
+            notes: self.notes.clone(),
+        };
+        let mut origin = Vec::with_capacity(self.elements.len());
+        for &root in &self.roots {
+            if root == NONE {
+                mesh.roots.push(NONE);
+                continue;
+            }
+            mesh.roots.push(mesh.cells.len() as u32);
+            mesh.cells.push(Cell::Leaf(NONE));
+            self.copy_cell(
+                root,
+                mesh.roots[mesh.roots.len() - 1],
+                &mut mesh,
+                split,
+                &mut origin,
+            );
+        }
+        (mesh, origin)
+    }
+
+    fn copy_cell(
+        &self,
+        from: u32,
+        to: u32,
+        mesh: &mut Mesh,
+        split: &[bool],
+        origin: &mut Vec<u32>,
+    ) {
+        match self.cells[from as usize] {
+            Cell::Leaf(e) => {
+                let level = self.levels[e as usize];
+                let depth = u8::from(split[e as usize] && level < MAX_DEPTH);
+                let before = mesh.elements.len();
+                mesh.grow(to, self.elements[e as usize], level, depth);
+                origin.extend(std::iter::repeat_n(e, mesh.elements.len() - before));
+            }
+            Cell::Inner(first) => {
+                let first_new = mesh.cells.len() as u32;
+                mesh.cells[to as usize] = Cell::Inner(first_new);
+                mesh.cells.extend([Cell::Leaf(NONE); 4]);
+                for k in 0..4 {
+                    self.copy_cell(first + k, first_new + k, mesh, split, origin);
+                }
+            }
+        }
+    }
+
+    /// Adaptive subdivision's test: per element, whether its reflected
+    /// radiance L - E differs from a neighbour's by more than `tolerance`
+    /// times the area-weighted mean over the mesh, in any colour channel
+    /// (the red and green walls' gradients hardly show in luminance).
+    /// Neighbours share a vertex and lie in the same plane (walls meeting at
+    /// a corner may differ); across a T-vertex only the elements that have
+    /// it count.
+    pub fn steep(&self, radiance: &[Rgb], tolerance: f32) -> Vec<bool> {
+        use std::collections::HashMap;
+        let reflected: Vec<Rgb> = self
+            .elements
+            .iter()
+            .zip(radiance)
+            .map(|(e, l)| *l - e.emission)
+            .collect();
+        let area: f32 = self.elements.iter().map(|e| e.area).sum();
+        let mean = self
+            .elements
+            .iter()
+            .zip(&reflected)
+            .map(|(e, l)| e.area * *l)
+            .sum::<Rgb>()
+            / area;
+        let mut range: HashMap<_, (Rgb, Rgb)> = HashMap::new();
+        for (e, &l) in self.elements.iter().zip(&reflected) {
+            for v in e.vertices {
+                let r = range.entry(vertex_key(v, e.normal)).or_insert((l, l));
+                *r = (r.0.min(l), r.1.max(l));
+            }
+        }
+        let limit = tolerance * mean;
+        self.elements
+            .iter()
+            .map(|e| {
+                e.vertices.iter().any(|&v| {
+                    let (low, high) = range[&vertex_key(v, e.normal)];
+                    (high - low).cmpgt(limit).any()
+                })
+            })
+            .collect()
+    }
+
     /// Per element, the radiance at its three vertices ([`vertex_average`]).
     pub fn vertex_average(&self, radiance: &[Rgb]) -> Vec<[Rgb; 3]> {
         vertex_average(self.elements.iter().zip(radiance.iter().copied()))
@@ -163,26 +301,20 @@ impl Mesh {
     /// The element of scene triangle `triangle` that contains the point at
     /// barycentrics (b1, b2) of the triangle, if the triangle is a patch.
     pub fn element_at(&self, triangle: usize, b1: f32, b2: f32) -> Option<usize> {
-        let first = *self.first.get(triangle)?;
-        if first == u32::MAX {
+        let mut cell = *self.roots.get(triangle)?;
+        if cell == NONE {
             return None;
         }
         let mut b = [1.0 - b1 - b2, b1, b2];
-        let mut index = 0usize;
-        for _ in 0..self.depth[triangle] {
-            // The child whose corner weight is at least 1/2, or the middle one.
-            let child = (0..3).find(|&k| b[k] >= 0.5).unwrap_or(3);
-            b = match child {
-                3 => [1.0 - 2.0 * b[0], 1.0 - 2.0 * b[1], 1.0 - 2.0 * b[2]],
-                k => {
-                    let mut c = [2.0 * b[0], 2.0 * b[1], 2.0 * b[2]];
-                    c[k] -= 1.0;
-                    c
+        loop {
+            match self.cells[cell as usize] {
+                Cell::Leaf(e) => return Some(e as usize),
+                Cell::Inner(first) => {
+                    let child = child_at(&mut b);
+                    cell = first + child as u32;
                 }
-            };
-            index = 4 * index + child;
+            }
         }
-        Some(first as usize + index)
     }
 }
 
@@ -196,10 +328,7 @@ pub fn vertex_average<'a>(
     elements: impl Iterator<Item = (&'a Element, Rgb)> + Clone,
 ) -> Vec<[Rgb; 3]> {
     use std::collections::HashMap;
-    let key = |v: Vec3A, n: Vec3A| {
-        let q = |x: f32| (x * 1024.0).round() as i32;
-        (v.to_array().map(f32::to_bits), [q(n.x), q(n.y), q(n.z)])
-    };
+    let key = vertex_key;
     let mut sums: HashMap<_, (Rgb, f32)> = HashMap::new();
     for (e, l) in elements.clone() {
         for v in e.vertices {
@@ -218,26 +347,46 @@ pub fn vertex_average<'a>(
         .collect()
 }
 
-/// Calls `emit` for the 4^depth children of triangle `v` in the order
-/// [`Mesh::element_at`] numbers them: corner children 0, 1, 2 (at the
-/// vertex of that index), then the middle one, recursively.
-fn subdivide(v: [Vec3A; 3], depth: u8, emit: &mut impl FnMut([Vec3A; 3])) {
-    if depth == 0 {
-        emit(v);
-        return;
-    }
+/// A vertex's position (exactly: midpoints are computed alike on both sides
+/// of an edge) and its element's plane orientation, as a hash key.
+fn vertex_key(v: Vec3A, n: Vec3A) -> ([u32; 3], [i32; 3]) {
+    let q = |x: f32| (x * 1024.0).round() as i32;
+    (v.to_array().map(f32::to_bits), [q(n.x), q(n.y), q(n.z)])
+}
+
+/// The four children of triangle `v` by midpoint subdivision: corner
+/// children 0, 1, 2 (at the vertex of that index), then the middle one.
+pub fn children(v: [Vec3A; 3]) -> [[Vec3A; 3]; 4] {
     // m[k] is the midpoint of the edge opposite vertex k.
     let m = [
         0.5 * (v[1] + v[2]),
         0.5 * (v[2] + v[0]),
         0.5 * (v[0] + v[1]),
     ];
-    subdivide([v[0], m[2], m[1]], depth - 1, emit);
-    subdivide([m[2], v[1], m[0]], depth - 1, emit);
-    subdivide([m[1], m[0], v[2]], depth - 1, emit);
     // The middle child: its vertex k is m[k], so its barycentric k is
     // 1 - 2 b_k of the parent's.
-    subdivide([m[0], m[1], m[2]], depth - 1, emit);
+    [
+        [v[0], m[2], m[1]],
+        [m[2], v[1], m[0]],
+        [m[1], m[0], v[2]],
+        [m[0], m[1], m[2]],
+    ]
+}
+
+/// The child of [`children`] that holds the point at barycentrics `b`, and
+/// `b` updated to the child's barycentrics.
+pub fn child_at(b: &mut [f32; 3]) -> usize {
+    // The child whose corner weight is at least 1/2, or the middle one.
+    let child = (0..3).find(|&k| b[k] >= 0.5).unwrap_or(3);
+    *b = match child {
+        3 => [1.0 - 2.0 * b[0], 1.0 - 2.0 * b[1], 1.0 - 2.0 * b[2]],
+        k => {
+            let mut c = [2.0 * b[0], 2.0 * b[1], 2.0 * b[2]];
+            c[k] -= 1.0;
+            c
+        }
+    };
+    child
 }
 
 #[cfg(test)]
@@ -247,37 +396,39 @@ mod tests {
     #[test]
     fn element_lookup_finds_the_element_containing_the_point() {
         let v = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
-        let mut elements = Vec::new();
-        subdivide(v, 3, &mut |e| elements.push(e));
-        let mesh = Mesh {
-            elements: elements
-                .iter()
-                .map(|&vertices| Element {
-                    triangle: 0,
-                    vertices,
-                    normal: Vec3A::Z,
-                    area: 0.0,
-                    reflectance: Rgb::ZERO,
-                    emission: Rgb::ZERO,
-                })
-                .collect(),
-            first: vec![0],
-            depth: vec![3],
-            notes: vec![],
+        let root = Element {
+            triangle: 0,
+            vertices: v,
+            normal: Vec3A::Z,
+            area: 0.5,
+            reflectance: Rgb::ZERO,
+            emission: Rgb::ZERO,
         };
+        let mut uniform = Mesh {
+            roots: vec![0],
+            cells: vec![Cell::Leaf(NONE)],
+            ..Mesh::default()
+        };
+        uniform.grow(0, root, 0, 2);
+        // One more level on every other element: an adaptive mesh.
+        let split: Vec<bool> = (0..uniform.elements.len()).map(|k| k % 2 == 0).collect();
+        let (mesh, origin) = uniform.refine(&split);
+        assert_eq!(mesh.elements.len(), 8 * 4 + 8);
+        let area: f32 = mesh.elements.iter().map(|e| e.area).sum();
+        assert!((area - 0.5).abs() < 1e-6, "{area}");
         for i in 0..40 {
             for j in 0..40 - i {
                 let (b1, b2) = ((i as f32 + 0.3) / 41.0, (j as f32 + 0.3) / 41.0);
                 let p = v[0] + b1 * v[1] + b2 * v[2];
-                let e = &mesh.elements[mesh.element_at(0, b1, b2).unwrap()];
-                // p inside e: all its edge functions agree in sign.
-                let [a, b, c] = e.vertices;
-                let side = |x: Vec3A, y: Vec3A| (y - x).cross(p - x).z;
-                let s = [side(a, b), side(b, c), side(c, a)];
-                assert!(
-                    s.iter().all(|&x| x >= -1e-6) || s.iter().all(|&x| x <= 1e-6),
-                    "{b1} {b2}"
-                );
+                let k = mesh.element_at(0, b1, b2).unwrap();
+                // p inside the element and its origin: all edge functions agree in sign.
+                let inside = |[a, b, c]: [Vec3A; 3]| {
+                    let side = |x: Vec3A, y: Vec3A| (y - x).cross(p - x).z;
+                    let s = [side(a, b), side(b, c), side(c, a)];
+                    s.iter().all(|&x| x >= -1e-6) || s.iter().all(|&x| x <= 1e-6)
+                };
+                assert!(inside(mesh.elements[k].vertices), "{b1} {b2}");
+                assert!(inside(uniform.elements[origin[k] as usize].vertices));
             }
         }
     }

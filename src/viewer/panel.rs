@@ -270,6 +270,23 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                     .logarithmic(true)
                     .text("Patch size (of the scene's diagonal)"),
             );
+            if options.radiosity_solver != RadiositySolver::Hierarchical {
+                ui.add(
+                    egui::Slider::new(&mut options.adaptive_rounds, 0..=4)
+                        .text("Adaptive subdivision rounds"),
+                );
+                if options.adaptive_rounds > 0 {
+                    ui.add(
+                        egui::Slider::new(&mut options.adaptive_tolerance, 0.05..=2.0)
+                            .logarithmic(true)
+                            .text("Tolerance (of the mean)"),
+                    );
+                }
+            }
+            ui.checkbox(
+                &mut options.radiosity_wireframe,
+                "Wireframe (colour by level)",
+            );
             ui.horizontal(|ui| {
                 ui.label("Form factors");
                 ui.radio_value(

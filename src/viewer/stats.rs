@@ -29,8 +29,12 @@ pub fn stats_panel(ui: &mut egui::Ui, app: &mut ViewerApp) {
         {
             ui.label(
                 egui::RichText::new(format!(
-                    "{name} solver: {} steps, {} elements, {} links, residual {:.3e}",
-                    solver.steps, solver.elements, solver.links, solver.residual
+                    "{name} solver: {} steps, {} elements, {} links, {:.1} MB, residual {:.3e}",
+                    solver.steps,
+                    solver.elements,
+                    solver.links,
+                    solver.memory as f64 * 1e-6,
+                    solver.residual
                 ))
                 .monospace(),
             );
