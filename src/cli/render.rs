@@ -93,7 +93,8 @@ pub struct RenderArgs {
     /// Samples per pixel.
     #[arg(long, conflicts_with_all = ["time", "rays_per_pixel"])]
     spp: Option<u32>,
-    /// Render for this many seconds instead of a sample count.
+    /// Render for this many seconds instead of a sample count (a solver:
+    /// solve, then add samples to the image of the solution until then).
     #[arg(long, conflicts_with = "rays_per_pixel")]
     time: Option<f64>,
     /// Render until this many rays per pixel (all kinds) are cast: equal-cost comparisons.
@@ -404,7 +405,14 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     let solver = matches!(settings.integrator, Integrator::Solver(_));
     let session = Session::new(Arc::new(scene), settings)?;
     let stats = match (target_spp, args.rays_per_pixel) {
-        _ if solver => render_solver(&session)?,
+        _ if solver => {
+            let stats = render_solver(&session)?;
+            match args.time {
+                // Converged: the rest of the time adds samples to its image.
+                Some(t) => render_until(&session, Duration::from_secs_f64(t)),
+                None => stats,
+            }
+        }
         (Some(spp), _) => render_spp(&session, spp),
         (None, Some(rays)) => render_rays(&session, rays),
         (None, None) => render_time(&session, Duration::from_secs_f64(args.time.unwrap_or(1.0))),
@@ -487,6 +495,16 @@ pub(crate) fn drive_solver(
         return Err(e);
     }
     Ok(session.stats())
+}
+
+/// One pass after another until the session's render time reaches `limit`.
+fn render_until(session: &Session, limit: Duration) -> RenderStats {
+    while session.stats().render_time < limit {
+        if !session.render_pass(1) {
+            break;
+        }
+    }
+    session.stats()
 }
 
 /// [`drive_solver`] with a progress bar.

@@ -281,7 +281,8 @@ impl Mesh {
                 *r = (r.0.min(l), r.1.max(l));
             }
         }
-        let limit = tolerance * mean;
+        // One threshold for every channel, as the image error weighs them.
+        let limit = Rgb::splat(tolerance * (mean.x + mean.y + mean.z) / 3.0);
         self.elements
             .iter()
             .map(|e| {

@@ -44,7 +44,8 @@ impl MultiPassVisitor for MultiPass<'_> {
 }
 
 /// A solver's pass: `k` solve steps, then a new image of the solution (the
-/// film restarts: the solution it showed is gone).
+/// film restarts: the solution it showed is gone), or, once the solution
+/// has converged, more samples of the same image.
 pub(super) struct SolverPass<'a> {
     pub(super) session: &'a Session,
     pub(super) k: u32,
@@ -69,18 +70,34 @@ impl SolverVisitor for SolverPass<'_> {
         let Some(typed) = state.as_mut().and_then(|s| s.downcast_mut::<S::State>()) else {
             unreachable!("a session's solver state has its solver's type");
         };
+        let before = *lock(&session.solver_progress);
         let mut counts = RayCounts::default();
         let progress = session
             .pool
             .install(|| solver.step(scene, typed, self.k, &mut counts));
         session.add_counts(0, &counts, 0);
         *lock(&session.solver_progress) = Some(progress);
-        session.film.clear();
+        // A converged solution that this pass left as it was keeps its
+        // image, which gains samples (the gather display's noise falls);
+        // any other pass draws the new solution on a clear film.
+        let unchanged = before.is_some_and(|b| b.converged && b.steps == progress.steps);
+        let first = if unchanged {
+            session.spp.load(Ordering::Relaxed)
+        } else {
+            session.film.clear();
+            0
+        };
         let spp = solver.display_spp().max(1);
         let typed = &*typed;
-        session.camera_pass(0, spp, None, 0, 1, spp == 1, |scene, ray, _, sampler, c| {
-            solver.radiance(scene, typed, ray, sampler, c)
-        });
-        (spp, u64::from(self.k))
+        session.camera_pass(
+            first,
+            spp,
+            None,
+            0,
+            1,
+            spp == 1,
+            |scene, ray, _, sampler, c| solver.radiance(scene, typed, ray, sampler, c),
+        );
+        (first + spp, u64::from(self.k))
     }
 }
