@@ -4,7 +4,8 @@
 //! of an equal-time comparison, memory over a long session, and UI frame
 //! times in the MC lab tab while its experiments run
 //! (`TRACELAB_BENCH_ONLY=lab` measures only those;
-//! `TRACELAB_BENCH_ONLY=transport` only BDPT's and photon mapping's frames).
+//! `TRACELAB_BENCH_ONLY=transport` only BDPT's and photon mapping's frames;
+//! `TRACELAB_BENCH_ONLY=radiosity` only radiosity's, while it solves).
 //!
 //! `cargo bench --bench viewer` (TRACELAB_SOAK_SECONDS=600 for the 10-minute
 //! memory figure). Prints a table; asserts nothing.
@@ -107,6 +108,58 @@ fn transport_frames(h: &mut Harness<'static, Window>) {
     h.state_mut().app.settings.a.integrator.kind = IntegratorKind::Path;
 }
 
+/// UI frame times while radiosity solves: Gauss-Seidel with a round of
+/// adaptive subdivision (form factors of a few thousand elements) and the
+/// hierarchical solver, each from a fresh start.
+fn radiosity_frames(h: &mut Harness<'static, Window>) {
+    use tracelab::radiosity::RadiositySolver;
+    for (solver, patch_size) in [
+        (RadiositySolver::GaussSeidel, 0.15),
+        (RadiositySolver::Hierarchical, 0.002),
+    ] {
+        {
+            let options = &mut h.state_mut().app.settings.a.integrator;
+            options.kind = IntegratorKind::Radiosity;
+            options.radiosity_solver = solver;
+            options.patch_size = patch_size;
+            options.adaptive_rounds = 1;
+            options.radiosity_epsilon = 1e-5;
+        }
+        let mut frames = Vec::new();
+        let start = Instant::now();
+        let until = start + Duration::from_secs(20);
+        frame(h);
+        while Instant::now() < until {
+            frames.push(frame(h).as_secs_f64() * 1e3);
+            let app = &h.state().app;
+            let f = app.frame();
+            let current = f.generation == app.live().generation();
+            let solver = f.views.first().and_then(|v| v.stats.solver);
+            if current && solver.is_some_and(|s| s.converged) {
+                break;
+            }
+        }
+        let elements = h
+            .state()
+            .app
+            .frame()
+            .views
+            .first()
+            .and_then(|v| v.stats.solver);
+        println!(
+            "UI frame time while radiosity ({}) solves: median {:.2} ms, p95 {:.2} ms, max {:.2} ms ({} frames, {:.1} s, {} elements)",
+            solver.name(),
+            percentile(frames.clone(), 0.5),
+            percentile(frames.clone(), 0.95),
+            percentile(frames.clone(), 1.0),
+            frames.len(),
+            start.elapsed().as_secs_f64(),
+            elements.map_or(0, |s| s.elements)
+        );
+    }
+    h.state_mut().app.settings.a.integrator.kind = IntegratorKind::Path;
+}
+
 fn main() {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
@@ -119,6 +172,9 @@ fn main() {
     }
     if only.is_empty() || only == "transport" {
         transport_frames(&mut h);
+    }
+    if only.is_empty() || only == "radiosity" {
+        radiosity_frames(&mut h);
     }
     if !only.is_empty() {
         return;

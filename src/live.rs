@@ -66,8 +66,8 @@ pub struct LiveView {
     pub snapshot: Arc<FilmSnapshot>,
     pub stats: RenderStats,
     pub history: Vec<ErrorPoint>,
-    /// Whether the target sample count is reached, the solver converged,
-    /// or the technique failed.
+    /// Whether the target sample count is reached (a solver: converged and
+    /// at the target), or the technique failed.
     pub done: bool,
     /// Why the technique could not run, if it could not.
     pub failure: Option<String>,
@@ -411,9 +411,14 @@ impl Job {
         view.snapshot = Arc::new(snapshot);
         view.stats = stats;
         view.failure = session.failure().map(|e| e.to_string());
-        view.done = self.targets[index].is_some_and(|t| stats.spp >= t)
-            || stats.solver.is_some_and(|s| s.converged)
-            || view.failure.is_some();
+        let target_reached = self.targets[index].is_some_and(|t| stats.spp >= t);
+        // A solver is done once converged and its image has the target's
+        // samples (until then its passes add samples to the same image).
+        view.done = view.failure.is_some()
+            || match stats.solver {
+                Some(s) => s.converged && target_reached,
+                None => target_reached,
+            };
         if self.frame.first_image_latency.is_none() {
             self.frame.first_image_latency = Some(self.requested.elapsed());
         }

@@ -306,7 +306,15 @@ fn radiosity_controls_drive_the_solver() {
     harness.run_steps(2);
     harness.get_by_label_contains("links");
     // Another solver restarts from its own mesh (a coarse one, for time).
+    // Progressive refinement converges over thousands of shots: 50 here.
     harness.state_mut().app.settings.a.integrator.patch_size = 0.3;
+    harness
+        .state_mut()
+        .app
+        .settings
+        .a
+        .integrator
+        .radiosity_iterations = 50;
     click(&mut harness, "progressive");
     let ambient = harness.state().app.settings.a.integrator.radiosity_ambient;
     click(&mut harness, "Ambient term");
@@ -317,6 +325,39 @@ fn radiosity_controls_drive_the_solver() {
         options.radiosity_solver,
         tracelab::radiosity::RadiositySolver::Progressive
     );
+    // Gauss-Seidel with a round of adaptive subdivision and the wireframe:
+    // the converged mesh has more elements than the uniform one (206).
+    harness
+        .state_mut()
+        .app
+        .settings
+        .a
+        .integrator
+        .radiosity_iterations = 0;
+    click(&mut harness, "gauss-seidel");
+    harness.get_by_role_and_label(egui::accesskit::Role::Slider, "Adaptive subdivision rounds");
+    harness
+        .state_mut()
+        .app
+        .settings
+        .a
+        .integrator
+        .adaptive_rounds = 1;
+    click(&mut harness, "Wireframe (colour by level)");
+    step_until(&mut harness, "the adaptive solution", finished);
+    assert!(
+        harness
+            .state()
+            .app
+            .settings
+            .a
+            .integrator
+            .radiosity_wireframe
+    );
+    let solver = harness.state().app.frame().views[0].stats.solver.unwrap();
+    assert!(solver.converged && solver.elements > 206, "{solver:?}");
+    harness.run_steps(2);
+    harness.get_by_label_contains("MB, residual");
 }
 
 #[test]
