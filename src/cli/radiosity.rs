@@ -181,27 +181,17 @@ fn rmse(image: &Image, reference: &Image, mask_above: f32) -> (f64, f64, usize) 
     ((all / n).sqrt(), (masked / kept.max(1) as f64).sqrt(), kept)
 }
 
-pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
-    args.radiosity.check()?;
-    for path in [&args.csv, &args.plot].into_iter().flatten() {
-        check_writable(path)?;
-    }
-    if let Some(plot) = &args.plot {
-        PlotFormat::of(plot)?;
-    }
-    let limits = Limits::default();
-    let mut scene = Scene::load_with_limits(&args.scene, &limits)?;
-    let reference = Image::read(&args.reference)?;
-    override_resolution(
-        &mut scene,
-        Some(reference.width),
-        Some(reference.height),
-        &limits,
-    )?;
-    let options = IntegratorOptions {
-        kind: IntegratorKind::Radiosity,
-        ..args.radiosity.options()
-    };
+/// One row of `tracelab radiosity`: steps, elements, links, shadow rays,
+/// bytes, solve seconds, residual, RMSE, masked RMSE.
+type Row = (u64, u64, u64, u64, u64, f64, f64, f64, f64);
+
+/// Solves with `options`, printing and returning a row after each pass.
+fn run(
+    scene: Arc<Scene>,
+    reference: &Image,
+    options: IntegratorOptions,
+    args: &RadiosityArgs,
+) -> Result<Vec<Row>> {
     let settings = RenderSettings {
         integrator: options.build(),
         sampler: SamplerKind::Independent,
@@ -212,14 +202,14 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
         domains: Default::default(),
         clamp: None,
     };
-    let session = Session::new(Arc::new(scene), settings)?;
+    let session = Session::new(scene, settings)?;
     println!(
         "{:>7} {:>9} {:>11} {:>9} {:>9} {:>9} {:>11} {:>9} {:>13}",
         "steps", "elements", "links", "rays M", "MB", "solve s", "residual", "RMSE", "masked RMSE"
     );
     let mut rows = Vec::new();
     drive_solver(&session, |stats, progress| {
-        let (all, masked, _) = rmse(&session.snapshot().image, &reference, args.mask_above);
+        let (all, masked, _) = rmse(&session.snapshot().image, reference, args.mask_above);
         // The solver's own time (form factors included), without drawing the image.
         let seconds = progress.solve_seconds;
         println!(
@@ -246,6 +236,50 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
             masked,
         ));
     })?;
+    Ok(rows)
+}
+
+pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
+    args.radiosity.check()?;
+    for path in [&args.csv, &args.plot].into_iter().flatten() {
+        check_writable(path)?;
+    }
+    if let Some(plot) = &args.plot {
+        PlotFormat::of(plot)?;
+    }
+    let limits = Limits::default();
+    let mut scene = Scene::load_with_limits(&args.scene, &limits)?;
+    let reference = Image::read(&args.reference)?;
+    override_resolution(
+        &mut scene,
+        Some(reference.width),
+        Some(reference.height),
+        &limits,
+    )?;
+    let options = IntegratorOptions {
+        kind: IntegratorKind::Radiosity,
+        ..args.radiosity.options()
+    };
+    let scene = Arc::new(scene);
+    let rows = run(scene.clone(), &reference, options, args)?;
+    // Progressive refinement: the plot shows both ambient settings.
+    let other = if options.radiosity_solver == RadiositySolver::Progressive && args.plot.is_some() {
+        let other = IntegratorOptions {
+            radiosity_ambient: !options.radiosity_ambient,
+            ..options
+        };
+        println!(
+            "and {} the ambient term, for the plot:",
+            if other.radiosity_ambient {
+                "with"
+            } else {
+                "without"
+            }
+        );
+        Some(run(scene, &reference, other, args)?)
+    } else {
+        None
+    };
     if let Some(path) = &args.csv {
         let mut text = String::from(
             "steps,elements,links,shadow_rays,bytes,solve_seconds,residual,rmse,masked_rmse\n",
@@ -261,13 +295,33 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
         eprintln!("wrote {}", path.display());
     }
     if let Some(path) = &args.plot {
-        let series = [
+        let mut series = vec![
             (
-                "masked RMSE",
+                "masked RMSE".to_string(),
                 rows.iter().map(|r| (r.0 as f64, r.8)).collect::<Vec<_>>(),
             ),
-            ("residual", rows.iter().map(|r| (r.0 as f64, r.6)).collect()),
+            (
+                "residual".to_string(),
+                rows.iter().map(|r| (r.0 as f64, r.6)).collect(),
+            ),
         ];
+        if let Some(other_rows) = &other {
+            let (this, that) = if options.radiosity_ambient {
+                ("with ambient", "without ambient")
+            } else {
+                ("without ambient", "with ambient")
+            };
+            series[0].0 = format!("masked RMSE, {this}");
+            series[1].0 = format!("unshot power, {this}");
+            series.push((
+                format!("masked RMSE, {that}"),
+                other_rows.iter().map(|r| (r.0 as f64, r.8)).collect(),
+            ));
+            series.push((
+                format!("unshot power, {that}"),
+                other_rows.iter().map(|r| (r.0 as f64, r.6)).collect(),
+            ));
+        }
         let series: Vec<Series> = series
             .iter()
             .enumerate()

@@ -1,7 +1,8 @@
 //! The radiosity system L_i = E_i + ρ_i Σ_j F_ij L_j (in radiance: B = π L
 //! for diffuse surfaces, so both sides divide by π) and its solvers:
 //! Jacobi and Gauss–Seidel gathering, and progressive refinement by
-//! shooting the element with the most unshot power (Southwell), with the
+//! shooting the patch with the most unshot power (Southwell; a patch's
+//! elements shoot together, Cohen et al.'s substructuring), with the
 //! ambient term of Cohen et al. 1988 for display.
 
 use super::form_factor::{FormFactorMethod, element_to_element};
@@ -219,23 +220,33 @@ pub fn step(
             change / emitted
         }
         MatrixSolver::Progressive => {
-            let Some(shooter) = (0..elements.len()).max_by(|&a, &b| {
-                let power = |k: usize| elements[k].area * luminance(s.unshot[k]);
-                power(a).total_cmp(&power(b))
-            }) else {
+            // Cohen et al.'s substructuring: a shot is a patch (a scene
+            // triangle), all of its elements at once, received by elements.
+            let patches = elements
+                .iter()
+                .map(|e| e.triangle as usize + 1)
+                .max()
+                .unwrap_or(0);
+            let mut power = vec![0.0f32; patches];
+            for (e, u) in elements.iter().zip(&s.unshot) {
+                power[e.triangle as usize] += e.area * luminance(*u);
+            }
+            let Some(patch) = (0..patches).max_by(|&a, &b| power[a].total_cmp(&power[b])) else {
                 return 0.0;
             };
-            let shot = s.unshot[shooter];
-            s.unshot[shooter] = Rgb::ZERO;
-            // L_j += ρ_j F_ji ΔL_i.
-            for (j, e) in elements.iter().enumerate() {
-                let fji = f.get(j, shooter);
-                if fji == 0.0 {
-                    continue;
+            for shooter in (0..elements.len()).filter(|&k| elements[k].triangle as usize == patch) {
+                let shot = s.unshot[shooter];
+                s.unshot[shooter] = Rgb::ZERO;
+                // L_j += ρ_j F_ji ΔL_i.
+                for (j, e) in elements.iter().enumerate() {
+                    let fji = f.get(j, shooter);
+                    if fji == 0.0 {
+                        continue;
+                    }
+                    let received = e.reflectance * shot * fji;
+                    s.radiance[j] += received;
+                    s.unshot[j] += received;
                 }
-                let received = e.reflectance * shot * fji;
-                s.radiance[j] += received;
-                s.unshot[j] += received;
             }
             let unshot: f64 = elements
                 .iter()
