@@ -150,7 +150,11 @@ fn a_closed_box_reaches_e_over_one_minus_rho_with_every_solver_at_any_scale() {
             };
             let mut technique = radiosity(solver, size);
             if solver == RadiositySolver::Hierarchical {
-                technique.epsilon = 1e-5;
+                // Every wall emits, so every link carries light: the 0.1%
+                // per leaf takes epsilon 2e-6 (460 884 links, 94% of the
+                // leaves' full matrix; measured worst leaf 0.015% off, 0.075%
+                // at 4e-6 with 385 896 links, 1.2% at 1e-5).
+                technique.epsilon = 2e-6;
             }
             let mut state = technique.init(&scene).expect("meshes");
             if let Some(m) = state.matrix() {
@@ -172,11 +176,8 @@ fn a_closed_box_reaches_e_over_one_minus_rho_with_every_solver_at_any_scale() {
                     assert!(leaves > 12, "{leaves} leaves, {links} links");
                     // Each leaf gathers through its own links and its
                     // ancestors', whose form factors are averages over the
-                    // ancestors: the area-weighted mean is right (measured
-                    // 2.00006), single leaves only up to the oracle's
-                    // tolerance and the smallest element size (measured:
-                    // worst leaf 1.2% off at epsilon 1e-5 and size 0.05;
-                    // the issue asks for 0.1%: not met).
+                    // ancestors: how close single leaves come depends on
+                    // epsilon (above); the area-weighted mean is right at any.
                     let (mut sum, mut area, mut worst) = (0.0f64, 0.0f64, 0.0f32);
                     for (e, l) in h.leaves() {
                         sum += (l.x * e.area) as f64;
@@ -188,7 +189,7 @@ fn a_closed_box_reaches_e_over_one_minus_rho_with_every_solver_at_any_scale() {
                         "hierarchical, scale {scale}: {leaves} leaves, {links} links, mean {mean:.5}, worst leaf off by {worst:.4}"
                     );
                     assert!((mean - 2.0).abs() < 2e-3, "mean {mean}");
-                    assert!(worst < 0.03, "worst leaf {worst}");
+                    assert!(worst < 2e-3, "worst leaf {worst}");
                     continue;
                 }
             };
