@@ -115,6 +115,9 @@ struct ViewArgs {
     /// Open BDPT's live strategy images (with --integrator bdpt).
     #[arg(long)]
     strategy_grid: bool,
+    /// Radiosity's settings, used with --integrator radiosity.
+    #[command(flatten)]
+    radiosity: radiosity::RadiosityFlags,
 }
 
 /// Runs the parsed command line.
@@ -129,22 +132,8 @@ pub fn run(cli: Cli) -> Result<()> {
         #[cfg(feature = "viewer")]
         Some(Command::View(args)) => view(args),
         #[cfg(feature = "viewer")]
-        None => view(ViewArgs {
-            scene: None,
-            integrator: None,
-            spp: None,
-            screenshot: None,
-            after_spp: 64,
-            compare: false,
-            compare_with: None,
-            distribute: false,
-            show: None,
-            threads: 0,
-            fresh: false,
-            export_dir: None,
-            lab: None,
-            strategy_grid: false,
-        }),
+        // The viewer with every flag at its default.
+        None => run(<Cli as clap::Parser>::parse_from(["tracelab", "view"])),
         #[cfg(not(feature = "viewer"))]
         None => {
             eprintln!(
@@ -177,9 +166,11 @@ fn view(args: ViewArgs) -> Result<()> {
     if let Some(shot) = &args.screenshot {
         tracelab::image::check_writable(shot)?;
     }
+    args.radiosity.check()?;
+    let launch_kind = args.integrator.map(integrator_kind);
     tracelab::viewer::run(tracelab::viewer::Launch {
         scene: args.scene,
-        integrator: args.integrator.map(integrator_kind),
+        integrator: launch_kind,
         target_spp: args.spp,
         fresh: args.fresh || args.screenshot.is_some(),
         screenshot: args.screenshot,
@@ -198,6 +189,8 @@ fn view(args: ViewArgs) -> Result<()> {
         lab: args.lab.map(|e| e.0),
         strategy_grid: args.strategy_grid,
         export_dir: args.export_dir,
+        radiosity: (launch_kind == Some(IntegratorKind::Radiosity))
+            .then(|| args.radiosity.options()),
     })
 }
 

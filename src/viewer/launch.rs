@@ -2,7 +2,7 @@
 //! a test), and where scene files are found.
 
 use super::settings::ViewMode;
-use crate::integrator::IntegratorKind;
+use crate::integrator::{IntegratorKind, IntegratorOptions};
 use crate::lab::Experiment;
 use std::path::{Path, PathBuf};
 
@@ -33,6 +33,8 @@ pub struct Launch {
     pub strategy_grid: bool,
     /// Open the Monte Carlo lab on this experiment.
     pub lab: Option<Experiment>,
+    /// Radiosity's settings from the command line (with `--integrator radiosity`).
+    pub radiosity: Option<IntegratorOptions>,
 }
 
 /// A relative scene path that does not exist here is looked up in the source
