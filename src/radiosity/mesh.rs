@@ -112,9 +112,14 @@ impl Mesh {
             return Err("radiosity needs diffuse surfaces: the scene has none".into());
         }
         if total > max_elements {
+            // Refused before allocating: n² form factors of 4 bytes.
+            let bytes = (total as f64).powi(2) * 4.0;
             return Err(format!(
-                "patch size {size} gives {total} elements, more than the {max_elements} the \
-                 form factor matrix fits in memory for: choose a larger --patch-size"
+                "patch size {size} gives {total} elements, whose form factor matrix would take \
+                 {:.1} GB, more than the {max_elements} elements ({:.1} GB) allowed: choose a \
+                 larger --patch-size",
+                bytes * 1e-9,
+                (max_elements as f64).powi(2) * 4e-9
             ));
         }
         let mut mesh = Mesh {
