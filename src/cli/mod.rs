@@ -5,6 +5,7 @@ mod bench;
 mod lab;
 mod radiosity;
 mod render;
+mod solver;
 mod strategies;
 mod stress;
 

@@ -2,6 +2,7 @@
 //! and a summary of what it cost; `--debug-sample` replays one path.
 
 use super::radiosity::RadiosityFlags;
+use super::solver::{render_solver, render_until};
 use super::{IntegratorArg, integrator_kind};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -13,7 +14,7 @@ use tracelab::film::{EXTREME_LUMINANCE, FinalImage, FlaggedPixel};
 use tracelab::image::check_writable;
 use tracelab::integrator::{
     CameraIntegrator, GlassShadows, Integrator, IntegratorKind, IntegratorOptions, MisHeuristic,
-    SolverProgress, SplattingIntegrator, Strategy,
+    SplattingIntegrator, Strategy,
 };
 use tracelab::math::OffsetMode;
 use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
@@ -466,56 +467,6 @@ pub(crate) fn progress_bar(len: u64, unit: &str) -> ProgressBar {
         ProgressStyle::with_template(&template).unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar
-}
-
-/// Runs a solver's steps until it converges (or reaches its step limit),
-/// in passes of 1, 2, 4, ... steps, each followed by an image of the
-/// solution; `after_pass` sees the statistics after each pass.
-pub(crate) fn drive_solver(
-    session: &Session,
-    mut after_pass: impl FnMut(&RenderStats, &SolverProgress),
-) -> Result<RenderStats> {
-    let mut steps = 1;
-    loop {
-        if !session.render_pass(steps) {
-            break;
-        }
-        let stats = session.stats();
-        let Some(progress) = stats.solver else { break };
-        after_pass(&stats, &progress);
-        if progress.converged {
-            break;
-        }
-        // Each pass ends with an image of the solution; doubling keeps
-        // their number logarithmic in the steps (progressive refinement
-        // takes thousands of shots).
-        steps = steps.saturating_mul(2);
-    }
-    if let Some(e) = session.failure() {
-        return Err(e);
-    }
-    Ok(session.stats())
-}
-
-/// One pass after another until the session's render time reaches `limit`.
-fn render_until(session: &Session, limit: Duration) -> RenderStats {
-    while session.stats().render_time < limit {
-        if !session.render_pass(1) {
-            break;
-        }
-    }
-    session.stats()
-}
-
-/// [`drive_solver`] with a progress bar.
-fn render_solver(session: &Session) -> Result<RenderStats> {
-    let bar = progress_bar(1, "steps");
-    let stats = drive_solver(session, |_, progress| {
-        bar.set_message(format!("residual {:.2e}", progress.residual));
-        bar.set_position(progress.steps);
-    });
-    bar.finish_and_clear();
-    stats
 }
 
 /// Renders exactly `spp` samples per pixel in passes small enough for a live progress bar.

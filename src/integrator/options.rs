@@ -115,6 +115,21 @@ impl Default for IntegratorOptions {
 }
 
 impl IntegratorOptions {
+    /// Takes radiosity's settings from `other`, leaving the rest.
+    pub fn set_radiosity_from(&mut self, other: &IntegratorOptions) {
+        self.radiosity_solver = other.radiosity_solver;
+        self.patch_size = other.patch_size;
+        self.radiosity_epsilon = other.radiosity_epsilon;
+        self.form_factor_method = other.form_factor_method;
+        self.form_factor_samples = other.form_factor_samples;
+        self.radiosity_ambient = other.radiosity_ambient;
+        self.radiosity_iterations = other.radiosity_iterations;
+        self.radiosity_display = other.radiosity_display;
+        self.adaptive_rounds = other.adaptive_rounds;
+        self.adaptive_tolerance = other.adaptive_tolerance;
+        self.radiosity_wireframe = other.radiosity_wireframe;
+    }
+
     /// The MIS heuristic of estimators that always combine strategies
     /// (`None` is not one of them).
     pub fn combining_heuristic(&self) -> MisHeuristic {

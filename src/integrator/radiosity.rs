@@ -255,7 +255,66 @@ impl Solver for Radiosity {
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
-        self.display(scene, state, ray, sampler, counts)
+        let mut ray = ray;
+        let mut weight = Rgb::ONE;
+        let mut travelled = 0.0;
+        for depth in 0..=SPECULAR_DEPTH {
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                return Rgb::ZERO;
+            };
+            travelled += hit.t;
+            if depth > 0 {
+                counts.bounce += 1;
+            }
+            let material = &scene.materials[hit.material as usize];
+            match material.bsdf {
+                Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => {
+                    let frame = Frame::from_normal(hit.normal);
+                    let wo = frame.to_local(-ray.direction);
+                    let u = sampler.next_1d_for(Domain::Bsdf);
+                    let Some(s) = material.bsdf.sample(wo, u, glam::Vec2::ZERO) else {
+                        return Rgb::ZERO;
+                    };
+                    weight *= s.weight;
+                    ray = hit.spawn_ray(frame.to_world(s.wi));
+                }
+                _ => {
+                    let Some(surface) = surface_at(scene, state, &hit) else {
+                        // Spheres are not patches: their own emission only.
+                        return weight * material.emitted(hit.normal, -ray.direction);
+                    };
+                    let e = &surface.element;
+                    if self.wireframe && on_edge(scene, &surface, travelled) {
+                        return weight * level_colour(surface.level);
+                    }
+                    let seen_emission = if e.normal.dot(ray.direction) < 0.0 {
+                        e.emission
+                    } else {
+                        Rgb::ZERO
+                    };
+                    let ambient = e.reflectance * surface.ambient;
+                    let reflected = match (self.display, surface.vertices) {
+                        (RadiosityDisplay::Gather, _) => gather(
+                            scene,
+                            state,
+                            &hit,
+                            e.reflectance,
+                            -ray.direction,
+                            sampler,
+                            counts,
+                        ),
+                        (RadiosityDisplay::Smooth, Some([l0, l1, l2])) => {
+                            let b = surface.barycentrics;
+                            ((1.0 - b.x - b.y) * l0 + b.x * l1 + b.y * l2 - e.emission)
+                                .max(Rgb::ZERO)
+                        }
+                        _ => surface.radiance - e.emission,
+                    };
+                    return weight * (seen_emission + reflected + ambient);
+                }
+            }
+        }
+        Rgb::ZERO
     }
 
     fn display_spp(&self) -> u32 {
@@ -425,77 +484,6 @@ impl Radiosity {
         state.rounds += 1;
         state.residual = 1.0;
         state.settled = state.rounds >= self.adaptive_rounds;
-    }
-
-    /// The display's radiance along a camera ray.
-    fn display(
-        &self,
-        scene: &Scene,
-        state: &RadiosityState,
-        ray: Ray,
-        sampler: &mut Sampler,
-        counts: &mut RayCounts,
-    ) -> Rgb {
-        let mut ray = ray;
-        let mut weight = Rgb::ONE;
-        let mut travelled = 0.0;
-        for depth in 0..=SPECULAR_DEPTH {
-            let Some(hit) = scene.geometry.intersect(&ray) else {
-                return Rgb::ZERO;
-            };
-            travelled += hit.t;
-            if depth > 0 {
-                counts.bounce += 1;
-            }
-            let material = &scene.materials[hit.material as usize];
-            match material.bsdf {
-                Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => {
-                    let frame = Frame::from_normal(hit.normal);
-                    let wo = frame.to_local(-ray.direction);
-                    let u = sampler.next_1d_for(Domain::Bsdf);
-                    let Some(s) = material.bsdf.sample(wo, u, glam::Vec2::ZERO) else {
-                        return Rgb::ZERO;
-                    };
-                    weight *= s.weight;
-                    ray = hit.spawn_ray(frame.to_world(s.wi));
-                }
-                _ => {
-                    let Some(surface) = surface_at(scene, state, &hit) else {
-                        // Spheres are not patches: their own emission only.
-                        return weight * material.emitted(hit.normal, -ray.direction);
-                    };
-                    let e = &surface.element;
-                    if self.wireframe && on_edge(scene, &surface, travelled) {
-                        return weight * level_colour(surface.level);
-                    }
-                    let seen_emission = if e.normal.dot(ray.direction) < 0.0 {
-                        e.emission
-                    } else {
-                        Rgb::ZERO
-                    };
-                    let ambient = e.reflectance * surface.ambient;
-                    let reflected = match (self.display, surface.vertices) {
-                        (RadiosityDisplay::Gather, _) => gather(
-                            scene,
-                            state,
-                            &hit,
-                            e.reflectance,
-                            -ray.direction,
-                            sampler,
-                            counts,
-                        ),
-                        (RadiosityDisplay::Smooth, Some([l0, l1, l2])) => {
-                            let b = surface.barycentrics;
-                            ((1.0 - b.x - b.y) * l0 + b.x * l1 + b.y * l2 - e.emission)
-                                .max(Rgb::ZERO)
-                        }
-                        _ => surface.radiance - e.emission,
-                    };
-                    return weight * (seen_emission + reflected + ambient);
-                }
-            }
-        }
-        Rgb::ZERO
     }
 }
 

@@ -135,19 +135,8 @@ impl ViewerApp {
         if let Some(kind) = launch.integrator {
             settings.a.integrator.kind = kind;
         }
-        if let Some(r) = launch.radiosity {
-            let options = &mut settings.a.integrator;
-            options.radiosity_solver = r.radiosity_solver;
-            options.patch_size = r.patch_size;
-            options.radiosity_epsilon = r.radiosity_epsilon;
-            options.form_factor_method = r.form_factor_method;
-            options.form_factor_samples = r.form_factor_samples;
-            options.radiosity_ambient = r.radiosity_ambient;
-            options.radiosity_iterations = r.radiosity_iterations;
-            options.radiosity_display = r.radiosity_display;
-            options.adaptive_rounds = r.adaptive_rounds;
-            options.adaptive_tolerance = r.adaptive_tolerance;
-            options.radiosity_wireframe = r.radiosity_wireframe;
+        if let Some(r) = &launch.radiosity {
+            settings.a.integrator.set_radiosity_from(r);
         }
         if let Some(spp) = launch.target_spp {
             settings.target_spp = spp.max(1);
