@@ -8,7 +8,7 @@ use super::display::render_view;
 use super::export::{export_path, write_color_image, write_exr};
 use super::lab::LabState;
 use super::launch::{Launch, list_scene_files, resolve_scene_path};
-use super::settings::{Config, Display, Settings, Tab, load_settings, settings_file};
+use super::settings::{Config, Display, Settings, Tab};
 use super::stats::percentile;
 use super::view_transform::ViewTransform;
 use crate::camera::Camera;
@@ -125,53 +125,8 @@ impl ViewerApp {
     /// the launch options, loads the scene and starts rendering.
     pub fn new(launch: Launch) -> Self {
         let strategy_grid = launch.strategy_grid;
-        let mut settings: Settings = match settings_file() {
-            Some(path) if !launch.fresh => load_settings(&path),
-            _ => Settings::default(),
-        };
-        if let Some(scene) = &launch.scene {
-            settings.scene_path = scene.to_string_lossy().into_owned();
-        }
-        if let Some(kind) = launch.integrator {
-            settings.a.integrator.kind = kind;
-        }
-        if let Some(r) = &launch.radiosity {
-            settings.a.integrator.set_radiosity_from(r);
-        }
-        if let Some(spp) = launch.target_spp {
-            settings.target_spp = spp.max(1);
-            settings.unlimited = false;
-        }
-        if launch.distribute {
-            settings.a.spread_by_noise = true;
-        }
-        if let Some(mode) = launch.show {
-            settings.display.view = mode;
-        }
-        if launch.compare {
-            settings.compare = true;
-            settings.b = Config {
-                sampler: crate::sampling::SamplerKind::Sobol,
-                ..settings.a
-            };
-        }
-        if let Some(kind) = launch.compare_with {
-            settings.compare = true;
-            settings.lock = crate::live::Lock::EqualTime;
-            settings.b = settings.a;
-            settings.b.integrator.kind = kind;
-        }
-        if let Some(dir) = &launch.export_dir {
-            settings.export_dir = dir.to_string_lossy().into_owned();
-        }
-        if launch.lab.is_some() {
-            settings.tab = Tab::Lab;
-        }
+        let settings = launch.settings();
         let lab = LabState::new(launch.lab.unwrap_or_default());
-        if launch.screenshot.is_some() {
-            settings.target_spp = settings.target_spp.max(launch.after_spp);
-            settings.unlimited = false;
-        }
         let mut errors = Vec::new();
         let live = match LiveRender::start(launch.threads) {
             Ok(live) => live,

@@ -1,7 +1,7 @@
 //! How the viewer is started: the launch options from the command line (or
-//! a test), and where scene files are found.
+//! a test), the settings they give, and where scene files are found.
 
-use super::settings::ViewMode;
+use super::settings::{Config, Settings, Tab, ViewMode, load_settings, settings_file};
 use crate::integrator::{IntegratorKind, IntegratorOptions};
 use crate::lab::Experiment;
 use std::path::{Path, PathBuf};
@@ -35,6 +35,60 @@ pub struct Launch {
     pub lab: Option<Experiment>,
     /// Radiosity's settings from the command line (with `--integrator radiosity`).
     pub radiosity: Option<IntegratorOptions>,
+}
+
+impl Launch {
+    /// The settings the viewer starts with: the saved ones (unless `fresh`)
+    /// or the defaults, with the launch options applied.
+    pub(super) fn settings(&self) -> Settings {
+        let mut settings = match settings_file() {
+            Some(path) if !self.fresh => load_settings(&path),
+            _ => Settings::default(),
+        };
+        if let Some(scene) = &self.scene {
+            settings.scene_path = scene.to_string_lossy().into_owned();
+        }
+        if let Some(kind) = self.integrator {
+            settings.a.integrator.kind = kind;
+        }
+        if let Some(r) = &self.radiosity {
+            settings.a.integrator.set_radiosity_from(r);
+        }
+        if let Some(spp) = self.target_spp {
+            settings.target_spp = spp.max(1);
+            settings.unlimited = false;
+        }
+        if self.distribute {
+            settings.a.spread_by_noise = true;
+        }
+        if let Some(mode) = self.show {
+            settings.display.view = mode;
+        }
+        if self.compare {
+            settings.compare = true;
+            settings.b = Config {
+                sampler: crate::sampling::SamplerKind::Sobol,
+                ..settings.a
+            };
+        }
+        if let Some(kind) = self.compare_with {
+            settings.compare = true;
+            settings.lock = crate::live::Lock::EqualTime;
+            settings.b = settings.a;
+            settings.b.integrator.kind = kind;
+        }
+        if let Some(dir) = &self.export_dir {
+            settings.export_dir = dir.to_string_lossy().into_owned();
+        }
+        if self.lab.is_some() {
+            settings.tab = Tab::Lab;
+        }
+        if self.screenshot.is_some() {
+            settings.target_spp = settings.target_spp.max(self.after_spp);
+            settings.unlimited = false;
+        }
+        settings
+    }
 }
 
 /// A relative scene path that does not exist here is looked up in the source
