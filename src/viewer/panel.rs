@@ -266,7 +266,9 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                 );
             }
             ui.add(
-                egui::Slider::new(&mut options.patch_size, 0.02..=0.5)
+                // Hierarchical: the smallest element, which goes well below
+                // the matrix solvers' sizes (the Cornell box runs use 0.002).
+                egui::Slider::new(&mut options.patch_size, 0.001..=0.5)
                     .logarithmic(true)
                     .text("Patch size (of the scene's diagonal)"),
             );
