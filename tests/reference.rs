@@ -171,6 +171,18 @@ fn bidirectional_path_tracing_matches_mitsuba_on_the_cornell_box() {
     );
 }
 
+/// Vertex connection and merging is biased at any finite radius; at 64
+/// iterations of a radius that shrinks from 0.2% of the diagonal its bias
+/// is far below the test's noise.
+#[test]
+fn vertex_connection_and_merging_matches_mitsuba_on_the_cornell_box() {
+    check_against_reference(
+        options(IntegratorKind::Vcm, 8),
+        "cornell_box_path_ref.exr",
+        "cornell_box_path_ref_var.exr",
+    );
+}
+
 /// Samples spread by noise (after 8 spp everywhere) pass the same test: the
 /// per-pixel standard errors follow each pixel's own count, so a bias from
 /// the allocation (a pixel's count depending on its own samples) would show

@@ -146,11 +146,11 @@ pub struct RenderArgs {
     /// Photon mapping: photons per iteration (0: one per pixel).
     #[arg(long, default_value_t = 0)]
     photons: u32,
-    /// Photon mapping: gather radius of the first iteration, as a fraction
-    /// of the scene's bounding-box diagonal.
+    /// Photon mapping and VCM: gather (merge) radius of the first
+    /// iteration, as a fraction of the scene's bounding-box diagonal.
     #[arg(long, default_value_t = 0.002)]
     radius: f32,
-    /// Photon mapping: the radius shrinks as r_i^2 = r_1^2 i^(alpha - 1)
+    /// Photon mapping and VCM: the radius shrinks as r_i^2 = r_1^2 i^(alpha - 1)
     /// (0 < alpha <= 1; 1 keeps it fixed, a biased estimate).
     #[arg(long, default_value_t = 2.0 / 3.0)]
     alpha: f32,

@@ -29,6 +29,7 @@ pub mod photon_map;
 pub mod radiosity;
 pub mod sppm;
 pub mod strategy_images;
+pub mod vcm;
 pub mod whitted;
 
 pub use bdpt::Bdpt;
@@ -167,12 +168,14 @@ pub trait MultiPassEstimator: Technique {
     /// as it runs on the session's threads. Randomness must come from
     /// (`seed`, `pass`) alone so images stay independent of the schedule.
     fn prepare(&self, scene: &Scene, pass: u32, seed: u64, counts: &mut RayCounts) -> Self::Pass;
-    /// One radiance sample along a camera ray, reading this pass's data.
+    /// One radiance sample along a camera ray through pixel `pixel`,
+    /// reading this pass's data.
     fn radiance(
         &self,
         scene: &Scene,
         pass: &Self::Pass,
         ray: Ray,
+        pixel: (u32, u32),
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb;
@@ -591,6 +594,7 @@ register_techniques! {
     multi_pass {
         Photon(photon::PhotonMap2Pass) = "photon", "Photon mapping (Jensen)";
         Sppm(sppm::PhotonMapper) = "sppm", "Progressive photon mapping";
+        Vcm(vcm::Vcm) = "vcm", "Vertex connection and merging";
     }
     solver {
         Radiosity(radiosity::Radiosity) = "radiosity", "Radiosity";

@@ -209,6 +209,7 @@ impl MultiPassEstimator for PhotonMap2Pass {
         scene: &Scene,
         maps: &Maps,
         ray: Ray,
+        _pixel: (u32, u32),
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {

@@ -41,6 +41,25 @@ pub struct PhotonPath {
     pub specular_only: bool,
 }
 
+/// What a map can hold: a point on a surface and the side of the surface
+/// it lies on (a photon, or a light subpath's vertex for vertex merging).
+pub trait Stored {
+    fn position(&self) -> Vec3A;
+    /// The surface's normal on the side the point was reached from.
+    fn facing(&self) -> Vec3A;
+}
+
+impl Stored for Photon {
+    #[inline]
+    fn position(&self) -> Vec3A {
+        self.point
+    }
+    #[inline]
+    fn facing(&self) -> Vec3A {
+        self.normal
+    }
+}
+
 /// The largest k of a k-nearest lookup.
 pub const MAX_K: usize = 256;
 
@@ -75,9 +94,9 @@ pub fn describe_photons(photons: u32) -> String {
     }
 }
 
-/// Photons in a hash grid.
-pub struct PhotonMap {
-    photons: Vec<Photon>,
+/// Photons (or other [`Stored`] points) in a hash grid.
+pub struct PhotonMap<P = Photon> {
+    photons: Vec<P>,
     /// Photon indices sorted by cell hash; `starts[h]..starts[h + 1]`
     /// are those of hash h.
     order: Vec<u32>,
@@ -87,9 +106,9 @@ pub struct PhotonMap {
     radius: f32,
 }
 
-impl PhotonMap {
+impl<P: Stored> PhotonMap<P> {
     /// A map of `photons` for lookups of radius at most `radius`.
-    pub fn build(photons: Vec<Photon>, radius: f32) -> PhotonMap {
+    pub fn build(photons: Vec<P>, radius: f32) -> PhotonMap<P> {
         let buckets = photons.len().next_power_of_two().max(1);
         let mut map = PhotonMap {
             order: vec![0; photons.len()],
@@ -100,7 +119,7 @@ impl PhotonMap {
         };
         let hashes: Vec<usize> = photons
             .iter()
-            .map(|p| map.hash(map.cell_of(p.point)))
+            .map(|p| map.hash(map.cell_of(p.position())))
             .collect();
         for &h in &hashes {
             map.starts[h + 1] += 1;
@@ -139,6 +158,11 @@ impl PhotonMap {
         self.photons.is_empty()
     }
 
+    /// What the map holds, in the order it was given.
+    pub fn items(&self) -> &[P] {
+        &self.photons
+    }
+
     /// The largest lookup radius.
     pub fn radius(&self) -> f32 {
         self.radius
@@ -147,13 +171,13 @@ impl PhotonMap {
     /// Calls `visit` with every photon within the map's radius of `point`
     /// on the side of the surface that `normal` faces.
     #[inline]
-    pub fn for_each_near(&self, point: Vec3A, normal: Vec3A, mut visit: impl FnMut(&Photon)) {
+    pub fn for_each_near(&self, point: Vec3A, normal: Vec3A, mut visit: impl FnMut(&P)) {
         self.visit_near(point, normal, |_, p| visit(p));
     }
 
     /// [`PhotonMap::for_each_near`] with each photon's index.
     #[inline]
-    fn visit_near(&self, point: Vec3A, normal: Vec3A, mut visit: impl FnMut(u32, &Photon)) {
+    fn visit_near(&self, point: Vec3A, normal: Vec3A, mut visit: impl FnMut(u32, &P)) {
         if self.photons.is_empty() {
             return;
         }
@@ -175,7 +199,7 @@ impl PhotonMap {
             seen[k as usize] = h;
             for &i in &self.order[self.starts[h] as usize..self.starts[h + 1] as usize] {
                 let p = &self.photons[i as usize];
-                if (p.point - point).length_squared() <= r2 && p.normal.dot(normal) > 0.0 {
+                if (p.position() - point).length_squared() <= r2 && p.facing().dot(normal) > 0.0 {
                     visit(i, p);
                 }
             }
@@ -196,7 +220,7 @@ impl PhotonMap {
         let k = k.clamp(1, MAX_K);
         let mut found = 0usize;
         self.visit_near(point, normal, |index, p| {
-            let d2 = (p.point - point).length_squared();
+            let d2 = (p.position() - point).length_squared();
             if found == k && d2 >= nearest[k - 1].0 {
                 return;
             }
@@ -218,7 +242,7 @@ impl PhotonMap {
     }
 
     /// The photon at `index` (from [`PhotonMap::nearest`]).
-    pub fn photon(&self, index: u32) -> &Photon {
+    pub fn photon(&self, index: u32) -> &P {
         &self.photons[index as usize]
     }
 }

@@ -123,6 +123,7 @@ impl MultiPassEstimator for PhotonMapper {
         scene: &Scene,
         iteration: &Iteration,
         ray: Ray,
+        _pixel: (u32, u32),
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {

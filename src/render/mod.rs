@@ -250,7 +250,7 @@ impl Session {
                     part,
                     parts,
                     deterministic,
-                    |s, r, p, sa, c| estimator.radiance(s, r, p, sa, c),
+                    |s, r, p, _, sa, c| estimator.radiance(s, r, p, sa, c),
                 );
                 (first + k, u64::from(k))
             }
@@ -342,7 +342,8 @@ impl Session {
         deterministic: bool,
         estimate: E,
     ) where
-        E: Fn(&Scene, Ray, PrimaryPixel<'_>, &mut Sampler, &mut RayCounts) -> Rgb + Sync,
+        E: Fn(&Scene, Ray, PrimaryPixel<'_>, (u32, u32), &mut Sampler, &mut RayCounts) -> Rgb
+            + Sync,
     {
         let scene = &*self.scene;
         let settings = &self.settings;
@@ -417,7 +418,8 @@ impl Session {
                                     camera_ray(scene, &mut ahead, x, y, deterministic, general);
                             }
                             counts.camera += 1;
-                            let mut value = estimate(scene, ray, known, &mut sampler, &mut counts);
+                            let mut value =
+                                estimate(scene, ray, known, (x, y), &mut sampler, &mut counts);
                             let (finite, is_extreme) = classify(value);
                             if !finite || is_extreme {
                                 note_flagged(flags, i as u32, s, finite);
@@ -629,7 +631,7 @@ pub fn thread_pool(threads: usize) -> Result<Arc<rayon::ThreadPool>> {
         .map_err(|e| Error::new(format!("cannot start render threads: {e}")))
 }
 
-mod splats;
+pub(crate) mod splats;
 mod technique_passes;
 
 #[cfg(test)]

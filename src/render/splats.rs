@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Per-pixel sums of light-tracing splats in 32.32 fixed point: integer
 /// additions commute, so the sums are the same in any thread order.
-pub(super) struct SplatBuffer {
+pub(crate) struct SplatBuffer {
     width: u32,
     height: u32,
     sums: Vec<[AtomicU64; 3]>,
@@ -17,7 +17,7 @@ pub(super) struct SplatBuffer {
 const SPLAT_SCALE: f64 = 4294967296.0;
 
 impl SplatBuffer {
-    pub(super) fn new(width: u32, height: u32) -> Self {
+    pub(crate) fn new(width: u32, height: u32) -> Self {
         let sums = (0..width as usize * height as usize)
             .map(|_| [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)])
             .collect();
@@ -30,7 +30,7 @@ impl SplatBuffer {
 
     /// Adds `value` to the pixel containing `film`; false (and nothing added)
     /// when the value is not finite, negative or too large to represent.
-    pub(super) fn add(&self, film: Vec2, value: Rgb) -> bool {
+    pub(crate) fn add(&self, film: Vec2, value: Rgb) -> bool {
         let (x, y) = (film.x as u32, film.y as u32);
         if x >= self.width || y >= self.height {
             return true;
@@ -43,6 +43,9 @@ impl SplatBuffer {
             }
             fixed[c] = v.round() as u64;
         }
+        if fixed == [0; 3] {
+            return true;
+        }
         let sums = &self.sums[(y * self.width + x) as usize];
         for c in 0..3 {
             sums[c].fetch_add(fixed[c], Ordering::Relaxed);
@@ -50,7 +53,7 @@ impl SplatBuffer {
         true
     }
 
-    pub(super) fn get(&self, index: u32) -> [f64; 3] {
+    pub(crate) fn get(&self, index: u32) -> [f64; 3] {
         let sums = &self.sums[index as usize];
         [0, 1, 2].map(|c| sums[c].load(Ordering::Relaxed) as f64 / SPLAT_SCALE)
     }

@@ -36,7 +36,9 @@ impl MultiPassVisitor for MultiPass<'_> {
                 0,
                 1,
                 false,
-                |scene, ray, _, sampler, c| estimator.radiance(scene, &pass, ray, sampler, c),
+                |scene, ray, _, pixel, sampler, c| {
+                    estimator.radiance(scene, &pass, ray, pixel, sampler, c)
+                },
             );
         }
         (self.first + self.k, u64::from(self.k))
@@ -96,7 +98,7 @@ impl SolverVisitor for SolverPass<'_> {
             0,
             1,
             spp == 1,
-            |scene, ray, _, sampler, c| solver.radiance(scene, typed, ray, sampler, c),
+            |scene, ray, _, _, sampler, c| solver.radiance(scene, typed, ray, sampler, c),
         );
         (first + spp, u64::from(self.k))
     }

@@ -214,21 +214,18 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                     .text("Largest radius (of the scene's diagonal)"),
             );
         }
+        IntegratorKind::Vcm => {
+            mis_heuristic(ui, &mut options.mis);
+            roulette(ui, &mut options.russian_roulette, &mut options.rr_depth);
+            merge_radius(ui, options);
+        }
         IntegratorKind::Sppm => {
             ui.add(
                 egui::Slider::new(&mut options.photons, 0..=4_000_000)
                     .logarithmic(true)
                     .text("Photons per iteration (0: one per pixel)"),
             );
-            ui.add(
-                egui::Slider::new(&mut options.photon_radius, 1e-4..=0.05)
-                    .logarithmic(true)
-                    .text("First radius (of the scene's diagonal)"),
-            );
-            ui.add(
-                egui::Slider::new(&mut options.photon_alpha, 0.05..=1.0)
-                    .text("Alpha (1: fixed radius, biased)"),
-            );
+            merge_radius(ui, options);
         }
         IntegratorKind::AmbientOcclusion => {
             let mut limited = options.ao_distance > 0.0;
@@ -519,4 +516,17 @@ fn export_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
             app.export_sheet();
         }
     });
+}
+
+/// The first merge radius and how fast it shrinks (SPPM, VCM).
+fn merge_radius(ui: &mut egui::Ui, options: &mut crate::integrator::IntegratorOptions) {
+    ui.add(
+        egui::Slider::new(&mut options.photon_radius, 1e-4..=0.05)
+            .logarithmic(true)
+            .text("First radius (of the scene's diagonal)"),
+    );
+    ui.add(
+        egui::Slider::new(&mut options.photon_alpha, 0.05..=1.0)
+            .text("Alpha (1: fixed radius, biased)"),
+    );
 }

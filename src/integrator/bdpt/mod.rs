@@ -39,6 +39,8 @@ use crate::scene::material::Bsdf;
 use glam::{Vec2, Vec3A};
 use std::cell::RefCell;
 
+mod mis;
+
 /// The deepest path bidirectional path tracing makes: subpaths live in
 /// per-thread buffers of this capacity, so that a sample allocates nothing.
 pub const MAX_BOUNCES: u32 = 32;
@@ -135,6 +137,11 @@ struct Vertex {
     delta: bool,
     /// A point light: no subpath can hit it.
     delta_light: bool,
+    /// The part of the MIS sum that depends on this subpath alone: the
+    /// heuristic's ratios p_i / p_s of the strategies that would have made
+    /// this vertex and the ones before it from the other side (see
+    /// [`Bdpt::prepare_mis`]).
+    mis_prefix: f32,
     /// The light the point lies on (light vertices and emitting surfaces),
     /// else [`NO_LIGHT`].
     light: u32,
@@ -161,6 +168,7 @@ impl Vertex {
         pdf_rev: 0.0,
         delta: false,
         delta_light: false,
+        mis_prefix: 0.0,
         light: NO_LIGHT,
         emitted: Rgb::ZERO,
         two_sided: false,
@@ -251,12 +259,26 @@ impl SplattingEstimator for Bdpt {
         counts: &mut RayCounts,
         mut splat: impl FnMut(Splat),
     ) {
+        // Every camera strategy (t > 1) lands on this sample's own pixel: one
+        // splat of their sum instead of one atomic add each (8% of the time
+        // on SmallVCM's scene went to those adds).
+        let mut own_pixel = Rgb::ZERO;
         self.trace_strategies(scene, pixel, sampler, counts, |c| {
-            splat(Splat {
-                film: c.film,
-                value: c.weighted,
-            })
+            if c.t > 1 {
+                own_pixel += c.weighted;
+            } else {
+                splat(Splat {
+                    film: c.film,
+                    value: c.weighted,
+                })
+            }
         });
+        if own_pixel != Rgb::ZERO {
+            splat(Splat {
+                film: Vec2::new(pixel.0 as f32 + 0.5, pixel.1 as f32 + 0.5),
+                value: own_pixel,
+            });
+        }
     }
 }
 
@@ -342,6 +364,7 @@ impl Bdpt {
             );
         }
 
+        self.prepare_mis(camera_path, light_path);
         let (cam, light) = (camera_path.as_slice(), light_path.as_slice());
         for t in 1..=cam.len() {
             for s in 0..=light.len() {
@@ -450,7 +473,7 @@ impl Bdpt {
             path[index - 1].pdf_rev = path[index].area_density_at(pdf_rev, &previous);
             bounces += 1;
             if self.russian_roulette && bounces > self.rr_depth {
-                let q = relative.max_element().min(0.95);
+                let q = relative.max_element().min(1.0);
                 if u_roulette >= q {
                     break;
                 }
@@ -613,72 +636,6 @@ impl Bdpt {
             qs_rev: pt.area_density_at(pdf_pt, qs),
             qs_minus_rev: qs.area_density_at(pdf_qs_reverse, &light[s - 2]),
         })
-    }
-
-    /// The MIS weight of strategy (s, t) for the path it made: the
-    /// densities next to the connection are the joined path's (from
-    /// [`Bdpt::connect`]), the rest are the subpaths' own.
-    fn mis_weight(
-        &self,
-        cam: &[Vertex],
-        light: &[Vertex],
-        s: usize,
-        t: usize,
-        joint: &Connection,
-    ) -> f32 {
-        // The connection's end points: a vertex a strategy sampled itself
-        // (the light point of s = 1, the lens of t = 1) replaces the
-        // subpath's own.
-        let qs = if s == 1 && t > 1 {
-            joint.sampled.as_ref()
-        } else if s > 0 {
-            Some(&light[s - 1])
-        } else {
-            None
-        };
-        let remap = |p: f32| if p != 0.0 { p } else { 1.0 };
-        let power = |r: f32| match self.mis {
-            MisHeuristic::Balance => r,
-            _ => r * r,
-        };
-        let mut sum = 0.0f32;
-        // Strategies with fewer camera vertices: z_i made by the light side.
-        let mut ratio = 1.0f32;
-        for i in (1..t).rev() {
-            let (rev, delta) = if i == t - 1 {
-                (joint.pt_rev, false)
-            } else if i + 2 == t {
-                (joint.pt_minus_rev, cam[i].delta)
-            } else {
-                (cam[i].pdf_rev, cam[i].delta)
-            };
-            ratio *= remap(rev) / remap(cam[i].pdf_fwd);
-            if !delta && !cam[i - 1].delta {
-                sum += power(ratio);
-            }
-        }
-        // Strategies with fewer light vertices: y_i made by the camera side.
-        let mut ratio = 1.0f32;
-        for i in (0..s).rev() {
-            let (v, rev, delta) = if i == s - 1 {
-                (qs.unwrap_or(&light[i]), joint.qs_rev, false)
-            } else if i + 2 == s {
-                (&light[i], joint.qs_minus_rev, light[i].delta)
-            } else {
-                (&light[i], light[i].pdf_rev, light[i].delta)
-            };
-            ratio *= remap(rev) / remap(v.pdf_fwd);
-            let previous_delta = if i > 0 {
-                light[i - 1].delta
-            } else {
-                v.delta_light
-            };
-            if !delta && !previous_delta {
-                sum += power(ratio);
-            }
-        }
-        let weight = 1.0 / (1.0 + sum);
-        if weight.is_finite() { weight } else { 0.0 }
     }
 }
 

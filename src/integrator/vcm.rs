@@ -1,0 +1,750 @@
+//! Vertex connection and merging (Georgiev, Křivánek, Davidovič & Slusallek
+//! 2012; Hachisuka, Pantaleoni & Jensen's unified path sampling is the same
+//! idea): bidirectional path tracing and photon mapping combined by
+//! multiple importance sampling. Every iteration:
+//!
+//! 1. traces N light subpaths (one per pixel), splats each vertex seen by
+//!    the camera (t = 1) and keeps the non-specular vertices in a hash grid;
+//! 2. traces one camera subpath per pixel; at each non-specular vertex it
+//!    samples a light (s = 1), connects to every vertex of the light subpath
+//!    of its own pixel, and merges with every light vertex within the
+//!    iteration's radius (a photon-map lookup, as in SPPM); a camera
+//!    subpath that hits a light counts too (s = 0).
+//!
+//! A merge is a connection whose last segment was not traced but accepted
+//! with probability pi r^2 p(x): its density is the connection's times
+//! eta = N pi r^2, which is how the two kinds of strategy are weighed. The
+//! weights use Georgiev et al.'s recursive quantities dVCM, dVC and dVM
+//! (their technical report, "Implementing vertex connection and merging"),
+//! kept per subpath vertex in three floats, so that a light vertex in the
+//! grid carries what its merges need without its subpath. Densities of
+//! Russian roulette are left out of the weights (they only have to sum to
+//! one), and light sampling is weighed with the area density of the light
+//! point, as in `bdpt`.
+//!
+//! The radius shrinks as in SPPM, r_i^2 = r_1^2 i^(alpha - 1), so the
+//! merges' bias goes to zero. Light and camera subpaths of an iteration see
+//! the scene at the shutter's opening, as the photon mappers do.
+
+use super::light::{importance_weight, sees_lens};
+use super::photon_map::{self, PhotonMap, Stored};
+use super::{IntegratorOptions, MisHeuristic, MultiPassEstimator, RayCounts, Technique};
+use crate::accel::NO_LIGHT;
+use crate::camera::CameraConnection;
+use crate::math::{Frame, Ray, Rgb, ray_between};
+use crate::render::splats::SplatBuffer;
+use crate::sampling::hash::hash_combine;
+use crate::sampling::{Domain, Sampler, SamplerKind};
+use crate::scene::Scene;
+use crate::scene::light::EmissionSample;
+use crate::scene::material::Bsdf;
+use glam::Vec3A;
+use rayon::prelude::*;
+use std::f32::consts::PI;
+
+/// Light subpaths per iteration at most: past it, pixels share them (a
+/// camera subpath connects to the light subpath of its pixel index modulo
+/// this), which bounds the vertices kept per iteration (~110 bytes each).
+pub const MAX_LIGHT_PATHS: u32 = 1 << 20;
+
+/// Settings of vertex connection and merging.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Vcm {
+    /// Bounces of a full path, as for path tracing.
+    pub max_depth: u32,
+    /// Roulette on both subpaths after this many bounces of each.
+    pub rr_depth: u32,
+    pub russian_roulette: bool,
+    /// How the strategies are combined (balance or power).
+    pub mis: MisHeuristic,
+    /// Merge radius of the first iteration: a fraction of the scene's
+    /// diagonal until [`Technique::for_scene`] makes it scene units.
+    pub radius: f32,
+    /// How fast the radius shrinks: r_i^2 = r_1^2 i^(alpha - 1).
+    pub alpha: f32,
+}
+
+impl Default for Vcm {
+    fn default() -> Self {
+        Vcm {
+            max_depth: 8,
+            rr_depth: 5,
+            russian_roulette: true,
+            mis: MisHeuristic::Power,
+            radius: 0.002,
+            alpha: 2.0 / 3.0,
+        }
+    }
+}
+
+impl Technique for Vcm {
+    const SUMMARY: &'static str = "Vertex connection and merging: bidirectional path tracing and \
+         progressive photon mapping in one estimator, every strategy weighted by multiple \
+         importance sampling.";
+
+    fn from_options(options: &IntegratorOptions) -> Self {
+        Vcm {
+            max_depth: options.max_depth,
+            rr_depth: options.rr_depth,
+            russian_roulette: options.russian_roulette,
+            mis: options.combining_heuristic(),
+            radius: options.photon_radius,
+            alpha: options.photon_alpha,
+        }
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "vcm (max depth {}, mis {:?}, radius {:.3e}, alpha {:.2}, rr {})",
+            self.max_depth,
+            self.mis,
+            self.radius,
+            self.alpha,
+            if self.russian_roulette {
+                format!("from {}", self.rr_depth)
+            } else {
+                "off".into()
+            }
+        )
+    }
+
+    fn for_scene(self, scene: &Scene) -> Self {
+        Vcm {
+            radius: photon_map::of_diagonal(scene, self.radius),
+            ..self
+        }
+    }
+}
+
+/// A light subpath's non-specular vertex, as merges and connections read
+/// it.
+#[derive(Clone, Copy, Debug)]
+pub struct LightVertex {
+    point: Vec3A,
+    error: Vec3A,
+    normal: Vec3A,
+    /// Unit direction towards the previous vertex (where the light came from).
+    wo: Vec3A,
+    /// The subpath's weight up to here (flux of one of N subpaths).
+    beta: Rgb,
+    material: u32,
+    /// Segments from the light to here.
+    segments: u32,
+    /// Georgiev et al.'s recursive MIS quantities at this vertex.
+    d_vcm: f32,
+    d_vc: f32,
+    d_vm: f32,
+}
+
+impl Stored for LightVertex {
+    #[inline]
+    fn position(&self) -> Vec3A {
+        self.point
+    }
+    #[inline]
+    fn facing(&self) -> Vec3A {
+        if self.normal.dot(self.wo) >= 0.0 {
+            self.normal
+        } else {
+            -self.normal
+        }
+    }
+}
+
+/// One iteration: the light subpaths' vertices (those of subpath i are
+/// `vertices[starts[i]..starts[i + 1]]`), their grid, the splats of the
+/// light vertices the camera sees, and the iteration's MIS constants.
+pub struct Iteration {
+    starts: Vec<u32>,
+    map: PhotonMap<LightVertex>,
+    light_image: SplatBuffer,
+    paths: u32,
+    radius: f32,
+    /// mis(eta) and mis(1 / eta), eta = N pi r^2.
+    vm_factor: f32,
+    vc_factor: f32,
+    time: f32,
+}
+
+/// What a subpath carries between vertices: its weight and the recursive
+/// MIS quantities.
+#[derive(Clone, Copy)]
+struct Walk {
+    beta: Rgb,
+    /// beta relative to where the subpath started, without the radiance
+    /// scaling of refraction: what roulette reads (as in `bdpt`).
+    relative: Rgb,
+    d_vcm: f32,
+    d_vc: f32,
+    d_vm: f32,
+}
+
+/// One scattering event at a surface, from the sampled BSDF.
+struct Scatter {
+    wi: Vec3A,
+    pdf: f32,
+    pdf_reverse: f32,
+    specular: bool,
+    cos: f32,
+}
+
+impl Vcm {
+    #[inline]
+    fn mis(&self, x: f32) -> f32 {
+        match self.mis {
+            MisHeuristic::Balance => x,
+            _ => x * x,
+        }
+    }
+
+    /// The radius of iteration `pass` (0, 1, ...).
+    pub fn radius_at(&self, pass: u32) -> f32 {
+        self.radius * ((pass + 1) as f32).powf((self.alpha - 1.0) * 0.5)
+    }
+
+    /// The light subpaths of an iteration: as many as pixels, at most
+    /// [`MAX_LIGHT_PATHS`].
+    pub fn light_paths(scene: &Scene) -> u32 {
+        (scene.camera.width * scene.camera.height).clamp(1, MAX_LIGHT_PATHS)
+    }
+
+    /// Arriving at a surface `dist2` away at |cos| `cos`: the quantities
+    /// turn from the previous vertex's solid angle into this one's area.
+    #[inline]
+    fn arrive(&self, walk: &mut Walk, dist2: f32, cos: f32) {
+        let c = self.mis(cos);
+        walk.d_vcm *= self.mis(dist2) / c;
+        walk.d_vc /= c;
+        walk.d_vm /= c;
+    }
+
+    /// Leaving a surface by `scatter`: the update of Georgiev et al.'s
+    /// quantities (their report, eqs. 34-38 in ratio form).
+    #[inline]
+    fn leave(&self, walk: &mut Walk, scatter: &Scatter, iteration: &Iteration) {
+        if scatter.specular {
+            walk.d_vcm = 0.0;
+            walk.d_vc *= self.mis(scatter.cos);
+            walk.d_vm *= self.mis(scatter.cos);
+        } else {
+            let g = self.mis(scatter.cos / scatter.pdf);
+            let reverse = self.mis(scatter.pdf_reverse);
+            walk.d_vc = g * (walk.d_vc * reverse + walk.d_vcm + iteration.vm_factor);
+            walk.d_vm = g * (walk.d_vm * reverse + walk.d_vcm * iteration.vc_factor + 1.0);
+            walk.d_vcm = self.mis(1.0 / scatter.pdf);
+        }
+    }
+
+    /// Samples the BSDF at `frame` for `wo` (local); roulette after
+    /// `bounces` bounces. `None` ends the subpath.
+    #[allow(clippy::too_many_arguments)]
+    fn scatter(
+        &self,
+        bsdf: Bsdf,
+        wo: Vec3A,
+        importance: bool,
+        bounces: u32,
+        walk: &mut Walk,
+        sampler: &mut Sampler,
+    ) -> Option<Scatter> {
+        let u_lobe = sampler.next_1d_for(Domain::Bsdf);
+        let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
+        let u_roulette = sampler.next_1d_for(Domain::Other);
+        let sample = bsdf.sample(wo, u_lobe, u_bsdf)?;
+        let weight = if importance {
+            importance_weight(bsdf, wo, sample.wi, sample.weight)
+        } else {
+            walk.relative /= bsdf.refraction_scale(wo, sample.wi);
+            sample.weight
+        };
+        walk.beta *= weight;
+        walk.relative *= weight;
+        if self.russian_roulette && bounces > self.rr_depth {
+            let q = walk.relative.max_element().min(1.0);
+            if u_roulette >= q {
+                return None;
+            }
+            walk.beta /= q;
+            walk.relative /= q;
+        }
+        if !(walk.beta.max_element() > 0.0) {
+            return None;
+        }
+        let (pdf, pdf_reverse) = if sample.specular {
+            (1.0, 1.0)
+        } else {
+            (sample.pdf, bsdf.pdf(sample.wi, wo))
+        };
+        Some(Scatter {
+            wi: sample.wi,
+            pdf,
+            pdf_reverse,
+            specular: sample.specular,
+            cos: sample.wi.z.abs(),
+        })
+    }
+
+    /// Traces light subpath `index`: its non-specular vertices go to
+    /// `vertices`, the camera's view of each to `light_image`.
+    #[allow(clippy::too_many_arguments)]
+    fn trace_light_path(
+        &self,
+        scene: &Scene,
+        iteration: &Iteration,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+        vertices: &mut Vec<LightVertex>,
+    ) {
+        let u_select = sampler.next_1d_for(Domain::Light);
+        let u_position = sampler.next_2d_for(Domain::Light);
+        let u_direction = sampler.next_2d_for(Domain::Light);
+        let Some(emission) = scene
+            .lights
+            .sample_emission(u_select, u_position, u_direction)
+        else {
+            return;
+        };
+        let delta_light = emission.normal == Vec3A::ZERO;
+        let cos_light = if delta_light {
+            1.0
+        } else {
+            emission.normal.dot(emission.direction).abs()
+        };
+        let emission_pdf = emission.pdf_position * emission.pdf_direction;
+        let d_vc = if delta_light {
+            0.0
+        } else {
+            self.mis(cos_light / emission_pdf)
+        };
+        let mut walk = Walk {
+            beta: emission.throughput,
+            relative: Rgb::ONE,
+            d_vcm: self.mis(1.0 / emission.pdf_direction),
+            d_vc,
+            d_vm: d_vc * iteration.vc_factor,
+        };
+        if !delta_light {
+            self.light_point_to_camera(scene, iteration, &emission, sampler, counts);
+        }
+        let mut ray = emission.ray().at_time(iteration.time);
+        counts.bounce += 1;
+        for segments in 1..=self.max_depth {
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                break;
+            };
+            let wo_world = -ray.direction;
+            let cos_in = hit.normal.dot(wo_world).abs();
+            self.arrive(&mut walk, (hit.point - ray.origin).length_squared(), cos_in);
+            let material = &scene.materials[hit.material as usize];
+            let bsdf = material.bsdf;
+            if bsdf.is_black() {
+                break;
+            }
+            if !bsdf.is_specular() {
+                let vertex = LightVertex {
+                    point: hit.point,
+                    error: hit.error,
+                    normal: hit.normal,
+                    wo: wo_world,
+                    beta: walk.beta,
+                    material: hit.material,
+                    segments,
+                    d_vcm: walk.d_vcm,
+                    d_vc: walk.d_vc,
+                    d_vm: walk.d_vm,
+                };
+                self.connect_to_camera(scene, iteration, &vertex, sampler, counts);
+                vertices.push(vertex);
+            }
+            if segments == self.max_depth {
+                break;
+            }
+            let frame = Frame::from_normal(hit.normal);
+            let Some(scatter) = self.scatter(
+                bsdf,
+                frame.to_local(wo_world),
+                true,
+                segments,
+                &mut walk,
+                sampler,
+            ) else {
+                break;
+            };
+            self.leave(&mut walk, &scatter, iteration);
+            ray = hit.spawn_ray(frame.to_world(scatter.wi));
+            counts.bounce += 1;
+        }
+    }
+
+    /// s = 1, t = 1: the light point itself seen through the lens, weighed
+    /// against camera rays that hit it (the splats spread an emitter's
+    /// edge over the pixels it covers, where camera rays alone are noisy).
+    fn light_point_to_camera(
+        &self,
+        scene: &Scene,
+        iteration: &Iteration,
+        emission: &EmissionSample,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) {
+        let u_lens = sampler.next_2d_for(Domain::Lens);
+        let Some(c) = scene.camera.connect(emission.point, u_lens) else {
+            return;
+        };
+        let cos = emission.normal.dot(c.wi).abs();
+        let value = emission.emitted_towards(c.wi) * (cos * c.weight / emission.pdf_position);
+        if !(value.max_element() > 0.0) {
+            return;
+        }
+        let w_camera = self.mis(
+            self.camera_density(scene, iteration, &c, emission.point, cos) / emission.pdf_position,
+        );
+        if !sees_lens(
+            scene,
+            emission.point,
+            emission.error,
+            emission.normal,
+            &c,
+            iteration.time,
+            counts,
+        ) {
+            return;
+        }
+        iteration.light_image.add(c.film, value / (1.0 + w_camera));
+    }
+
+    /// The density (area, at `point`) of the camera's rays reaching it, per
+    /// light subpath: the film-wide density times pixels / N (pbrt's and
+    /// SmallVCM's t = 1 weight).
+    fn camera_density(
+        &self,
+        scene: &Scene,
+        iteration: &Iteration,
+        c: &CameraConnection,
+        point: Vec3A,
+        cos: f32,
+    ) -> f32 {
+        let dist2 = (c.lens_point - point).length_squared();
+        let pixels = (scene.camera.width * scene.camera.height) as f32;
+        scene.camera.pdf_direction(-c.wi) * cos / dist2 * pixels / iteration.paths as f32
+    }
+
+    /// t = 1: the light vertex seen through the lens, splatted where it
+    /// lands.
+    fn connect_to_camera(
+        &self,
+        scene: &Scene,
+        iteration: &Iteration,
+        v: &LightVertex,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) {
+        let u_lens = sampler.next_2d_for(Domain::Lens);
+        let Some(c) = scene.camera.connect(v.point, u_lens) else {
+            return;
+        };
+        let bsdf = scene.materials[v.material as usize].bsdf;
+        let frame = Frame::from_normal(v.normal);
+        let (f, _, pdf_reverse) = bsdf.eval_with_pdfs(frame.to_local(v.wo), frame.to_local(c.wi));
+        let cos = v.normal.dot(c.wi).abs();
+        let value = v.beta * f * (cos * c.weight);
+        if !(value.max_element() > 0.0) {
+            return;
+        }
+        let camera_pdf = self.camera_density(scene, iteration, &c, v.point, cos);
+        let w_light =
+            self.mis(camera_pdf) * (iteration.vm_factor + v.d_vcm + v.d_vc * self.mis(pdf_reverse));
+        let weight = 1.0 / (1.0 + w_light);
+        if !sees_lens(
+            scene,
+            v.point,
+            v.error,
+            v.normal,
+            &c,
+            iteration.time,
+            counts,
+        ) {
+            return;
+        }
+        // A non-finite splat is dropped by the buffer: the film stays clean.
+        iteration.light_image.add(c.film, value * weight);
+    }
+}
+
+impl MultiPassEstimator for Vcm {
+    type Pass = Iteration;
+
+    fn prepare(&self, scene: &Scene, pass: u32, seed: u64, counts: &mut RayCounts) -> Iteration {
+        let paths = Self::light_paths(scene);
+        let radius = self.radius_at(pass);
+        let eta = paths as f32 * PI * radius * radius;
+        let mut iteration = Iteration {
+            starts: Vec::new(),
+            map: PhotonMap::build(Vec::new(), radius),
+            light_image: SplatBuffer::new(scene.camera.width, scene.camera.height),
+            paths,
+            radius,
+            vm_factor: self.mis(eta),
+            vc_factor: self.mis(1.0 / eta),
+            time: scene.camera.shutter_open,
+        };
+        const CHUNK: u32 = 4096;
+        let key = hash_combine(hash_combine(seed, u64::from(pass)), 0x56_434d);
+        let chunks: Vec<(Vec<LightVertex>, Vec<u32>, RayCounts)> = (0..paths.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|chunk| {
+                let mut sampler = Sampler::new(SamplerKind::Independent, key, 0);
+                let mut vertices = Vec::new();
+                let mut ends = Vec::new();
+                let mut rays = RayCounts::default();
+                for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(paths) {
+                    sampler.start(index, 0);
+                    self.trace_light_path(
+                        scene,
+                        &iteration,
+                        &mut sampler,
+                        &mut rays,
+                        &mut vertices,
+                    );
+                    ends.push(vertices.len() as u32);
+                }
+                (vertices, ends, rays)
+            })
+            .collect();
+        let mut vertices = Vec::new();
+        let mut starts = Vec::with_capacity(paths as usize + 1);
+        starts.push(0);
+        for (chunk, ends, rays) in chunks {
+            let offset = vertices.len() as u32;
+            starts.extend(ends.iter().map(|e| e + offset));
+            vertices.extend(chunk);
+            counts.bounce += rays.bounce;
+            counts.shadow += rays.shadow;
+        }
+        iteration.starts = starts;
+        iteration.map = PhotonMap::build(vertices, radius);
+        iteration
+    }
+
+    fn radiance(
+        &self,
+        scene: &Scene,
+        iteration: &Iteration,
+        ray: Ray,
+        (x, y): (u32, u32),
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
+        let camera = &scene.camera;
+        let pixel = y * camera.width + x;
+        let splatted = Rgb::from_array(
+            iteration
+                .light_image
+                .get(pixel)
+                .map(|v| (v / f64::from(iteration.paths)) as f32),
+        );
+        let subpath = pixel % iteration.paths;
+        let light_path = iteration.starts[subpath as usize] as usize
+            ..iteration.starts[subpath as usize + 1] as usize;
+        let mut ray = ray.at_time(iteration.time);
+        let pixels = (camera.width * camera.height) as f32;
+        let camera_pdf = camera.pdf_direction(ray.direction) * pixels;
+        let mut walk = Walk {
+            beta: Rgb::ONE,
+            relative: Rgb::ONE,
+            d_vcm: self.mis(iteration.paths as f32 / camera_pdf),
+            d_vc: 0.0,
+            d_vm: 0.0,
+        };
+        let normalisation =
+            1.0 / (PI * iteration.radius * iteration.radius * iteration.paths as f32);
+        let mut radiance = Rgb::ZERO;
+        for segments in 1..=self.max_depth + 1 {
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                break;
+            };
+            let wo_world = -ray.direction;
+            let cos_in = hit.normal.dot(wo_world).abs();
+            self.arrive(&mut walk, (hit.point - ray.origin).length_squared(), cos_in);
+            let material = &scene.materials[hit.material as usize];
+            if hit.light != NO_LIGHT {
+                let emitted = material.emitted(hit.normal, wo_world);
+                if emitted.max_element() > 0.0 {
+                    // Against light sampling and every longer light subpath;
+                    // seen directly, against the light point's splat.
+                    let (pdf_position, pdf_direction) =
+                        scene.lights.emission_pdf(hit.light, hit.normal, wo_world);
+                    let w_camera = self.mis(pdf_position) * walk.d_vcm
+                        + self.mis(pdf_position * pdf_direction) * walk.d_vc;
+                    let weight = 1.0 / (1.0 + w_camera);
+                    radiance += walk.beta * emitted * weight;
+                }
+            }
+            let bsdf = material.bsdf;
+            if bsdf.is_black() || segments > self.max_depth {
+                break;
+            }
+            let frame = Frame::from_normal(hit.normal);
+            let wo = frame.to_local(wo_world);
+            let at = CameraVertex {
+                point: hit.point,
+                error: hit.error,
+                normal: hit.normal,
+                frame,
+                wo,
+                bsdf,
+                segments,
+            };
+            if !bsdf.is_specular() {
+                radiance +=
+                    walk.beta * self.light_sample(scene, iteration, &at, &walk, sampler, counts);
+                for light in &iteration.map.items()[light_path.clone()] {
+                    if light.segments + segments <= self.max_depth {
+                        radiance +=
+                            walk.beta * self.connect(scene, iteration, &at, &walk, light, counts);
+                    }
+                }
+                let merged = self.merge(iteration, &at, &walk);
+                radiance += walk.beta * merged * normalisation;
+            }
+            let Some(scatter) = self.scatter(bsdf, wo, false, segments, &mut walk, sampler) else {
+                break;
+            };
+            self.leave(&mut walk, &scatter, iteration);
+            ray = hit.spawn_ray(frame.to_world(scatter.wi));
+            counts.bounce += 1;
+        }
+        radiance + splatted
+    }
+}
+
+/// A camera subpath's vertex where it connects and merges.
+struct CameraVertex {
+    point: Vec3A,
+    error: Vec3A,
+    normal: Vec3A,
+    frame: Frame,
+    wo: Vec3A,
+    bsdf: Bsdf,
+    segments: u32,
+}
+
+impl Vcm {
+    /// s = 1: a point sampled on a light, weighed against hitting it (s = 0)
+    /// and against every strategy with more light vertices.
+    fn light_sample(
+        &self,
+        scene: &Scene,
+        iteration: &Iteration,
+        at: &CameraVertex,
+        walk: &Walk,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
+        let u_select = sampler.next_1d_for(Domain::Light);
+        let u_light = sampler.next_2d_for(Domain::Light);
+        let Some(ls) = scene.lights.sample(at.point, u_select, u_light) else {
+            return Rgb::ZERO;
+        };
+        let (f, pdf, pdf_reverse) = at.bsdf.eval_with_pdfs(at.wo, at.frame.to_local(ls.wi));
+        let cos = at.normal.dot(ls.wi).abs();
+        let value = f * ls.radiance * (cos / ls.pdf);
+        if !(value.max_element() > 0.0) {
+            return Rgb::ZERO;
+        }
+        let dist2 = ls.distance * ls.distance;
+        let (pdf_position, pdf_emission) = scene.lights.emission_pdf(ls.light, ls.normal, -ls.wi);
+        let w_light = if ls.delta {
+            0.0
+        } else {
+            let cos_light = ls.normal.dot(ls.wi).abs();
+            self.mis(pdf * cos_light / (dist2 * pdf_position))
+        };
+        let w_camera = self.mis(pdf_emission * cos / dist2)
+            * (iteration.vm_factor + walk.d_vcm + walk.d_vc * self.mis(pdf_reverse));
+        counts.shadow += 1;
+        let shadow = ray_between(at.point, at.error, at.normal, ls.point, ls.error, ls.normal)
+            .at_time(iteration.time);
+        if scene.geometry.occluded(&shadow) {
+            return Rgb::ZERO;
+        }
+        value / (1.0 + w_light + w_camera)
+    }
+
+    /// s >= 2, t >= 2: a shadow ray from the camera vertex to a vertex of
+    /// its pixel's light subpath.
+    fn connect(
+        &self,
+        scene: &Scene,
+        iteration: &Iteration,
+        at: &CameraVertex,
+        walk: &Walk,
+        light: &LightVertex,
+        counts: &mut RayCounts,
+    ) -> Rgb {
+        let d = light.point - at.point;
+        let dist2 = d.length_squared();
+        if !(dist2 > 0.0) {
+            return Rgb::ZERO;
+        }
+        let w = d / dist2.sqrt();
+        let (f_camera, pdf_camera, pdf_camera_reverse) =
+            at.bsdf.eval_with_pdfs(at.wo, at.frame.to_local(w));
+        let light_bsdf = scene.materials[light.material as usize].bsdf;
+        let light_frame = Frame::from_normal(light.normal);
+        let (f_light, pdf_light, pdf_light_reverse) =
+            light_bsdf.eval_with_pdfs(light_frame.to_local(light.wo), light_frame.to_local(-w));
+        let (cos_camera, cos_light) = (at.normal.dot(w).abs(), light.normal.dot(w).abs());
+        let value = f_camera * f_light * light.beta * (cos_camera * cos_light / dist2);
+        if !(value.max_element() > 0.0) {
+            return Rgb::ZERO;
+        }
+        // Densities (area) of each end sampled from the other.
+        let camera_to_light = pdf_camera * cos_light / dist2;
+        let light_to_camera = pdf_light * cos_camera / dist2;
+        let w_light = self.mis(camera_to_light)
+            * (iteration.vm_factor + light.d_vcm + light.d_vc * self.mis(pdf_light_reverse));
+        let w_camera = self.mis(light_to_camera)
+            * (iteration.vm_factor + walk.d_vcm + walk.d_vc * self.mis(pdf_camera_reverse));
+        counts.shadow += 1;
+        let shadow = ray_between(
+            at.point,
+            at.error,
+            at.normal,
+            light.point,
+            light.error,
+            light.normal,
+        )
+        .at_time(iteration.time);
+        if scene.geometry.occluded(&shadow) {
+            return Rgb::ZERO;
+        }
+        value / (1.0 + w_light + w_camera)
+    }
+
+    /// Merges: every light vertex within the radius on the same side, its
+    /// flux reflected by the camera vertex's BSDF, each weighed against the
+    /// connections that could have made its path (not yet divided by
+    /// pi r^2 N).
+    fn merge(&self, iteration: &Iteration, at: &CameraVertex, walk: &Walk) -> Rgb {
+        let facing = if at.normal.dot(at.frame.to_world(at.wo)) >= 0.0 {
+            at.normal
+        } else {
+            -at.normal
+        };
+        let mut sum = Rgb::ZERO;
+        iteration.map.for_each_near(at.point, facing, |light| {
+            if light.segments + at.segments > self.max_depth + 1 {
+                return;
+            }
+            let (f, pdf, pdf_reverse) = at.bsdf.eval_with_pdfs(at.wo, at.frame.to_local(light.wo));
+            if !(f.max_element() > 0.0) {
+                return;
+            }
+            let w_light = light.d_vcm * iteration.vc_factor + light.d_vm * self.mis(pdf);
+            let w_camera = walk.d_vcm * iteration.vc_factor + walk.d_vm * self.mis(pdf_reverse);
+            sum += f * light.beta / (1.0 + w_light + w_camera);
+        });
+        sum
+    }
+}
