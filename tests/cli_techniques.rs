@@ -153,6 +153,37 @@ fn bidirectional_and_photon_settings_are_checked() {
         1,
         &["--radius 0 is not a fraction"],
     );
+    assert_fails(
+        &tracelab(&[
+            "render",
+            s,
+            "--integrator",
+            "vcm",
+            "--alpha",
+            "0",
+            "--out",
+            "x.exr",
+        ]),
+        1,
+        &["--alpha 0 is not in (0, 1]"],
+    );
+    let vcm = dir.join("vcm.exr");
+    let o = tracelab(&[
+        "render",
+        s,
+        "--integrator",
+        "vcm",
+        "--spp",
+        "2",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--out",
+        vcm.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(vcm.is_file());
     // The pyramid: every strategy of up to 2 bounces and the sheets.
     let o = tracelab(&[
         "render",

@@ -412,4 +412,25 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
     assert_eq!(options.photon_alpha, 1.0);
     step_until(&mut harness, "2 iterations of photon mapping", finished);
     assert!(harness.state().app.frame().views[0].stats.spp >= 2);
+
+    // VCM: the heuristic, roulette and the merge radius.
+    click(&mut harness, "Vertex connection and merging");
+    click(&mut harness, "Power");
+    harness
+        .get_by_role_and_label(
+            egui::accesskit::Role::Slider,
+            "First radius (of the scene's diagonal)",
+        )
+        .set_value_accesskit(0.01);
+    harness.run_steps(2);
+    let options = harness.state().app.settings.a.integrator;
+    assert_eq!(options.kind, IntegratorKind::Vcm);
+    assert_eq!(options.mis, tracelab::integrator::MisHeuristic::Power);
+    assert!(
+        (options.photon_radius - 0.01).abs() < 1e-6,
+        "{}",
+        options.photon_radius
+    );
+    step_until(&mut harness, "2 iterations of VCM", finished);
+    assert!(harness.state().app.frame().views[0].stats.spp >= 2);
 }

@@ -1,13 +1,15 @@
 //! Photons and the map that finds them, shared by the photon mappers
-//! (`photon.rs`, Jensen's two-pass method; `sppm.rs`, progressive).
+//! (`photon.rs`, Jensen's two-pass method; `sppm.rs`, progressive) and by
+//! vertex connection and merging (`vcm.rs`, for its light vertices).
 //!
 //! Photons are found through a hash grid of cells of side 2R built once per
 //! map (a counting sort of photon indices by cell), R the largest radius a
 //! lookup may use: a query sphere then touches at most 2 x 2 x 2 cells.
 //! Every lookup of an iteration has the same largest radius and the map is
 //! rebuilt every iteration, so a k-d tree's balancing and general
-//! nearest-neighbour machinery (kiddo, rstar) buy nothing here; SmallVCM's
-//! hash grid works the same way.
+//! nearest-neighbour machinery buy nothing here; SmallVCM's hash grid works
+//! the same way. Against kiddo's k-d tree (`benches/photon_lookup.rs`) the
+//! grid builds 7x faster and answers lookups 1.3-2x faster.
 
 use super::RayCounts;
 use super::light::importance_weight;

@@ -42,7 +42,15 @@ impl MultiPassEstimator for PassNumber {
         counts.bounce += 10;
         pass as f32
     }
-    fn radiance(&self, _: &Scene, pass: &f32, _: Ray, _: &mut Sampler, _: &mut RayCounts) -> Rgb {
+    fn radiance(
+        &self,
+        _: &Scene,
+        pass: &f32,
+        _: Ray,
+        _: (u32, u32),
+        _: &mut Sampler,
+        _: &mut RayCounts,
+    ) -> Rgb {
         Rgb::splat(*pass)
     }
 }
