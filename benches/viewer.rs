@@ -4,7 +4,7 @@
 //! of an equal-time comparison, memory over a long session, and UI frame
 //! times in the MC lab tab while its experiments run
 //! (`TRACELAB_BENCH_ONLY=lab` measures only those;
-//! `TRACELAB_BENCH_ONLY=transport` only BDPT's and photon mapping's frames;
+//! `TRACELAB_BENCH_ONLY=transport` only BDPT's, photon mapping's and VCM's frames;
 //! `TRACELAB_BENCH_ONLY=radiosity` only radiosity's, while it solves).
 //!
 //! `cargo bench --bench viewer` (TRACELAB_SOAK_SECONDS=600 for the 10-minute
@@ -88,7 +88,7 @@ fn lab_frames(h: &mut Harness<'static, Window>) {
 /// UI frame times while bidirectional path tracing and photon mapping
 /// render (their passes splat or build a photon map over the whole film).
 fn transport_frames(h: &mut Harness<'static, Window>) {
-    for kind in [IntegratorKind::Bdpt, IntegratorKind::Sppm] {
+    for kind in [IntegratorKind::Bdpt, IntegratorKind::Sppm, IntegratorKind::Vcm] {
         h.state_mut().app.settings.a.integrator.kind = kind;
         let mut frames = Vec::new();
         let until = Instant::now() + Duration::from_secs(8);
