@@ -88,7 +88,11 @@ fn lab_frames(h: &mut Harness<'static, Window>) {
 /// UI frame times while bidirectional path tracing and photon mapping
 /// render (their passes splat or build a photon map over the whole film).
 fn transport_frames(h: &mut Harness<'static, Window>) {
-    for kind in [IntegratorKind::Bdpt, IntegratorKind::Sppm, IntegratorKind::Vcm] {
+    for kind in [
+        IntegratorKind::Bdpt,
+        IntegratorKind::Sppm,
+        IntegratorKind::Vcm,
+    ] {
         h.state_mut().app.settings.a.integrator.kind = kind;
         let mut frames = Vec::new();
         let until = Instant::now() + Duration::from_secs(8);

@@ -75,24 +75,26 @@ fn form_factors_between_squares_match_closed_forms() {
         let f = square_to_square(a, b, FormFactorMethod::Analytic, 1024);
         eprintln!("{name}: analytic {f:.6} (exact {exact})");
         assert!((f - exact).abs() < 1e-4, "{name}: {f} vs {exact}");
-        // Point pairs: the error falls with n (printed). At 4096 pairs it is
-        // within 2e-3 for the parallel squares (about 4 standard errors of
-        // the kernel's spread); the perpendicular squares' kernel is singular
-        // along their shared edge (1/r² with r -> 0), its variance barely
-        // finite, and the error there is only within 1e-2.
+        // Point pairs, the second point by solid angle with the cosine warped
+        // in: the error falls with n (printed). At the default 16 pairs the
+        // unit squares are within 3e-4 (the shared edge's singular kernel no
+        // longer matters), the 2x2 squares, where the bilinear cosine is
+        // cruder, within 1.5e-3 (measured 1.43e-3: the 1e-3 goal is missed
+        // there); at 1 024 pairs all three are within 1e-3 (largest 4.7e-4).
         let mut errors = Vec::new();
-        for n in [64, 256, 1024, 4096] {
+        for n in [16, 64, 256, 1024, 4096] {
             let f = square_to_square(a, b, FormFactorMethod::RayCast, n);
             errors.push((n as f64, (f - exact).abs().max(1e-9)));
         }
         let slope = tracelab::lab::stats::log_log_slope(&errors);
         eprintln!("{name}: ray cast errors {errors:?}, slope {slope:.2}");
-        let tolerance = if name.starts_with("perpendicular") {
-            1e-2
+        let at_default = if name.starts_with("parallel 2x2") {
+            1.5e-3
         } else {
-            2e-3
+            3e-4
         };
-        assert!(errors[3].1 < tolerance, "{name}: {errors:?}");
+        assert!(errors[0].1 < at_default, "{name} at 16 pairs: {errors:?}");
+        assert!(errors[3].1 < 1e-3, "{name} at 1024 pairs: {errors:?}");
     }
 }
 

@@ -1,8 +1,15 @@
 //! Form factors between elements. F_ij = (1/A_i) ∫_i ∫_j cos θ_i cos θ_j
 //! V / (π r²) dA_j dA_i, estimated two ways:
 //!
-//! - **ray casting**: n pairs of points (x on i, y on j), the point-to-point
-//!   kernel times the visibility of the segment, times A_j;
+//! - **ray casting**: n pairs of points (x on i, y on j) joined by a shadow
+//!   ray. y is sampled uniformly in the solid angle Ω that j subtends from x
+//!   (Arvo's spherical triangles, as light sampling does), so a pair
+//!   estimates Ω cos θ_i / π times its visibility: the point-to-point kernel
+//!   cos θ_i cos θ_j / (π r²) divided by y's density cos θ_j / (Ω r²). With
+//!   y by area instead (where j is too small or too large in solid angle
+//!   for the spherical construction) the kernel's 1/r² makes the variance
+//!   barely finite for elements that share an edge: 5e-3 error at 4 096
+//!   pairs on perpendicular unit squares, against 1e-4 by solid angle;
 //! - **analytic**: n points x on i, the unoccluded point-to-polygon form
 //!   factor of j from x by Lambert's contour integral, times the visibility
 //!   of one point of j.
@@ -14,7 +21,8 @@
 use super::mesh::Element;
 use crate::accel::Geometry;
 use crate::math::{gamma, ray_between};
-use crate::sampling::warp::square_to_uniform_triangle;
+use crate::sampling::spherical_triangle;
+use crate::sampling::warp::{self, square_to_uniform_triangle};
 use crate::sampling::{Sampler, SamplerKind};
 use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
@@ -80,6 +88,40 @@ fn point_on(element: &Element, u: Vec2) -> (Vec3A, Vec3A) {
     (a + e1 + e2, gamma(7) * (a.abs() + e1.abs() + e2.abs()))
 }
 
+/// A direction from `x` towards `j`, nearly proportional to the cosine at x
+/// (`i_normal`) within the solid angle j subtends, 1 / its density (the
+/// solid angle where the sampling is uniform), and the point of `j` the
+/// direction reaches with its error bound;
+/// `None` where the spherical construction is inaccurate (tiny or nearly
+/// surrounding solid angles) or the direction misses j's plane.
+#[inline]
+fn toward(x: Vec3A, i_normal: Vec3A, j: &Element, u: Vec2) -> Option<(Vec3A, f32, Vec3A, Vec3A)> {
+    let solid_angle = spherical_triangle::solid_angle(x, j.vertices);
+    if !spherical_triangle::usable(solid_angle) {
+        return None;
+    }
+    // The cosine at x warped in by a bilinear approximation over the
+    // sample square, whose corners map to the triangle's vertices (pbrt-v4's
+    // light sampling): what remains to estimate is nearly constant.
+    let [a, b, c] = j
+        .vertices
+        .map(|v| i_normal.dot((v - x).normalize_or_zero()).max(0.01));
+    let corners = [b, b, a, c];
+    let warped = warp::square_to_bilinear(u, corners);
+    let (w, _) = spherical_triangle::sample(x, j.vertices, warped)?;
+    let bilinear = warp::square_to_bilinear_pdf(warped, corners);
+    let denominator = j.normal.dot(w);
+    let t = j.normal.dot(j.vertices[0] - x) / denominator;
+    if !(t > 0.0 && t.is_finite()) {
+        return None;
+    }
+    let y = x + t * w;
+    // A ray-plane intersection: a few roundings of x, t w and the plane's
+    // offset.
+    let error = gamma(12) * (x.abs() + (t * w).abs() + j.vertices[0].abs());
+    Some((w, solid_angle / bilinear, y, error))
+}
+
 /// Whether `j` lies entirely behind `i`'s plane or `i` behind `j`'s (then
 /// F_ij = 0), measured relative to the elements' sizes.
 pub fn faces(i: &Element, j: &Element) -> bool {
@@ -111,24 +153,37 @@ pub fn element_to_element(
     }
     let mut on_i = Sampler::new(SamplerKind::Stratified, 0x5eed, n);
     let mut on_j = Sampler::new(SamplerKind::Stratified, 0x5eed_0001, n);
-    let mut sum = 0.0f32;
+    let mut sum = 0.0f64;
     let mut rays = 0;
     for k in 0..n {
         on_i.start(key_i, k);
         on_j.start(key_pair, k);
         let (x, x_error) = point_on(i, on_i.next_2d());
-        let (y, y_error) = point_on(j, on_j.next_2d());
-        let d = y - x;
-        let r2 = d.length_squared();
-        let value = match method {
-            FormFactorMethod::RayCast => {
-                let (cos_i, cos_j) = (i.normal.dot(d), -j.normal.dot(d));
-                if cos_i <= 0.0 || cos_j <= 0.0 || r2 == 0.0 {
-                    continue;
+        let u_j = on_j.next_2d();
+        let (value, y, y_error) = match method {
+            FormFactorMethod::RayCast => match toward(x, i.normal, j, u_j) {
+                Some((w, solid_angle, y, y_error)) => {
+                    let cos_i = i.normal.dot(w);
+                    if cos_i <= 0.0 || j.normal.dot(w) >= 0.0 {
+                        continue;
+                    }
+                    (solid_angle * cos_i / PI, y, y_error)
                 }
-                cos_i * cos_j / (PI * r2 * r2) * j.area
+                None => {
+                    let (y, y_error) = point_on(j, u_j);
+                    let d = y - x;
+                    let r2 = d.length_squared();
+                    let (cos_i, cos_j) = (i.normal.dot(d), -j.normal.dot(d));
+                    if cos_i <= 0.0 || cos_j <= 0.0 || r2 == 0.0 {
+                        continue;
+                    }
+                    (cos_i * cos_j / (PI * r2 * r2) * j.area, y, y_error)
+                }
+            },
+            FormFactorMethod::Analytic => {
+                let (y, y_error) = point_on(j, u_j);
+                (point_to_polygon(x, i.normal, &j.vertices), y, y_error)
             }
-            FormFactorMethod::Analytic => point_to_polygon(x, i.normal, &j.vertices),
         };
         if value == 0.0 {
             continue;
@@ -136,10 +191,10 @@ pub fn element_to_element(
         rays += 1;
         let ray = ray_between(x, x_error, i.normal, y, y_error, j.normal);
         if !geometry.occluded(&ray) {
-            sum += value;
+            sum += f64::from(value);
         }
     }
-    (sum / n as f32, rays)
+    ((sum / f64::from(n)) as f32, rays)
 }
 
 #[cfg(test)]

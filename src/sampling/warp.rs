@@ -140,3 +140,40 @@ mod tests {
         }
     }
 }
+
+/// A sample of the density on [0, 1] proportional to the line from `a` at 0
+/// to `b` at 1 (a, b >= 0, not both 0), by inverting its cumulative
+/// distribution (pbrt-v4's `SampleLinear`).
+#[inline]
+pub fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
+    if u == 0.0 && a == 0.0 {
+        return 0.0;
+    }
+    let x = u * (a + b) / (a + (a * a + u * (b * b - a * a)).max(0.0).sqrt());
+    x.min(1.0 - f32::EPSILON / 2.0)
+}
+
+/// A point of the unit square with density proportional to the bilinear
+/// interpolation of the corner values `w` = [w(0, 0), w(1, 0), w(0, 1),
+/// w(1, 1)], all >= 0 (pbrt-v4's `SampleBilinear`): y from the marginal,
+/// then x given y.
+#[inline]
+pub fn square_to_bilinear(u: Vec2, w: [f32; 4]) -> Vec2 {
+    let y = sample_linear(u.y, w[0] + w[1], w[2] + w[3]);
+    let x = sample_linear(u.x, w[0] + (w[2] - w[0]) * y, w[1] + (w[3] - w[1]) * y);
+    Vec2::new(x, y)
+}
+
+/// The density of [`square_to_bilinear`] at `p`.
+#[inline]
+pub fn square_to_bilinear_pdf(p: Vec2, w: [f32; 4]) -> f32 {
+    let sum = w[0] + w[1] + w[2] + w[3];
+    if sum == 0.0 {
+        return 1.0;
+    }
+    4.0 * ((1.0 - p.x) * (1.0 - p.y) * w[0]
+        + p.x * (1.0 - p.y) * w[1]
+        + (1.0 - p.x) * p.y * w[2]
+        + p.x * p.y * w[3])
+        / sum
+}
