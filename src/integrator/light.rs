@@ -21,6 +21,7 @@ use crate::camera::CameraConnection;
 use crate::math::{Frame, Rgb, ray_between};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
+use crate::scene::light::EmissionSample;
 use crate::scene::material::Bsdf;
 use glam::{Vec2, Vec3A};
 
@@ -86,15 +87,10 @@ impl SplattingEstimator for LightTracer {
         counts: &mut RayCounts,
         mut splat: impl FnMut(Splat),
     ) {
-        let u_select = sampler.next_1d_for(Domain::Light);
-        let u_position = sampler.next_2d_for(Domain::Light);
-        let u_direction = sampler.next_2d_for(Domain::Light);
+        let emission = sample_particle(scene, sampler);
         let u_lens = sampler.next_2d_for(Domain::Lens);
         let time = super::sample_time(scene, sampler, false);
-        let Some(emission) = scene
-            .lights
-            .sample_emission(u_select, u_position, u_direction)
-        else {
+        let Some(emission) = emission else {
             return;
         };
         let camera = &scene.camera;
@@ -203,6 +199,20 @@ pub(super) fn sees_lens(
     )
     .at_time(time);
     !scene.geometry.occluded(&ray)
+}
+
+/// A particle's start: a light, a point on it and a direction, from three
+/// dimensions of the sampler's light domain, which every particle tracer
+/// (light tracing, BDPT's light subpaths, photons, VCM) draws first and in
+/// this order.
+#[inline]
+pub(super) fn sample_particle(scene: &Scene, sampler: &mut Sampler) -> Option<EmissionSample> {
+    let u_select = sampler.next_1d_for(Domain::Light);
+    let u_position = sampler.next_2d_for(Domain::Light);
+    let u_direction = sampler.next_2d_for(Domain::Light);
+    scene
+        .lights
+        .sample_emission(u_select, u_position, u_direction)
 }
 
 /// The sample weight f cos / p in importance transport: as for radiance,

@@ -310,13 +310,7 @@ fn trace_photon(
     counts: &mut RayCounts,
     mut store: impl FnMut(Photon, PhotonPath),
 ) {
-    let u_select = sampler.next_1d_for(Domain::Light);
-    let u_position = sampler.next_2d_for(Domain::Light);
-    let u_direction = sampler.next_2d_for(Domain::Light);
-    let Some(emission) = scene
-        .lights
-        .sample_emission(u_select, u_position, u_direction)
-    else {
+    let Some(emission) = super::light::sample_particle(scene, sampler) else {
         return;
     };
     let roulette_scale = 1.0 / emission.throughput.max_element();

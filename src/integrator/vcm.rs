@@ -26,7 +26,7 @@
 //! merges' bias goes to zero. Light and camera subpaths of an iteration see
 //! the scene at the shutter's opening, as the photon mappers do.
 
-use super::light::{importance_weight, sees_lens};
+use super::light::{importance_weight, sample_particle, sees_lens};
 use super::photon_map::{self, PhotonMap, Stored};
 use super::{IntegratorOptions, MisHeuristic, MultiPassEstimator, RayCounts, Technique};
 use crate::accel::NO_LIGHT;
@@ -295,13 +295,7 @@ impl Vcm {
         counts: &mut RayCounts,
         vertices: &mut Vec<LightVertex>,
     ) {
-        let u_select = sampler.next_1d_for(Domain::Light);
-        let u_position = sampler.next_2d_for(Domain::Light);
-        let u_direction = sampler.next_2d_for(Domain::Light);
-        let Some(emission) = scene
-            .lights
-            .sample_emission(u_select, u_position, u_direction)
-        else {
+        let Some(emission) = sample_particle(scene, sampler) else {
             return;
         };
         let delta_light = emission.normal == Vec3A::ZERO;

@@ -29,7 +29,7 @@
 //! splatting pass, which divides by N: a camera strategy's estimate for its
 //! own pixel is multiplied by W H.
 
-use super::light::{importance_weight, sees_lens};
+use super::light::{importance_weight, sample_particle, sees_lens};
 use super::{IntegratorOptions, MisHeuristic, RayCounts, Splat, SplattingEstimator, Technique};
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, ray_between};
@@ -327,14 +327,9 @@ impl Bdpt {
             camera_path,
         );
 
-        let u_select = sampler.next_1d_for(Domain::Light);
-        let u_position = sampler.next_2d_for(Domain::Light);
-        let u_direction = sampler.next_2d_for(Domain::Light);
+        let emission = sample_particle(scene, sampler);
         let u_lens = sampler.next_2d_for(Domain::Lens);
-        if let Some(emission) = scene
-            .lights
-            .sample_emission(u_select, u_position, u_direction)
-        {
+        if let Some(emission) = emission {
             light_path.push(Vertex {
                 kind: Kind::Light,
                 point: emission.point,
