@@ -1,6 +1,6 @@
 //! Photons and the map that finds them, shared by the photon mappers
 //! (`photon.rs`, Jensen's two-pass method; `sppm.rs`, progressive) and by
-//! vertex connection and merging (`vcm.rs`, for its light vertices).
+//! vertex connection and merging (`vcm/`, for its light vertices).
 //!
 //! Photons are found through a hash grid of cells of side 2R built once per
 //! map (a counting sort of photon indices by cell), R the largest radius a

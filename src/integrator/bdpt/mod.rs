@@ -41,6 +41,8 @@ use std::cell::RefCell;
 
 mod mis;
 
+use mis::{light_direction_pdf, pdf};
+
 /// The deepest path bidirectional path tracing makes: subpaths live in
 /// per-thread buffers of this capacity, so that a sample allocates nothing.
 pub const MAX_BOUNCES: u32 = 32;
@@ -647,37 +649,6 @@ struct Connection {
     pt_minus_rev: f32,
     qs_rev: f32,
     qs_minus_rev: f32,
-}
-
-/// The density (area, at `next`) with which vertex `v`, reached from
-/// `previous`, samples `next`.
-#[inline]
-fn pdf(scene: &Scene, v: &Vertex, previous: Option<&Vertex>, next: &Vertex) -> f32 {
-    let d = next.point - v.point;
-    let dist = d.length();
-    if !(dist > 0.0) {
-        return 0.0;
-    }
-    let w = d / dist;
-    let pdf_direction = match v.kind {
-        Kind::Camera => scene.camera.pdf_direction(w),
-        Kind::Light => return light_direction_pdf(scene, v, next),
-        Kind::Surface => {
-            let wo = previous.map_or(v.wo, |p| (p.point - v.point).normalize_or_zero());
-            let frame = Frame::from_normal(v.normal);
-            v.bsdf.pdf(frame.to_local(wo), frame.to_local(w))
-        }
-    };
-    v.area_density_at(pdf_direction, next)
-}
-
-/// The density (area, at `next`) with which a particle leaving the light
-/// point `v` heads for `next`.
-#[inline]
-fn light_direction_pdf(scene: &Scene, v: &Vertex, next: &Vertex) -> f32 {
-    let w = (next.point - v.point).normalize_or_zero();
-    let (_, pdf_direction) = scene.lights.emission_pdf(v.light, v.normal, w);
-    v.area_density_at(pdf_direction, next)
 }
 
 /// A light's emitted radiance (or intensity) and sidedness.

@@ -26,21 +26,22 @@
 //! merges' bias goes to zero. Light and camera subpaths of an iteration see
 //! the scene at the shutter's opening, as the photon mappers do.
 
-use super::light::{importance_weight, sample_particle, sees_lens};
+use super::light::{importance_weight, sample_particle};
 use super::photon_map::{self, PhotonMap, Stored};
 use super::{IntegratorOptions, MisHeuristic, MultiPassEstimator, RayCounts, Technique};
 use crate::accel::NO_LIGHT;
-use crate::camera::CameraConnection;
-use crate::math::{Frame, Ray, Rgb, ray_between};
+use crate::math::{Frame, Ray, Rgb};
 use crate::render::splats::SplatBuffer;
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Sampler, SamplerKind};
 use crate::scene::Scene;
-use crate::scene::light::EmissionSample;
 use crate::scene::material::Bsdf;
 use glam::Vec3A;
 use rayon::prelude::*;
 use std::f32::consts::PI;
+use strategies::CameraVertex;
+
+mod strategies;
 
 /// Light subpaths per iteration at most: past it, pixels share them (a
 /// camera subpath connects to the light subpath of its pixel index modulo
@@ -369,100 +370,6 @@ impl Vcm {
             counts.bounce += 1;
         }
     }
-
-    /// s = 1, t = 1: the light point itself seen through the lens, weighed
-    /// against camera rays that hit it (the splats spread an emitter's
-    /// edge over the pixels it covers, where camera rays alone are noisy).
-    fn light_point_to_camera(
-        &self,
-        scene: &Scene,
-        iteration: &Iteration,
-        emission: &EmissionSample,
-        sampler: &mut Sampler,
-        counts: &mut RayCounts,
-    ) {
-        let u_lens = sampler.next_2d_for(Domain::Lens);
-        let Some(c) = scene.camera.connect(emission.point, u_lens) else {
-            return;
-        };
-        let cos = emission.normal.dot(c.wi).abs();
-        let value = emission.emitted_towards(c.wi) * (cos * c.weight / emission.pdf_position);
-        if !(value.max_element() > 0.0) {
-            return;
-        }
-        let w_camera = self.mis(
-            self.camera_density(scene, iteration, &c, emission.point, cos) / emission.pdf_position,
-        );
-        if !sees_lens(
-            scene,
-            emission.point,
-            emission.error,
-            emission.normal,
-            &c,
-            iteration.time,
-            counts,
-        ) {
-            return;
-        }
-        iteration.light_image.add(c.film, value / (1.0 + w_camera));
-    }
-
-    /// The density (area, at `point`) of the camera's rays reaching it, per
-    /// light subpath: the film-wide density times pixels / N (pbrt's and
-    /// SmallVCM's t = 1 weight).
-    fn camera_density(
-        &self,
-        scene: &Scene,
-        iteration: &Iteration,
-        c: &CameraConnection,
-        point: Vec3A,
-        cos: f32,
-    ) -> f32 {
-        let dist2 = (c.lens_point - point).length_squared();
-        let pixels = (scene.camera.width * scene.camera.height) as f32;
-        scene.camera.pdf_direction(-c.wi) * cos / dist2 * pixels / iteration.paths as f32
-    }
-
-    /// t = 1: the light vertex seen through the lens, splatted where it
-    /// lands.
-    fn connect_to_camera(
-        &self,
-        scene: &Scene,
-        iteration: &Iteration,
-        v: &LightVertex,
-        sampler: &mut Sampler,
-        counts: &mut RayCounts,
-    ) {
-        let u_lens = sampler.next_2d_for(Domain::Lens);
-        let Some(c) = scene.camera.connect(v.point, u_lens) else {
-            return;
-        };
-        let bsdf = scene.materials[v.material as usize].bsdf;
-        let frame = Frame::from_normal(v.normal);
-        let (f, _, pdf_reverse) = bsdf.eval_with_pdfs(frame.to_local(v.wo), frame.to_local(c.wi));
-        let cos = v.normal.dot(c.wi).abs();
-        let value = v.beta * f * (cos * c.weight);
-        if !(value.max_element() > 0.0) {
-            return;
-        }
-        let camera_pdf = self.camera_density(scene, iteration, &c, v.point, cos);
-        let w_light =
-            self.mis(camera_pdf) * (iteration.vm_factor + v.d_vcm + v.d_vc * self.mis(pdf_reverse));
-        let weight = 1.0 / (1.0 + w_light);
-        if !sees_lens(
-            scene,
-            v.point,
-            v.error,
-            v.normal,
-            &c,
-            iteration.time,
-            counts,
-        ) {
-            return;
-        }
-        // A non-finite splat is dropped by the buffer: the film stays clean.
-        iteration.light_image.add(c.film, value * weight);
-    }
 }
 
 impl MultiPassEstimator for Vcm {
@@ -609,136 +516,5 @@ impl MultiPassEstimator for Vcm {
             counts.bounce += 1;
         }
         radiance + splatted
-    }
-}
-
-/// A camera subpath's vertex where it connects and merges.
-struct CameraVertex {
-    point: Vec3A,
-    error: Vec3A,
-    normal: Vec3A,
-    frame: Frame,
-    wo: Vec3A,
-    bsdf: Bsdf,
-    segments: u32,
-}
-
-impl Vcm {
-    /// s = 1: a point sampled on a light, weighed against hitting it (s = 0)
-    /// and against every strategy with more light vertices.
-    fn light_sample(
-        &self,
-        scene: &Scene,
-        iteration: &Iteration,
-        at: &CameraVertex,
-        walk: &Walk,
-        sampler: &mut Sampler,
-        counts: &mut RayCounts,
-    ) -> Rgb {
-        let u_select = sampler.next_1d_for(Domain::Light);
-        let u_light = sampler.next_2d_for(Domain::Light);
-        let Some(ls) = scene.lights.sample(at.point, u_select, u_light) else {
-            return Rgb::ZERO;
-        };
-        let (f, pdf, pdf_reverse) = at.bsdf.eval_with_pdfs(at.wo, at.frame.to_local(ls.wi));
-        let cos = at.normal.dot(ls.wi).abs();
-        let value = f * ls.radiance * (cos / ls.pdf);
-        if !(value.max_element() > 0.0) {
-            return Rgb::ZERO;
-        }
-        let dist2 = ls.distance * ls.distance;
-        let (pdf_position, pdf_emission) = scene.lights.emission_pdf(ls.light, ls.normal, -ls.wi);
-        let w_light = if ls.delta {
-            0.0
-        } else {
-            let cos_light = ls.normal.dot(ls.wi).abs();
-            self.mis(pdf * cos_light / (dist2 * pdf_position))
-        };
-        let w_camera = self.mis(pdf_emission * cos / dist2)
-            * (iteration.vm_factor + walk.d_vcm + walk.d_vc * self.mis(pdf_reverse));
-        counts.shadow += 1;
-        let shadow = ray_between(at.point, at.error, at.normal, ls.point, ls.error, ls.normal)
-            .at_time(iteration.time);
-        if scene.geometry.occluded(&shadow) {
-            return Rgb::ZERO;
-        }
-        value / (1.0 + w_light + w_camera)
-    }
-
-    /// s >= 2, t >= 2: a shadow ray from the camera vertex to a vertex of
-    /// its pixel's light subpath.
-    fn connect(
-        &self,
-        scene: &Scene,
-        iteration: &Iteration,
-        at: &CameraVertex,
-        walk: &Walk,
-        light: &LightVertex,
-        counts: &mut RayCounts,
-    ) -> Rgb {
-        let d = light.point - at.point;
-        let dist2 = d.length_squared();
-        if !(dist2 > 0.0) {
-            return Rgb::ZERO;
-        }
-        let w = d / dist2.sqrt();
-        let (f_camera, pdf_camera, pdf_camera_reverse) =
-            at.bsdf.eval_with_pdfs(at.wo, at.frame.to_local(w));
-        let light_bsdf = scene.materials[light.material as usize].bsdf;
-        let light_frame = Frame::from_normal(light.normal);
-        let (f_light, pdf_light, pdf_light_reverse) =
-            light_bsdf.eval_with_pdfs(light_frame.to_local(light.wo), light_frame.to_local(-w));
-        let (cos_camera, cos_light) = (at.normal.dot(w).abs(), light.normal.dot(w).abs());
-        let value = f_camera * f_light * light.beta * (cos_camera * cos_light / dist2);
-        if !(value.max_element() > 0.0) {
-            return Rgb::ZERO;
-        }
-        // Densities (area) of each end sampled from the other.
-        let camera_to_light = pdf_camera * cos_light / dist2;
-        let light_to_camera = pdf_light * cos_camera / dist2;
-        let w_light = self.mis(camera_to_light)
-            * (iteration.vm_factor + light.d_vcm + light.d_vc * self.mis(pdf_light_reverse));
-        let w_camera = self.mis(light_to_camera)
-            * (iteration.vm_factor + walk.d_vcm + walk.d_vc * self.mis(pdf_camera_reverse));
-        counts.shadow += 1;
-        let shadow = ray_between(
-            at.point,
-            at.error,
-            at.normal,
-            light.point,
-            light.error,
-            light.normal,
-        )
-        .at_time(iteration.time);
-        if scene.geometry.occluded(&shadow) {
-            return Rgb::ZERO;
-        }
-        value / (1.0 + w_light + w_camera)
-    }
-
-    /// Merges: every light vertex within the radius on the same side, its
-    /// flux reflected by the camera vertex's BSDF, each weighed against the
-    /// connections that could have made its path (not yet divided by
-    /// pi r^2 N).
-    fn merge(&self, iteration: &Iteration, at: &CameraVertex, walk: &Walk) -> Rgb {
-        let facing = if at.normal.dot(at.frame.to_world(at.wo)) >= 0.0 {
-            at.normal
-        } else {
-            -at.normal
-        };
-        let mut sum = Rgb::ZERO;
-        iteration.map.for_each_near(at.point, facing, |light| {
-            if light.segments + at.segments > self.max_depth + 1 {
-                return;
-            }
-            let (f, pdf, pdf_reverse) = at.bsdf.eval_with_pdfs(at.wo, at.frame.to_local(light.wo));
-            if !(f.max_element() > 0.0) {
-                return;
-            }
-            let w_light = light.d_vcm * iteration.vc_factor + light.d_vm * self.mis(pdf);
-            let w_camera = walk.d_vcm * iteration.vc_factor + walk.d_vm * self.mis(pdf_reverse);
-            sum += f * light.beta / (1.0 + w_light + w_camera);
-        });
-        sum
     }
 }
