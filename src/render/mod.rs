@@ -136,7 +136,7 @@ impl Session {
             && needed > available
         {
             return Err(Error::new(format!(
-                "a {}x{} render needs about {:.1} GB for its film and image, more than the {:.1} GB available",
+                "a {}x{} render needs about {:.1} GB for its film, image and buffers, more than the {:.1} GB available",
                 scene.camera.width,
                 scene.camera.height,
                 needed as f64 * 1e-9,
@@ -183,9 +183,9 @@ impl Session {
         }
     }
 
-    /// Bytes a session of `settings` on `scene` allocates per pixel, in
-    /// all: the film's statistics, a splatting estimator's buffer, and the
-    /// image it ends with.
+    /// Bytes a session of `settings` on `scene` allocates, in all: per
+    /// pixel the film's statistics, a splatting estimator's buffer and the
+    /// image it ends with, and VCM's light vertices of an iteration.
     pub fn memory_estimate(scene: &Scene, settings: &RenderSettings) -> u64 {
         let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
         let film = std::mem::size_of::<crate::film::PixelSums>() as u64;
@@ -194,7 +194,13 @@ impl Session {
             Integrator::Splatting(_) => 24,
             _ => 0,
         };
-        pixels * (film + image + splats)
+        let iteration = match settings.integrator {
+            Integrator::MultiPass(crate::integrator::MultiPassIntegrator::Vcm(_)) => {
+                crate::integrator::vcm::Vcm::memory_per_iteration(scene)
+            }
+            _ => 0,
+        };
+        pixels * (film + image + splats) + iteration
     }
 
     pub fn scene(&self) -> &Scene {

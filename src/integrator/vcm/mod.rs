@@ -203,6 +203,15 @@ impl Vcm {
         self.radius * ((pass + 1) as f32).powf((self.alpha - 1.0) * 0.5)
     }
 
+    /// Bytes an iteration holds besides the film: its splat buffer and the
+    /// light vertices with their grid, for the typical four stored vertices
+    /// per light subpath (roulette ends most before the depth limit).
+    pub fn memory_per_iteration(scene: &Scene) -> u64 {
+        let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
+        let per_vertex = std::mem::size_of::<LightVertex>() as u64 + 2 * 4;
+        pixels * 24 + u64::from(Self::light_paths(scene)) * (4 * per_vertex + 4)
+    }
+
     /// The light subpaths of an iteration: as many as pixels, at most
     /// [`MAX_LIGHT_PATHS`].
     pub fn light_paths(scene: &Scene) -> u32 {
