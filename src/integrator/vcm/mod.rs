@@ -29,7 +29,7 @@
 use super::light::{importance_weight, sample_particle};
 use super::photon_map::{self, PhotonMap, Stored};
 use super::{IntegratorOptions, MisHeuristic, MultiPassEstimator, RayCounts, Technique};
-use crate::accel::NO_LIGHT;
+use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb};
 use crate::render::splats::SplatBuffer;
 use crate::sampling::hash::hash_combine;
@@ -218,14 +218,17 @@ impl Vcm {
         (scene.camera.width * scene.camera.height).clamp(1, MAX_LIGHT_PATHS)
     }
 
-    /// Arriving at a surface `dist2` away at |cos| `cos`: the quantities
-    /// turn from the previous vertex's solid angle into this one's area.
+    /// The next surface along `ray`, with the walk's quantities moved to it:
+    /// from the previous vertex's solid angle into this one's area (the
+    /// distance squared over the |cos| of arrival).
     #[inline]
-    fn arrive(&self, walk: &mut Walk, dist2: f32, cos: f32) {
-        let c = self.mis(cos);
-        walk.d_vcm *= self.mis(dist2) / c;
+    fn advance(&self, scene: &Scene, ray: &Ray, walk: &mut Walk) -> Option<SurfaceHit> {
+        let hit = scene.geometry.intersect(ray)?;
+        let c = self.mis(hit.normal.dot(ray.direction).abs());
+        walk.d_vcm *= self.mis((hit.point - ray.origin).length_squared()) / c;
         walk.d_vc /= c;
         walk.d_vm /= c;
+        Some(hit)
     }
 
     /// Leaving a surface by `scatter`: the update of Georgiev et al.'s
@@ -333,12 +336,10 @@ impl Vcm {
         let mut ray = emission.ray().at_time(iteration.time);
         counts.bounce += 1;
         for segments in 1..=self.max_depth {
-            let Some(hit) = scene.geometry.intersect(&ray) else {
+            let Some(hit) = self.advance(scene, &ray, &mut walk) else {
                 break;
             };
             let wo_world = -ray.direction;
-            let cos_in = hit.normal.dot(wo_world).abs();
-            self.arrive(&mut walk, (hit.point - ray.origin).length_squared(), cos_in);
             let material = &scene.materials[hit.material as usize];
             let bsdf = material.bsdf;
             if bsdf.is_black() {
@@ -470,12 +471,10 @@ impl MultiPassEstimator for Vcm {
             1.0 / (PI * iteration.radius * iteration.radius * iteration.paths as f32);
         let mut radiance = Rgb::ZERO;
         for segments in 1..=self.max_depth + 1 {
-            let Some(hit) = scene.geometry.intersect(&ray) else {
+            let Some(hit) = self.advance(scene, &ray, &mut walk) else {
                 break;
             };
             let wo_world = -ray.direction;
-            let cos_in = hit.normal.dot(wo_world).abs();
-            self.arrive(&mut walk, (hit.point - ray.origin).length_squared(), cos_in);
             let material = &scene.materials[hit.material as usize];
             if hit.light != NO_LIGHT {
                 let emitted = material.emitted(hit.normal, wo_world);

@@ -38,30 +38,64 @@ impl Vcm {
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) {
+        let at = (emission.point, emission.error, emission.normal);
+        self.splat_through_lens(scene, iteration, at, sampler, counts, |c| {
+            let cos = emission.normal.dot(c.wi).abs();
+            let value = emission.emitted_towards(c.wi) * (cos * c.weight / emission.pdf_position);
+            let camera = self.camera_density(scene, iteration, c, emission.point, cos);
+            value / (1.0 + self.mis(camera / emission.pdf_position))
+        });
+    }
+
+    /// t = 1: the light vertex seen through the lens, splatted where it
+    /// lands.
+    pub(super) fn connect_to_camera(
+        &self,
+        scene: &Scene,
+        iteration: &Iteration,
+        v: &LightVertex,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) {
+        let at = (v.point, v.error, v.normal);
+        self.splat_through_lens(scene, iteration, at, sampler, counts, |c| {
+            let bsdf = scene.materials[v.material as usize].bsdf;
+            let frame = Frame::from_normal(v.normal);
+            let (f, _, pdf_reverse) =
+                bsdf.eval_with_pdfs(frame.to_local(v.wo), frame.to_local(c.wi));
+            let cos = v.normal.dot(c.wi).abs();
+            let value = v.beta * f * (cos * c.weight);
+            let camera = self.camera_density(scene, iteration, c, v.point, cos);
+            let w_light =
+                self.mis(camera) * (iteration.vm_factor + v.d_vcm + v.d_vc * self.mis(pdf_reverse));
+            value / (1.0 + w_light)
+        });
+    }
+
+    /// Joins the point `(point, error, normal)` to a lens point and, where
+    /// `weighted` (its MIS-weighted value) is positive and the lens is in
+    /// sight, splats it where it lands on the film. A non-finite value is
+    /// dropped by the buffer: the film stays clean.
+    fn splat_through_lens(
+        &self,
+        scene: &Scene,
+        iteration: &Iteration,
+        (point, error, normal): (Vec3A, Vec3A, Vec3A),
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+        weighted: impl FnOnce(&CameraConnection) -> Rgb,
+    ) {
         let u_lens = sampler.next_2d_for(Domain::Lens);
-        let Some(c) = scene.camera.connect(emission.point, u_lens) else {
+        let Some(c) = scene.camera.connect(point, u_lens) else {
             return;
         };
-        let cos = emission.normal.dot(c.wi).abs();
-        let value = emission.emitted_towards(c.wi) * (cos * c.weight / emission.pdf_position);
-        if !(value.max_element() > 0.0) {
+        let value = weighted(&c);
+        if !(value.max_element() > 0.0)
+            || !sees_lens(scene, point, error, normal, &c, iteration.time, counts)
+        {
             return;
         }
-        let w_camera = self.mis(
-            self.camera_density(scene, iteration, &c, emission.point, cos) / emission.pdf_position,
-        );
-        if !sees_lens(
-            scene,
-            emission.point,
-            emission.error,
-            emission.normal,
-            &c,
-            iteration.time,
-            counts,
-        ) {
-            return;
-        }
-        iteration.light_image.add(c.film, value / (1.0 + w_camera));
+        iteration.light_image.add(c.film, value);
     }
 
     /// The density (area, at `point`) of the camera's rays reaching it, per
@@ -78,47 +112,6 @@ impl Vcm {
         let dist2 = (c.lens_point - point).length_squared();
         let pixels = (scene.camera.width * scene.camera.height) as f32;
         scene.camera.pdf_direction(-c.wi) * cos / dist2 * pixels / iteration.paths as f32
-    }
-
-    /// t = 1: the light vertex seen through the lens, splatted where it
-    /// lands.
-    pub(super) fn connect_to_camera(
-        &self,
-        scene: &Scene,
-        iteration: &Iteration,
-        v: &LightVertex,
-        sampler: &mut Sampler,
-        counts: &mut RayCounts,
-    ) {
-        let u_lens = sampler.next_2d_for(Domain::Lens);
-        let Some(c) = scene.camera.connect(v.point, u_lens) else {
-            return;
-        };
-        let bsdf = scene.materials[v.material as usize].bsdf;
-        let frame = Frame::from_normal(v.normal);
-        let (f, _, pdf_reverse) = bsdf.eval_with_pdfs(frame.to_local(v.wo), frame.to_local(c.wi));
-        let cos = v.normal.dot(c.wi).abs();
-        let value = v.beta * f * (cos * c.weight);
-        if !(value.max_element() > 0.0) {
-            return;
-        }
-        let camera_pdf = self.camera_density(scene, iteration, &c, v.point, cos);
-        let w_light =
-            self.mis(camera_pdf) * (iteration.vm_factor + v.d_vcm + v.d_vc * self.mis(pdf_reverse));
-        let weight = 1.0 / (1.0 + w_light);
-        if !sees_lens(
-            scene,
-            v.point,
-            v.error,
-            v.normal,
-            &c,
-            iteration.time,
-            counts,
-        ) {
-            return;
-        }
-        // A non-finite splat is dropped by the buffer: the film stays clean.
-        iteration.light_image.add(c.film, value * weight);
     }
 
     /// s = 1: a point sampled on a light, weighed against hitting it (s = 0)
