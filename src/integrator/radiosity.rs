@@ -352,7 +352,7 @@ impl Radiosity {
         );
         let solution = Solution::new(&mesh);
         let vertex_radiance = if self.display == RadiosityDisplay::Smooth {
-            mesh.vertex_average(&solution.radiance)
+            mesh.vertex_radiance(&solution.radiance)
         } else {
             Vec::new()
         };
@@ -420,7 +420,9 @@ impl Radiosity {
         }
         if self.display == RadiosityDisplay::Smooth {
             match &mut state.model {
-                Model::Matrix(m) => m.vertex_radiance = m.mesh.vertex_average(&m.solution.radiance),
+                Model::Matrix(m) => {
+                    m.vertex_radiance = m.mesh.vertex_radiance(&m.solution.radiance)
+                }
                 Model::Hierarchical(h) => h.smooth(),
             }
         }

@@ -396,14 +396,14 @@ impl Hierarchy {
             .iter()
             .filter(|n| n.children == NONE)
             .map(|n| (&n.element, n.radiance));
-        let averaged = super::mesh::vertex_average(leaves);
+        let reconstructed = super::reconstruct::vertex_radiance(leaves);
         let mut per_node = vec![[Rgb::ZERO; 3]; self.nodes.len()];
         let leaf_nodes = self
             .nodes
             .iter()
             .enumerate()
             .filter(|(_, n)| n.children == NONE);
-        for ((k, _), v) in leaf_nodes.zip(averaged) {
+        for ((k, _), v) in leaf_nodes.zip(reconstructed) {
             per_node[k] = v;
         }
         self.vertex_radiance = per_node;

@@ -299,9 +299,10 @@ impl Mesh {
             .collect()
     }
 
-    /// Per element, the radiance at its three vertices ([`vertex_average`]).
-    pub fn vertex_average(&self, radiance: &[Rgb]) -> Vec<[Rgb; 3]> {
-        vertex_average(self.elements.iter().zip(radiance.iter().copied()))
+    /// Per element, the radiance at its three vertices for the smooth
+    /// display ([`super::reconstruct::vertex_radiance`]).
+    pub fn vertex_radiance(&self, radiance: &[Rgb]) -> Vec<[Rgb; 3]> {
+        super::reconstruct::vertex_radiance(self.elements.iter().zip(radiance.iter().copied()))
     }
 
     /// The element of scene triangle `triangle` that contains the point at
@@ -322,35 +323,6 @@ impl Mesh {
             }
         }
     }
-}
-
-/// Per element, the radiance at its three vertices: the area-weighted mean
-/// of the radiance of the elements that share the vertex (same position,
-/// exactly: midpoints are computed alike on both sides of an edge) and lie
-/// in the same plane, so that walls meeting at a corner keep their own
-/// values. A vertex in the middle of a coarser neighbour's edge (a
-/// T-vertex of a hierarchy) averages only the elements that have it.
-pub fn vertex_average<'a>(
-    elements: impl Iterator<Item = (&'a Element, Rgb)> + Clone,
-) -> Vec<[Rgb; 3]> {
-    use std::collections::HashMap;
-    let key = vertex_key;
-    let mut sums: HashMap<_, (Rgb, f32)> = HashMap::new();
-    for (e, l) in elements.clone() {
-        for v in e.vertices {
-            let entry = sums.entry(key(v, e.normal)).or_insert((Rgb::ZERO, 0.0));
-            entry.0 += l * e.area;
-            entry.1 += e.area;
-        }
-    }
-    elements
-        .map(|(e, _)| {
-            e.vertices.map(|v| {
-                let (sum, area) = sums[&key(v, e.normal)];
-                sum / area
-            })
-        })
-        .collect()
 }
 
 /// A vertex's position (exactly: midpoints are computed alike on both sides

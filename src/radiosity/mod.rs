@@ -5,6 +5,7 @@
 pub mod form_factor;
 pub mod hierarchy;
 pub mod mesh;
+pub mod reconstruct;
 pub mod solve;
 
 pub use form_factor::FormFactorMethod;
