@@ -45,9 +45,9 @@ fn square_to_square(a: &[Element; 2], b: &[Element; 2], method: FormFactorMethod
     let mut f = 0.0;
     for (i, ei) in a.iter().enumerate() {
         for (j, ej) in b.iter().enumerate() {
-            let (fij, _) =
+            let exchange =
                 element_to_element(&geometry, ei, ej, method, n, (i as u32, (i * 2 + j) as u32));
-            f += ei.area as f64 * fij as f64;
+            f += ei.area as f64 * exchange.f as f64;
         }
     }
     f / area

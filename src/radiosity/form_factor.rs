@@ -147,14 +147,14 @@ pub fn element_to_element(
     method: FormFactorMethod,
     n: u32,
     (key_i, key_pair): (u32, u32),
-) -> (f32, u32) {
+) -> Exchange {
     if !faces(i, j) {
-        return (0.0, 0);
+        return Exchange::default();
     }
     let mut on_i = Sampler::new(SamplerKind::Stratified, 0x5eed, n);
     let mut on_j = Sampler::new(SamplerKind::Stratified, 0x5eed_0001, n);
     let mut sum = 0.0f64;
-    let mut rays = 0;
+    let (mut rays, mut visible) = (0, 0);
     for k in 0..n {
         on_i.start(key_i, k);
         on_j.start(key_pair, k);
@@ -192,9 +192,30 @@ pub fn element_to_element(
         let ray = ray_between(x, x_error, i.normal, y, y_error, j.normal);
         if !geometry.occluded(&ray) {
             sum += f64::from(value);
+            visible += 1;
         }
     }
-    ((sum / f64::from(n)) as f32, rays)
+    Exchange {
+        f: (sum / f64::from(n)) as f32,
+        rays,
+        visibility: if rays == 0 {
+            1.0
+        } else {
+            visible as f32 / rays as f32
+        },
+    }
+}
+
+/// What [`element_to_element`] found.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Exchange {
+    /// The form factor F_ij.
+    pub f: f32,
+    /// Shadow rays cast.
+    pub rays: u32,
+    /// The share of them that arrived (1 when none was needed): the
+    /// hierarchy's smooth display scales point-to-polygon form factors by it.
+    pub visibility: f32,
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@
 //! refines the links the new radiance makes too coarse. The cost is linear
 //! in the number of links instead of quadratic in the elements.
 
-use super::form_factor::{FormFactorMethod, element_to_element, faces, point_to_polygon};
+use super::form_factor::{Exchange, FormFactorMethod, element_to_element, faces, point_to_polygon};
 use super::mesh::Element;
 use crate::accel::Geometry;
 use crate::math::Rgb;
@@ -19,11 +19,16 @@ use crate::scene::Scene;
 use crate::scene::material::Bsdf;
 use rayon::prelude::*;
 
-/// A link: the node gathers from `source` with form factor `f`.
+/// A link: the node gathers from `source` with form factor `f`, of which
+/// the share `visibility` of its shadow rays arrived; `f_max` is the
+/// oracle's unoccluded bound (geometry only, so kept rather than recomputed
+/// at every step).
 #[derive(Clone, Copy, Debug)]
 struct Link {
     source: u32,
     f: f32,
+    visibility: f32,
+    f_max: f32,
 }
 
 /// One element of a patch's tree.
@@ -76,6 +81,17 @@ pub struct Hierarchy {
     /// Smooth display: per node, its vertices' radiance (leaves only; set
     /// by [`Hierarchy::smooth`]).
     vertex_radiance: Vec<[Rgb; 3]>,
+}
+
+/// A link through a shadow boundary is refined while its transfer exceeds
+/// this share of ε: constant elements smear the boundary over their size,
+/// and an element half hidden (the ceiling behind the light) shows its
+/// hidden half's darkness on its visible half. Cornell box, ε 1e-5, smooth
+/// display: masked RMSE 0.00327 without, 0.00250 at 1/16, 0.00223 at 1/100.
+const PARTIAL_SHARE: f32 = 1.0 / 16.0;
+
+fn partly_visible(visibility: f32) -> bool {
+    visibility > 0.0 && visibility < 1.0
 }
 
 fn luminance(c: Rgb) -> f32 {
@@ -178,14 +194,14 @@ impl Hierarchy {
                 h.nodes.len()
             ));
         }
-        let patches: Vec<u32> = (0..h.nodes.len() as u32).collect();
-        for &p in &patches {
-            for &q in &patches {
-                if p != q && faces(&h.nodes[p as usize].element, &h.nodes[q as usize].element) {
-                    h.refine(geometry, p, q);
-                }
-            }
-        }
+        let patches = h.nodes.len() as u32;
+        let pairs: Vec<(u32, u32, bool)> = (0..patches)
+            .flat_map(|p| (0..patches).map(move |q| (p, q, false)))
+            .filter(|&(p, q, _)| {
+                p != q && faces(&h.nodes[p as usize].element, &h.nodes[q as usize].element)
+            })
+            .collect();
+        h.link(geometry, pairs);
         Ok(h)
     }
 
@@ -209,18 +225,24 @@ impl Hierarchy {
     /// towards the centroid). It bounds both the transfer (Hanrahan's BF)
     /// and its variation over p (F_max - F_min); either alone left single
     /// leaves of a uniform closed box further from E/(1 - ρ) (1.4% and 3.8%).
-    fn transfer(&self, p: u32, q: u32) -> f32 {
-        let (pn, qn) = (&self.nodes[p as usize], &self.nodes[q as usize]);
-        let e = &pn.element;
+    fn f_max(&self, p: u32, q: u32) -> f32 {
+        let e = &self.nodes[p as usize].element;
+        let source = &self.nodes[q as usize].element;
         let centroid = (e.vertices[0] + e.vertices[1] + e.vertices[2]) / 3.0;
         let mut high = 0.0f32;
         for x in [centroid, e.vertices[0], e.vertices[1], e.vertices[2]] {
             let x = x + 0.05 * (centroid - x);
-            let f = point_to_polygon(x, e.normal, &qn.element.vertices);
-            high = high.max(f);
+            high = high.max(point_to_polygon(x, e.normal, &source.vertices));
         }
-        (luminance(e.reflectance * qn.radiance) as f64 * high as f64 * e.area as f64 / self.emitted)
-            as f32
+        high
+    }
+
+    /// The oracle's bound for a link from q to p with bound `f_max`,
+    /// relative to the emitted power.
+    fn transfer(&self, p: u32, q: u32, f_max: f32) -> f32 {
+        let e = &self.nodes[p as usize].element;
+        let light = luminance(e.reflectance * self.nodes[q as usize].radiance);
+        (light as f64 * f_max as f64 * e.area as f64 / self.emitted) as f32
     }
 
     /// Whether node `k` may be subdivided.
@@ -268,10 +290,57 @@ impl Hierarchy {
         Some(first)
     }
 
-    /// Links p (gatherer) to q (source), subdividing while the oracle says
-    /// the exchange is too coarse.
-    fn refine(&mut self, geometry: &Geometry, p: u32, q: u32) {
-        let coarse = self.transfer(p, q) > self.settings.epsilon;
+    /// Links every (gatherer, source, forced) pair, subdividing while the
+    /// oracle finds an exchange too coarse; a forced pair is split once
+    /// regardless. The new links' form factors, where the rays go, are
+    /// estimated in parallel between rounds of refinement; a partly visible
+    /// link whose transfer is above [`PARTIAL_SHARE`] of ε goes back for
+    /// another round, split.
+    fn link(&mut self, geometry: &Geometry, mut pairs: Vec<(u32, u32, bool)>) {
+        let mut pending = Vec::new();
+        while !pairs.is_empty() {
+            pending.clear();
+            for (p, q, forced) in pairs.drain(..) {
+                self.refine(p, q, forced, &mut pending);
+            }
+            let nodes = &self.nodes;
+            let settings = self.settings;
+            let exchanges: Vec<Exchange> = pending
+                .par_iter()
+                .map(|&(p, q, _)| {
+                    element_to_element(
+                        geometry,
+                        &nodes[p as usize].element,
+                        &nodes[q as usize].element,
+                        settings.method,
+                        settings.samples,
+                        (p, p ^ (q << 16)),
+                    )
+                })
+                .collect();
+            for (&(p, q, f_max), x) in pending.iter().zip(exchanges) {
+                self.rays += x.rays as u64;
+                let link = Link {
+                    source: q,
+                    f: x.f,
+                    visibility: x.visibility,
+                    f_max,
+                };
+                let divisible = self.divisible(p) || self.divisible(q);
+                if self.too_coarse(p, &link) && divisible && !self.budget_spent {
+                    pairs.push((p, q, true));
+                } else if x.f > 0.0 {
+                    self.nodes[p as usize].links.push(link);
+                }
+            }
+        }
+    }
+
+    /// Refines the pair p (gatherer), q (source) down to the links the
+    /// oracle accepts, which go to `pending` with their bound.
+    fn refine(&mut self, p: u32, q: u32, forced: bool, pending: &mut Vec<(u32, u32, f32)>) {
+        let f_max = self.f_max(p, q);
+        let coarse = forced || self.transfer(p, q, f_max) > self.settings.epsilon;
         let (can_p, can_q) = (self.divisible(p), self.divisible(q));
         let (ap, aq) = (
             self.nodes[p as usize].element.area,
@@ -283,44 +352,27 @@ impl Hierarchy {
         } else {
             None
         };
-        if let Some(first) = children {
-            if split_q {
-                for c in first..first + 4 {
-                    if faces(
-                        &self.nodes[p as usize].element,
-                        &self.nodes[c as usize].element,
-                    ) {
-                        self.refine(geometry, p, c);
-                    }
-                }
-            } else {
-                for c in first..first + 4 {
-                    if faces(
-                        &self.nodes[c as usize].element,
-                        &self.nodes[q as usize].element,
-                    ) {
-                        self.refine(geometry, c, q);
-                    }
-                }
-            }
+        let Some(first) = children else {
+            pending.push((p, q, f_max));
             return;
+        };
+        for c in first..first + 4 {
+            let (gatherer, source) = if split_q { (p, c) } else { (c, q) };
+            if faces(
+                &self.nodes[gatherer as usize].element,
+                &self.nodes[source as usize].element,
+            ) {
+                self.refine(gatherer, source, false, pending);
+            }
         }
-        let (pe, qe) = (
-            self.nodes[p as usize].element,
-            self.nodes[q as usize].element,
-        );
-        let (f, rays) = element_to_element(
-            geometry,
-            &pe,
-            &qe,
-            self.settings.method,
-            self.settings.samples,
-            (p, p ^ (q << 16)),
-        );
-        self.rays += rays as u64;
-        if f > 0.0 {
-            self.nodes[p as usize].links.push(Link { source: q, f });
-        }
+    }
+
+    /// Whether a link is too coarse for the current radiance: its transfer
+    /// above ε, or above [`PARTIAL_SHARE`] of ε through a shadow boundary.
+    fn too_coarse(&self, p: u32, link: &Link) -> bool {
+        let transfer = self.transfer(p, link.source, link.f_max);
+        transfer > self.settings.epsilon
+            || (transfer > self.settings.epsilon * PARTIAL_SHARE && partly_visible(link.visibility))
     }
 
     /// One step: gather over every link, push-pull, then refine the links
@@ -351,21 +403,22 @@ impl Hierarchy {
             }
         }
         // Refine: every link the oracle now finds too coarse is replaced by finer ones.
-        let coarse: Vec<(u32, u32)> = (0..self.nodes.len() as u32)
-            .flat_map(|p| {
+        let mut coarse = Vec::new();
+        for p in 0..self.nodes.len() as u32 {
+            let before = coarse.len();
+            for l in &self.nodes[p as usize].links {
+                if self.too_coarse(p, l) && (self.divisible(p) || self.divisible(l.source)) {
+                    coarse.push((p, l.source, false));
+                }
+            }
+            if coarse.len() > before {
+                let removed = &coarse[before..];
                 self.nodes[p as usize]
                     .links
-                    .iter()
-                    .filter(|l| self.transfer(p, l.source) > self.settings.epsilon)
-                    .map(move |l| (p, l.source))
-                    .collect::<Vec<_>>()
-            })
-            .filter(|&(p, q)| self.divisible(p) || self.divisible(q))
-            .collect();
-        for (p, q) in coarse {
-            self.nodes[p as usize].links.retain(|l| l.source != q);
-            self.refine(geometry, p, q);
+                    .retain(|l| !removed.iter().any(|&(_, q, _)| q == l.source));
+            }
         }
+        self.link(geometry, coarse);
         change / self.emitted
     }
 
@@ -389,22 +442,51 @@ impl Hierarchy {
         radiance
     }
 
-    /// Computes the leaves' vertex radiance for the smooth display.
+    /// Computes the leaves' vertex radiance for the smooth display: at each
+    /// vertex, E + ρ Σ B_q F(x → q) V over the links of the leaf and of its
+    /// ancestors, F the point-to-polygon form factor at the vertex and V the
+    /// link's share of visible shadow rays. A link's transfer is constant
+    /// over its gatherer (the constant basis) but its kernel is not, so a
+    /// coarse link that lights a whole wall still shades it smoothly where
+    /// pushing its constant down would leave steps the size of the link;
+    /// Cornell box, ε 1e-5: masked RMSE 0.00450 with per-leaf gradients.
     pub fn smooth(&mut self) {
-        let leaves = self
-            .nodes
-            .iter()
-            .filter(|n| n.children == NONE)
-            .map(|n| (&n.element, n.radiance));
-        let reconstructed = super::reconstruct::vertex_radiance(leaves);
+        let mut parent = vec![NONE; self.nodes.len()];
+        for (k, n) in self.nodes.iter().enumerate() {
+            if n.children != NONE {
+                parent[n.children as usize..n.children as usize + 4].fill(k as u32);
+            }
+        }
+        let leaves: Vec<u32> = (0..self.nodes.len() as u32)
+            .filter(|&k| self.nodes[k as usize].children == NONE)
+            .collect();
+        let gathered: Vec<[Rgb; 3]> = leaves
+            .par_iter()
+            .map(|&k| {
+                let e = &self.nodes[k as usize].element;
+                let centroid = (e.vertices[0] + e.vertices[1] + e.vertices[2]) / 3.0;
+                e.vertices.map(|v| {
+                    // Just inside: on a neighbour's edge the integral is singular.
+                    let x = v + 1e-3 * (centroid - v);
+                    let mut irradiance = Rgb::ZERO;
+                    let mut a = k;
+                    while a != NONE {
+                        for link in &self.nodes[a as usize].links {
+                            let q = &self.nodes[link.source as usize];
+                            let f = point_to_polygon(x, e.normal, &q.element.vertices);
+                            irradiance += (link.visibility * f) * q.radiance;
+                        }
+                        a = parent[a as usize];
+                    }
+                    e.emission + e.reflectance * irradiance
+                })
+            })
+            .collect();
+        let elements = leaves.iter().map(|&k| &self.nodes[k as usize].element);
+        let shared = super::reconstruct::shared_mean(elements, &gathered);
         let mut per_node = vec![[Rgb::ZERO; 3]; self.nodes.len()];
-        let leaf_nodes = self
-            .nodes
-            .iter()
-            .enumerate()
-            .filter(|(_, n)| n.children == NONE);
-        for ((k, _), v) in leaf_nodes.zip(reconstructed) {
-            per_node[k] = v;
+        for (&k, v) in leaves.iter().zip(shared) {
+            per_node[k as usize] = v;
         }
         self.vertex_radiance = per_node;
     }

@@ -56,23 +56,40 @@ pub fn vertex_radiance<'a>(
             gradient(e, samples)
         })
         .collect();
-    let mut sums: HashMap<VertexKey, (Rgb, f32)> = HashMap::with_capacity(at_vertex.len());
-    for ((e, l), g) in elements.iter().zip(&gradients) {
-        let c = centroid(e);
-        for v in e.vertices {
-            let d = v - c;
-            let value = *l + Rgb::new(g[0].dot(d), g[1].dot(d), g[2].dot(d));
+    let planes: Vec<[Rgb; 3]> = elements
+        .iter()
+        .zip(&gradients)
+        .map(|((e, l), g)| {
+            let c = centroid(e);
+            e.vertices.map(|v| {
+                let d = v - c;
+                *l + Rgb::new(g[0].dot(d), g[1].dot(d), g[2].dot(d))
+            })
+        })
+        .collect();
+    shared_mean(elements.iter().map(|(e, _)| *e), &planes)
+}
+
+/// Per element, the area-weighted mean of `values` (one per element
+/// vertex) over the elements that share each vertex: one value per vertex,
+/// so the interpolated image has no cracks. Negative means (a plane past a
+/// sharp shadow edge) are clamped to zero.
+pub fn shared_mean<'a>(
+    elements: impl Iterator<Item = &'a Element> + Clone,
+    values: &[[Rgb; 3]],
+) -> Vec<[Rgb; 3]> {
+    let mut sums: HashMap<VertexKey, (Rgb, f32)> = HashMap::with_capacity(values.len());
+    for (e, at) in elements.clone().zip(values) {
+        for (v, value) in e.vertices.into_iter().zip(at) {
             let entry = sums.entry(vertex_key(v, e)).or_insert((Rgb::ZERO, 0.0));
-            entry.0 += e.area * value;
+            entry.0 += e.area * *value;
             entry.1 += e.area;
         }
     }
     elements
-        .iter()
-        .map(|(e, _)| {
+        .map(|e| {
             e.vertices.map(|v| {
                 let (sum, area) = sums[&vertex_key(v, e)];
-                // A plane may dip below zero past a sharp shadow edge.
                 (sum / area).max(Rgb::ZERO)
             })
         })

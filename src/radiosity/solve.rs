@@ -98,7 +98,7 @@ impl FormFactors {
                         continue;
                     }
                     let keys = (i as u32, (i * n + j) as u32);
-                    let (fij, r) = element_to_element(
+                    let exchange = element_to_element(
                         geometry,
                         &elements[i],
                         &elements[j],
@@ -106,8 +106,8 @@ impl FormFactors {
                         samples,
                         keys,
                     );
-                    *f = fij;
-                    rays += r as u64;
+                    *f = exchange.f;
+                    rays += exchange.rays as u64;
                 }
                 rays
             })
