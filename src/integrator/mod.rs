@@ -207,6 +207,13 @@ pub trait Solver: Technique {
     /// Samples per pixel of one image of the solution (ray-cast display
     /// with antialiasing, say); 1 for a deterministic display.
     fn display_spp(&self) -> u32;
+    /// The sampler of a display whose only noise is the pixel's coverage (a
+    /// lookup of the solution): stratified antialiasing needs a quarter of
+    /// the rays of independent samples for the same edge noise. `None`
+    /// follows the session's sampler.
+    fn display_sampler(&self) -> Option<crate::sampling::SamplerKind> {
+        None
+    }
 }
 
 /// Where a solver stands after a batch of steps.

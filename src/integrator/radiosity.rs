@@ -28,6 +28,7 @@ use crate::radiosity::{
     Element, FormFactorMethod, FormFactors, Hierarchy, HierarchySettings, Mesh, RadiositySolver,
     Solution, solve,
 };
+use crate::sampling::SamplerKind;
 use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
@@ -319,6 +320,13 @@ impl Solver for Radiosity {
 
     fn display_spp(&self) -> u32 {
         16
+    }
+
+    /// Flat and smooth displays look the solution up: only edges are noisy.
+    /// Cornell box, ε 3e-6, smooth: masked RMSE 0.00216 with independent
+    /// pixel samples, 0.00174 with these.
+    fn display_sampler(&self) -> Option<SamplerKind> {
+        (self.display != RadiosityDisplay::Gather).then_some(SamplerKind::Sobol)
     }
 }
 

@@ -73,10 +73,36 @@ pub fn point_to_polygon(p: Vec3A, n: Vec3A, vertices: &[Vec3A]) -> f32 {
         if length == 0.0 {
             continue;
         }
-        let angle = length.atan2(a.dot(b));
+        let angle = angle_from(length, a.dot(b));
         sum += (n.dot(cross) / length * angle) as f64;
     }
     (sum.abs() / (2.0 * std::f64::consts::PI)) as f32
+}
+
+/// atan2(y, x) for y ≥ 0, the angle between two vectors from |a × b| and
+/// a · b. libm's atan2f took 46% of hierarchical radiosity's time; this is
+/// Cephes' atanf (a cubic in z² after reduction to |t| ≤ tan π/8), within
+/// 2e-7 of it.
+#[inline]
+fn angle_from(y: f32, x: f32) -> f32 {
+    use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+    let (low, high) = (y.min(x.abs()), y.max(x.abs()));
+    if high == 0.0 {
+        return 0.0;
+    }
+    let t = low / high;
+    let (offset, t) = if t > 0.414_213_56 {
+        (FRAC_PI_4, (t - 1.0) / (t + 1.0))
+    } else {
+        (0.0, t)
+    };
+    let z = t * t;
+    let poly = ((8.053_744_5e-2 * z - 1.387_768_6e-1) * z + 1.997_771_1e-1) * z - 3.333_294_9e-1;
+    let mut angle = offset + t + t * z * poly;
+    if y > x.abs() {
+        angle = FRAC_PI_2 - angle;
+    }
+    if x < 0.0 { PI - angle } else { angle }
 }
 
 /// A point of `element` and its rounding-error bound.
@@ -221,6 +247,20 @@ pub struct Exchange {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_fast_angle_matches_atan2_over_the_upper_half_plane() {
+        let mut worst = 0.0f32;
+        for k in 0..=100_000 {
+            let phi = std::f32::consts::PI * k as f32 / 100_000.0;
+            for r in [1e-3f32, 1.0, 1e3] {
+                let (y, x) = (r * phi.sin().abs(), r * phi.cos());
+                worst = worst.max((angle_from(y, x) - y.atan2(x)).abs());
+            }
+        }
+        assert!(worst < 5e-7, "{worst}");
+        assert_eq!(angle_from(0.0, 0.0), 0.0);
+    }
 
     #[test]
     fn a_point_under_a_huge_square_sees_all_of_the_hemisphere() {

@@ -256,6 +256,7 @@ impl Session {
                     part,
                     parts,
                     deterministic,
+                    self.settings.sampler,
                     |s, r, p, _, sa, c| estimator.radiance(s, r, p, sa, c),
                 );
                 (first + k, u64::from(k))
@@ -346,6 +347,7 @@ impl Session {
         part: u32,
         parts: u32,
         deterministic: bool,
+        sampler: SamplerKind,
         estimate: E,
     ) where
         E: Fn(&Scene, Ray, PrimaryPixel<'_>, (u32, u32), &mut Sampler, &mut RayCounts) -> Rgb
@@ -374,9 +376,8 @@ impl Session {
                         return;
                     }
                     let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
-                    let mut sampler =
-                        Sampler::new(settings.sampler, settings.seed, settings.planned_spp)
-                            .with_domains(settings.domains);
+                    let mut sampler = Sampler::new(sampler, settings.seed, settings.planned_spp)
+                        .with_domains(settings.domains);
                     // The next sample's, whose camera ray is made while this
                     // sample's path is traced (below).
                     let mut ahead = sampler.clone();

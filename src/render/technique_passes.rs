@@ -36,6 +36,7 @@ impl MultiPassVisitor for MultiPass<'_> {
                 0,
                 1,
                 false,
+                settings.sampler,
                 |scene, ray, _, pixel, sampler, c| {
                     estimator.radiance(scene, &pass, ray, pixel, sampler, c)
                 },
@@ -98,6 +99,7 @@ impl SolverVisitor for SolverPass<'_> {
             0,
             1,
             spp == 1,
+            solver.display_sampler().unwrap_or(session.settings.sampler),
             |scene, ray, _, _, sampler, c| solver.radiance(scene, typed, ray, sampler, c),
         );
         (first + spp, u64::from(self.k))
