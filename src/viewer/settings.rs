@@ -60,6 +60,11 @@ impl Config {
                 format!("path d{} {:?}", i.max_depth, i.strategy).to_lowercase()
             }
             IntegratorKind::Light => format!("light d{}", i.max_depth),
+            IntegratorKind::Radiosity => format!(
+                "radiosity {} {}",
+                i.radiosity_solver.name(),
+                i.radiosity_display.name()
+            ),
             // Techniques without a label of their own.
             #[allow(unreachable_patterns)]
             other => other.name().to_string(),
@@ -86,7 +91,15 @@ impl Config {
         } else {
             ""
         };
-        format!("{estimator} {}{partial}{adaptive}", self.sampler.name())
+        // Lookup displays of radiosity antialias with Sobol points.
+        let lookup = i.kind == IntegratorKind::Radiosity
+            && i.radiosity_display != crate::integrator::radiosity::RadiosityDisplay::Gather;
+        let sampler = if lookup {
+            SamplerKind::Sobol
+        } else {
+            self.sampler
+        };
+        format!("{estimator} {}{partial}{adaptive}", sampler.name())
     }
 }
 
