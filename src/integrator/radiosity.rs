@@ -431,7 +431,7 @@ impl Radiosity {
                 Model::Matrix(m) => {
                     m.vertex_radiance = m.mesh.vertex_radiance(&m.solution.radiance)
                 }
-                Model::Hierarchical(h) => h.smooth(),
+                Model::Hierarchical(h) => h.smooth(&scene.geometry),
             }
         }
         let (elements, links) = state.counts();

@@ -232,6 +232,22 @@ pub fn element_to_element(
     }
 }
 
+/// The share of `n` shadow rays from the point `x` (normal `normal`) to
+/// stratified points of `j` that arrive: visibility at a point, where a
+/// link's share is the mean over its gatherer.
+pub fn point_visibility(geometry: &Geometry, x: Vec3A, normal: Vec3A, j: &Element, n: u32) -> f32 {
+    let mut on_j = Sampler::new(SamplerKind::Stratified, 0x5eed_0002, n);
+    let x_error = gamma(7) * x.abs();
+    let mut visible = 0;
+    for k in 0..n {
+        on_j.start(0, k);
+        let (y, y_error) = point_on(j, on_j.next_2d());
+        let ray = ray_between(x, x_error, normal, y, y_error, j.normal);
+        visible += u32::from(!geometry.occluded(&ray));
+    }
+    visible as f32 / n as f32
+}
+
 /// What [`element_to_element`] found.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Exchange {

@@ -128,11 +128,11 @@ fn gradient(e: &Element, samples: impl Iterator<Item = (Vec3A, Rgb)>) -> [Vec3A;
     [0, 1, 2].map(|c| gx[c] * t + gy[c] * b)
 }
 
-type VertexKey = ([u32; 3], [i32; 3], [u32; 3]);
+pub(crate) type VertexKey = ([u32; 3], [i32; 3], [u32; 3]);
 
 /// A vertex's position (exact bits), its element's plane orientation and
 /// emission, as a hash key.
-fn vertex_key(v: Vec3A, e: &Element) -> VertexKey {
+pub(crate) fn vertex_key(v: Vec3A, e: &Element) -> VertexKey {
     let q = |x: f32| (x * 1024.0).round() as i32;
     let n = e.normal;
     (
