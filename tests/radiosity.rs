@@ -421,3 +421,61 @@ fn cornell_wall_means_agree_with_photons_and_the_peer() {
         }
     }
 }
+
+/// Hierarchical radiosity against Mitsuba's path-traced Cornell box, as the
+/// issue measured the peer: the smooth display at 16 rays per pixel, the
+/// pixels that see the light (reference above 1) left out. Solve and display
+/// are deterministic (fixed seeds, any thread count), so the bounds are the
+/// measured figures with room for rounding, not a variance: ε 3e-5 measures
+/// masked RMSE 0.00218 (the issue's goal 0.0022) and a mean 0.4-0.5% low;
+/// the bound 0.0024 fails the display before vertex visibility (0.00264)
+/// and the same image 1% darker (0.00261).
+#[test]
+fn hierarchical_radiosity_matches_mitsuba_on_the_cornell_box() {
+    use std::sync::Arc;
+    use tracelab::render::{RenderSettings, Session};
+    let scene = crate::common::cornell_box();
+    let options = IntegratorOptions {
+        kind: IntegratorKind::Radiosity,
+        radiosity_solver: RadiositySolver::Hierarchical,
+        radiosity_epsilon: 3e-5,
+        patch_size: 0.005,
+        radiosity_display: tracelab::integrator::radiosity::RadiosityDisplay::Smooth,
+        ..IntegratorOptions::default()
+    };
+    let settings = RenderSettings {
+        integrator: options.build(),
+        sampler: tracelab::sampling::SamplerKind::Independent,
+        seed: 0,
+        planned_spp: 0,
+        threads: 0,
+        adaptive: None,
+        domains: Default::default(),
+        clamp: None,
+    };
+    let session = Session::new(Arc::new(scene), settings).expect("session starts");
+    while session.render_pass(64) {
+        if session.stats().solver.is_some_and(|p| p.converged) {
+            break;
+        }
+    }
+    let image = session.snapshot().image;
+    let reference = crate::common::reference("cornell_box_path_ref.exr");
+    let (mut squared, mut kept) = (0.0f64, 0usize);
+    for (p, r) in image.pixels.iter().zip(&reference.pixels) {
+        if r.iter().all(|&v| v <= 1.0) {
+            squared += (0..3).map(|c| ((p[c] - r[c]) as f64).powi(2)).sum::<f64>() / 3.0;
+            kept += 1;
+        }
+    }
+    let masked = (squared / kept as f64).sqrt();
+    let (mean, expected) = (image.mean(), reference.mean());
+    eprintln!("hierarchical ε 3e-5: masked RMSE {masked:.5}, mean {mean:?} vs {expected:?}");
+    assert!(masked < 0.0024, "masked RMSE {masked}");
+    for c in 0..3 {
+        assert!(
+            (mean[c] / expected[c] - 1.0).abs() < 0.01,
+            "{mean:?} vs {expected:?}"
+        );
+    }
+}

@@ -183,8 +183,8 @@ fn rmse(image: &Image, reference: &Image, mask_above: f32) -> (f64, f64, usize) 
 }
 
 /// One row of `tracelab radiosity`: steps, elements, links, shadow rays,
-/// bytes, solve seconds, residual, RMSE, masked RMSE.
-type Row = (u64, u64, u64, u64, u64, f64, f64, f64, f64);
+/// bytes, solve seconds, residual, RMSE, masked RMSE, display seconds.
+type Row = (u64, u64, u64, u64, u64, f64, f64, f64, f64, f64);
 
 /// Solves with `options`, printing and returning a row after each pass.
 fn run(
@@ -205,8 +205,17 @@ fn run(
     };
     let session = Session::new(scene, settings)?;
     println!(
-        "{:>7} {:>9} {:>11} {:>9} {:>9} {:>9} {:>11} {:>9} {:>13}",
-        "steps", "elements", "links", "rays M", "MB", "solve s", "residual", "RMSE", "masked RMSE"
+        "{:>7} {:>9} {:>11} {:>9} {:>9} {:>9} {:>10} {:>11} {:>9} {:>13}",
+        "steps",
+        "elements",
+        "links",
+        "rays M",
+        "MB",
+        "solve s",
+        "display s",
+        "residual",
+        "RMSE",
+        "masked RMSE"
     );
     let mut rows = Vec::new();
     drive_solver(&session, |stats, progress| {
@@ -214,13 +223,14 @@ fn run(
         // The solver's own time (form factors included), without drawing the image.
         let seconds = progress.solve_seconds;
         println!(
-            "{:>7} {:>9} {:>11} {:>9.2} {:>9.1} {:>9.3} {:>11.3e} {:>9.5} {:>13.5}",
+            "{:>7} {:>9} {:>11} {:>9.2} {:>9.1} {:>9.3} {:>10.3} {:>11.3e} {:>9.5} {:>13.5}",
             progress.steps,
             progress.elements,
             progress.links,
             stats.rays.shadow as f64 * 1e-6,
             progress.memory as f64 * 1e-6,
             seconds,
+            progress.display_seconds,
             progress.residual,
             all,
             masked
@@ -235,6 +245,7 @@ fn run(
             progress.residual,
             all,
             masked,
+            progress.display_seconds,
         ));
     })?;
     Ok(rows)
@@ -283,11 +294,14 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
     };
     if let Some(path) = &args.csv {
         let mut text = String::from(
-            "steps,elements,links,shadow_rays,bytes,solve_seconds,residual,rmse,masked_rmse\n",
+            "steps,elements,links,shadow_rays,bytes,solve_seconds,display_seconds,residual,rmse,\
+             masked_rmse\n",
         );
-        for (steps, elements, links, rays, bytes, seconds, residual, all, masked) in &rows {
+        for (steps, elements, links, rays, bytes, seconds, residual, all, masked, display) in &rows
+        {
             text.push_str(&format!(
-                "{steps},{elements},{links},{rays},{bytes},{seconds},{residual},{all},{masked}\n"
+                "{steps},{elements},{links},{rays},{bytes},{seconds},{display},{residual},{all},\
+                 {masked}\n"
             ));
         }
         tracelab::image::write_atomically(path, |tmp| {

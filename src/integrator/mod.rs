@@ -234,6 +234,9 @@ pub struct SolverProgress {
     pub memory: u64,
     /// Seconds spent setting up and solving so far, without drawing images.
     pub solve_seconds: f64,
+    /// Seconds spent preparing the display from the solution so far (the
+    /// smooth display's vertex values), without drawing images.
+    pub display_seconds: f64,
 }
 
 /// What a session can say about a technique's error without a reference.

@@ -159,8 +159,10 @@ pub struct RadiosityState {
     /// Adaptive subdivision rounds done, and whether another would change nothing.
     rounds: u32,
     settled: bool,
-    /// Seconds spent setting up (form factors, initial links) and in steps.
+    /// Seconds spent setting up (form factors, initial links) and in steps,
+    /// and preparing the display.
     solve_seconds: f64,
+    display_seconds: f64,
 }
 
 impl RadiosityState {
@@ -244,7 +246,11 @@ impl Solver for Radiosity {
         let start = std::time::Instant::now();
         let mut progress = self.solve(scene, state, steps, counts);
         state.solve_seconds += start.elapsed().as_secs_f64();
+        let start = std::time::Instant::now();
+        self.prepare_display(scene, state);
+        state.display_seconds += start.elapsed().as_secs_f64();
         progress.solve_seconds = state.solve_seconds;
+        progress.display_seconds = state.display_seconds;
         progress
     }
 
@@ -349,6 +355,7 @@ impl Radiosity {
                 rounds: 0,
                 settled: true,
                 solve_seconds: 0.0,
+                display_seconds: 0.0,
             });
         }
         let mesh = Mesh::build(scene, self.patch_size, MAX_ELEMENTS).map_err(crate::Error::new)?;
@@ -376,7 +383,20 @@ impl Radiosity {
             rounds: 0,
             settled: self.adaptive_rounds == 0,
             solve_seconds: 0.0,
+            display_seconds: 0.0,
         })
+    }
+
+    /// The smooth display's vertex values of the current solution.
+    fn prepare_display(&self, scene: &Scene, state: &mut RadiosityState) {
+        if self.display == RadiosityDisplay::Smooth {
+            match &mut state.model {
+                Model::Matrix(m) => {
+                    m.vertex_radiance = m.mesh.vertex_radiance(&m.solution.radiance)
+                }
+                Model::Hierarchical(h) => h.smooth(&scene.geometry),
+            }
+        }
     }
 
     /// Up to `steps` sweeps or shots, with adaptive rounds between solves.
@@ -426,14 +446,6 @@ impl Radiosity {
                 }
             }
         }
-        if self.display == RadiosityDisplay::Smooth {
-            match &mut state.model {
-                Model::Matrix(m) => {
-                    m.vertex_radiance = m.mesh.vertex_radiance(&m.solution.radiance)
-                }
-                Model::Hierarchical(h) => h.smooth(&scene.geometry),
-            }
-        }
         let (elements, links) = state.counts();
         SolverProgress {
             steps: state.steps,
@@ -443,6 +455,7 @@ impl Radiosity {
             links: links as u64,
             memory: state.memory_bytes() as u64,
             solve_seconds: 0.0,
+            display_seconds: 0.0,
         }
     }
 

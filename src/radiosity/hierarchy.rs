@@ -86,6 +86,10 @@ pub struct Hierarchy {
     /// Smooth display: per node, its vertices' radiance (leaves only; set
     /// by [`Hierarchy::smooth`]).
     vertex_radiance: Vec<[Rgb; 3]>,
+    /// Per node, the radiance the last step gathered from (children made
+    /// since take their parent's), so that the smooth display's gather
+    /// shows the same bounce as the leaves: one step is direct light.
+    gathered_from: Vec<Rgb>,
 }
 
 /// A link through a shadow boundary is refined while its transfer exceeds
@@ -187,6 +191,7 @@ impl Hierarchy {
             notes: Vec::new(),
             budget_spent: false,
             vertex_radiance: Vec::new(),
+            gathered_from: Vec::new(),
         };
         if specular > 0 {
             h.notes.push(format!(
@@ -223,7 +228,10 @@ impl Hierarchy {
     /// Bytes the nodes and links take.
     pub fn memory_bytes(&self) -> usize {
         let (_, links) = self.counts();
-        self.nodes.len() * std::mem::size_of::<Node>() + links * std::mem::size_of::<Link>()
+        self.nodes.len() * std::mem::size_of::<Node>()
+            + links * std::mem::size_of::<Link>()
+            + self.gathered_from.len() * std::mem::size_of::<Rgb>()
+            + self.vertex_radiance.len() * std::mem::size_of::<[Rgb; 3]>()
     }
 
     /// The oracle: a bound on the light a link from q to p carries, and so
@@ -295,6 +303,9 @@ impl Hierarchy {
             });
         }
         self.nodes[k as usize].children = first;
+        if let Some(&from) = self.gathered_from.get(k as usize) {
+            self.gathered_from.extend([from; 4]);
+        }
         Some(first)
     }
 
@@ -388,6 +399,9 @@ impl Hierarchy {
     /// (area-weighted, over the emitted power).
     pub fn step(&mut self, geometry: &Geometry) -> f64 {
         self.steps += 1;
+        self.gathered_from.clear();
+        self.gathered_from
+            .extend(self.nodes.iter().map(|n| n.radiance));
         let gathered: Vec<Rgb> = self
             .nodes
             .par_iter()
@@ -505,7 +519,8 @@ impl Hierarchy {
                         } else {
                             link.visibility
                         };
-                        irradiance += (visibility * f) * q.radiance;
+                        let from = self.gathered_from.get(link.source as usize);
+                        irradiance += (visibility * f) * from.copied().unwrap_or(q.radiance);
                     }
                     a = parent[a as usize];
                 }
