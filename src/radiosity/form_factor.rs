@@ -180,7 +180,10 @@ pub fn element_to_element(
     let mut on_i = Sampler::new(SamplerKind::Stratified, 0x5eed, n);
     let mut on_j = Sampler::new(SamplerKind::Stratified, 0x5eed_0001, n);
     let mut sum = 0.0f64;
-    let (mut rays, mut visible) = (0, 0);
+    // Pairs that j's back faces count as tested and dark: the link is then
+    // partly visible, so refinement and the smooth display's vertex rays
+    // find the edge of j's plane (a block standing on the floor).
+    let (mut rays, mut visible, mut behind) = (0, 0, 0);
     for k in 0..n {
         on_i.start(key_i, k);
         on_j.start(key_pair, k);
@@ -207,6 +210,13 @@ pub fn element_to_element(
                 }
             },
             FormFactorMethod::Analytic => {
+                // j is one-sided: from behind its plane (a floor point under
+                // a block, behind the block's side) it sends nothing. The
+                // contour integral clips to x's hemisphere only.
+                if j.normal.dot(x - j.vertices[0]) <= 0.0 {
+                    behind += 1;
+                    continue;
+                }
                 let (y, y_error) = point_on(j, u_j);
                 (point_to_polygon(x, i.normal, &j.vertices), y, y_error)
             }
@@ -224,10 +234,10 @@ pub fn element_to_element(
     Exchange {
         f: (sum / f64::from(n)) as f32,
         rays,
-        visibility: if rays == 0 {
+        visibility: if rays + behind == 0 {
             1.0
         } else {
-            visible as f32 / rays as f32
+            visible as f32 / (rays + behind) as f32
         },
     }
 }

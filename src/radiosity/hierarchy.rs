@@ -510,6 +510,10 @@ impl Hierarchy {
                 while a != NONE {
                     for link in &self.nodes[a as usize].links {
                         let q = &self.nodes[link.source as usize];
+                        // One-sided sources send nothing behind their plane.
+                        if q.element.normal.dot(x - q.element.vertices[0]) <= 0.0 {
+                            continue;
+                        }
                         let f = point_to_polygon(x, e.normal, &q.element.vertices);
                         // Through a shadow boundary the link's mean is not
                         // the vertex's: a leaf half behind the light gave
