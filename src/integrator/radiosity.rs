@@ -163,6 +163,9 @@ pub struct RadiosityState {
     /// and preparing the display.
     solve_seconds: f64,
     display_seconds: f64,
+    /// Steps and elements the display was last prepared for: a converged
+    /// solution's further passes only add samples to its image.
+    displayed: Option<(u64, usize)>,
 }
 
 impl RadiosityState {
@@ -356,6 +359,7 @@ impl Radiosity {
                 settled: true,
                 solve_seconds: 0.0,
                 display_seconds: 0.0,
+                displayed: None,
             });
         }
         let mesh = Mesh::build(scene, self.patch_size, MAX_ELEMENTS).map_err(crate::Error::new)?;
@@ -384,12 +388,15 @@ impl Radiosity {
             settled: self.adaptive_rounds == 0,
             solve_seconds: 0.0,
             display_seconds: 0.0,
+            displayed: None,
         })
     }
 
     /// The smooth display's vertex values of the current solution.
     fn prepare_display(&self, scene: &Scene, state: &mut RadiosityState) {
-        if self.display == RadiosityDisplay::Smooth {
+        let key = (state.steps, state.counts().0);
+        if self.display == RadiosityDisplay::Smooth && state.displayed != Some(key) {
+            state.displayed = Some(key);
             match &mut state.model {
                 Model::Matrix(m) => {
                     m.vertex_radiance = m.mesh.vertex_radiance(&m.solution.radiance)
