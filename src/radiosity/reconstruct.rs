@@ -8,8 +8,9 @@
 //! takes the area-weighted mean of its elements' planes there: exact for a
 //! linear field, so the error falls as the element size squared, and shared
 //! by every element at the vertex, so the image has no cracks (bar the
-//! T-vertices of a hierarchy, where the coarser element interpolates its own
-//! corners).
+//! T-vertices of an adaptive mesh, where the coarser element interpolates
+//! its own corners). Hierarchies gather their vertices over their links
+//! instead ([`super::hierarchy::Hierarchy::smooth`]).
 
 use super::mesh::Element;
 use crate::math::Rgb;
@@ -21,9 +22,7 @@ use std::collections::HashMap;
 /// computed alike on both sides of an edge), lie in the same plane (walls
 /// meeting at a corner keep their own values) and emit alike (a light's edge
 /// is a true discontinuity).
-pub fn vertex_radiance<'a>(
-    elements: impl Iterator<Item = (&'a Element, Rgb)> + Clone,
-) -> Vec<[Rgb; 3]> {
+pub fn vertex_radiance<'a>(elements: impl Iterator<Item = (&'a Element, Rgb)>) -> Vec<[Rgb; 3]> {
     let elements: Vec<(&Element, Rgb)> = elements.collect();
     let mut at_vertex: HashMap<VertexKey, Vec<u32>> = HashMap::new();
     for (k, (e, _)) in elements.iter().enumerate() {
@@ -74,7 +73,7 @@ pub fn vertex_radiance<'a>(
 /// vertex) over the elements that share each vertex: one value per vertex,
 /// so the interpolated image has no cracks. Negative means (a plane past a
 /// sharp shadow edge) are clamped to zero.
-pub fn shared_mean<'a>(
+fn shared_mean<'a>(
     elements: impl Iterator<Item = &'a Element> + Clone,
     values: &[[Rgb; 3]],
 ) -> Vec<[Rgb; 3]> {
