@@ -6,6 +6,7 @@
 //! the solution changes fast between neighbours, so each patch keeps a
 //! quadtree of its elements.
 
+use super::reconstruct::vertex_key;
 use crate::math::Rgb;
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
@@ -260,8 +261,9 @@ impl Mesh {
     /// radiance L - E differs from a neighbour's by more than `tolerance`
     /// times the area-weighted mean over the mesh, in any colour channel
     /// (the red and green walls' gradients hardly show in luminance).
-    /// Neighbours share a vertex and lie in the same plane (walls meeting at
-    /// a corner may differ); across a T-vertex only the elements that have
+    /// Neighbours are the smooth display's ([`super::reconstruct`]): they
+    /// share a vertex, lie in the same plane (walls meeting at a corner may
+    /// differ) and emit alike; across a T-vertex only the elements that have
     /// it count.
     pub fn steep(&self, radiance: &[Rgb], tolerance: f32) -> Vec<bool> {
         use std::collections::HashMap;
@@ -282,7 +284,7 @@ impl Mesh {
         let mut range: HashMap<_, (Rgb, Rgb)> = HashMap::new();
         for (e, &l) in self.elements.iter().zip(&reflected) {
             for v in e.vertices {
-                let r = range.entry(vertex_key(v, e.normal)).or_insert((l, l));
+                let r = range.entry(vertex_key(v, e)).or_insert((l, l));
                 *r = (r.0.min(l), r.1.max(l));
             }
         }
@@ -292,7 +294,7 @@ impl Mesh {
             .iter()
             .map(|e| {
                 e.vertices.iter().any(|&v| {
-                    let (low, high) = range[&vertex_key(v, e.normal)];
+                    let (low, high) = range[&vertex_key(v, e)];
                     (high - low).cmpgt(limit).any()
                 })
             })
@@ -323,13 +325,6 @@ impl Mesh {
             }
         }
     }
-}
-
-/// A vertex's position (exactly: midpoints are computed alike on both sides
-/// of an edge) and its element's plane orientation, as a hash key.
-fn vertex_key(v: Vec3A, n: Vec3A) -> ([u32; 3], [i32; 3]) {
-    let q = |x: f32| (x * 1024.0).round() as i32;
-    (v.to_array().map(f32::to_bits), [q(n.x), q(n.y), q(n.z)])
 }
 
 /// The four children of triangle `v` by midpoint subdivision: corner
