@@ -462,8 +462,6 @@ fn cornell_wall_means_agree_with_photons_and_the_peer() {
 /// and the same image 1% darker (0.00261).
 #[test]
 fn hierarchical_radiosity_matches_mitsuba_on_the_cornell_box() {
-    use std::sync::Arc;
-    use tracelab::render::{RenderSettings, Session};
     let scene = crate::common::cornell_box();
     let options = IntegratorOptions {
         kind: IntegratorKind::Radiosity,
@@ -473,23 +471,22 @@ fn hierarchical_radiosity_matches_mitsuba_on_the_cornell_box() {
         radiosity_display: tracelab::integrator::radiosity::RadiosityDisplay::Smooth,
         ..IntegratorOptions::default()
     };
-    let settings = RenderSettings {
-        integrator: options.build(),
-        sampler: tracelab::sampling::SamplerKind::Independent,
-        seed: 0,
-        planned_spp: 0,
-        threads: 0,
-        adaptive: None,
-        domains: Default::default(),
-        clamp: None,
-    };
-    let session = Session::new(Arc::new(scene), settings).expect("session starts");
-    while session.render_pass(64) {
-        if session.stats().solver.is_some_and(|p| p.converged) {
-            break;
-        }
-    }
-    let image = session.snapshot().image;
+    // One pass of up to 64 steps: the solve converges in 22.
+    let (snapshot, stats) = crate::common::render_with(
+        scene,
+        options.build(),
+        tracelab::sampling::SamplerKind::Independent,
+        64,
+        0,
+        0,
+        64,
+    );
+    assert!(
+        stats.solver.is_some_and(|p| p.converged),
+        "{:?}",
+        stats.solver
+    );
+    let image = snapshot.image;
     let reference = crate::common::reference("cornell_box_path_ref.exr");
     let (mut squared, mut kept) = (0.0f64, 0usize);
     for (p, r) in image.pixels.iter().zip(&reference.pixels) {
