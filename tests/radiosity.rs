@@ -488,14 +488,7 @@ fn hierarchical_radiosity_matches_mitsuba_on_the_cornell_box() {
     );
     let image = snapshot.image;
     let reference = crate::common::reference("cornell_box_path_ref.exr");
-    let (mut squared, mut kept) = (0.0f64, 0usize);
-    for (p, r) in image.pixels.iter().zip(&reference.pixels) {
-        if r.iter().all(|&v| v <= 1.0) {
-            squared += (0..3).map(|c| ((p[c] - r[c]) as f64).powi(2)).sum::<f64>() / 3.0;
-            kept += 1;
-        }
-    }
-    let masked = (squared / kept as f64).sqrt();
+    let masked = masked_rmse(&image, &reference);
     let (mean, expected) = (image.mean(), reference.mean());
     eprintln!("hierarchical ε 3e-5: masked RMSE {masked:.5}, mean {mean:?} vs {expected:?}");
     assert!(masked < 0.0024, "masked RMSE {masked}");
@@ -505,4 +498,50 @@ fn hierarchical_radiosity_matches_mitsuba_on_the_cornell_box() {
             "{mean:?} vs {expected:?}"
         );
     }
+}
+
+/// RMSE over the pixels whose reference stays at or below 1 in every
+/// channel: all but the 444 that see the light.
+fn masked_rmse(image: &tracelab::image::Image, reference: &tracelab::image::Image) -> f64 {
+    let (mut squared, mut kept) = (0.0f64, 0usize);
+    for (p, r) in image.pixels.iter().zip(&reference.pixels) {
+        if r.iter().all(|&v| v <= 1.0) {
+            squared += (0..3).map(|c| ((p[c] - r[c]) as f64).powi(2)).sum::<f64>() / 3.0;
+            kept += 1;
+        }
+    }
+    (squared / kept as f64).sqrt()
+}
+
+/// One step of hierarchical radiosity is direct light: against Mitsuba's
+/// direct-only Cornell box (the goal 0.0021, the peer's figure with
+/// 1 304 leaves). Deterministic like the test above; ε 1e-4 measures 0.00137.
+/// The corner pixel the light covers 5.5% of (reference 0.945) took 0.0026
+/// of RMSE on its own when the display sampled the light's edge instead of
+/// adding the pixel's exact share of it, so the bound fails that display.
+#[test]
+fn one_hierarchical_step_matches_mitsuba_direct_light() {
+    let scene = crate::common::cornell_box();
+    let options = IntegratorOptions {
+        kind: IntegratorKind::Radiosity,
+        radiosity_solver: RadiositySolver::Hierarchical,
+        radiosity_epsilon: 1e-4,
+        patch_size: 0.005,
+        radiosity_display: tracelab::integrator::radiosity::RadiosityDisplay::Smooth,
+        ..IntegratorOptions::default()
+    };
+    let (snapshot, stats) = crate::common::render_with(
+        scene,
+        options.build(),
+        tracelab::sampling::SamplerKind::Independent,
+        1,
+        0,
+        0,
+        1,
+    );
+    assert_eq!(stats.solver.map(|p| p.steps), Some(1));
+    let reference = crate::common::reference("cornell_box_direct_ref.exr");
+    let masked = masked_rmse(&snapshot.image, &reference);
+    eprintln!("hierarchical ε 1e-4, one step: masked RMSE {masked:.5}");
+    assert!(masked < 0.0021, "masked RMSE {masked}");
 }

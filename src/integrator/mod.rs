@@ -195,12 +195,14 @@ pub trait Solver: Technique {
         steps: u32,
         counts: &mut RayCounts,
     ) -> SolverProgress;
-    /// One radiance sample of the current solution along a camera ray.
+    /// One radiance sample of the current solution along a camera ray of
+    /// `pixel` (whose seen emission, where known, the display adds itself).
     fn radiance(
         &self,
         scene: &Scene,
         state: &Self::State,
         ray: Ray,
+        pixel: PrimaryPixel<'_>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb;

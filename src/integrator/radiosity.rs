@@ -33,6 +33,7 @@ use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
+use crate::shortcuts::PrimaryPixel;
 
 /// Most elements (the form factor matrix of 16 384 elements takes 1 GiB).
 pub const MAX_ELEMENTS: usize = 16_384;
@@ -262,10 +263,44 @@ impl Solver for Radiosity {
         scene: &Scene,
         state: &RadiosityState,
         ray: Ray,
+        pixel: PrimaryPixel<'_>,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
-        let mut ray = ray;
+        // As in the path tracer: where the pixel's share of a light is known
+        // exactly, it is added here and the camera ray's own hit on the light
+        // adds no emission. Cornell box, hierarchical ε 3e-5, one step
+        // against the direct reference: masked RMSE 0.00278 -> 0.00105; 92%
+        // of it was one pixel at the light's corner that no point saw lit.
+        let seen = pixel.seen_emission;
+        let looked_up = self.look_up(scene, state, ray, seen.is_some(), sampler, counts);
+        looked_up + seen.unwrap_or(Rgb::ZERO)
+    }
+
+    fn display_spp(&self) -> u32 {
+        16
+    }
+
+    /// Flat and smooth displays look the solution up: only edges are noisy.
+    /// Cornell box, ε 3e-6, smooth: masked RMSE 0.00216 with independent
+    /// pixel samples, 0.00174 with these.
+    fn display_sampler(&self) -> Option<SamplerKind> {
+        (self.display != RadiosityDisplay::Gather).then_some(SamplerKind::Sobol)
+    }
+}
+
+impl Radiosity {
+    /// The solution seen along a camera ray, through mirrors and glass;
+    /// `seen_known`: the first hit's emission is accounted for elsewhere.
+    fn look_up(
+        &self,
+        scene: &Scene,
+        state: &RadiosityState,
+        mut ray: Ray,
+        seen_known: bool,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
         let mut weight = Rgb::ONE;
         let mut travelled = 0.0;
         for depth in 0..=SPECULAR_DEPTH {
@@ -297,7 +332,9 @@ impl Solver for Radiosity {
                     if self.wireframe && on_edge(scene, &surface, travelled) {
                         return weight * level_colour(surface.level);
                     }
-                    let seen_emission = if e.normal.dot(ray.direction) < 0.0 {
+                    let seen_emission = if depth == 0 && seen_known {
+                        Rgb::ZERO
+                    } else if e.normal.dot(ray.direction) < 0.0 {
                         e.emission
                     } else {
                         Rgb::ZERO
@@ -327,19 +364,6 @@ impl Solver for Radiosity {
         Rgb::ZERO
     }
 
-    fn display_spp(&self) -> u32 {
-        16
-    }
-
-    /// Flat and smooth displays look the solution up: only edges are noisy.
-    /// Cornell box, ε 3e-6, smooth: masked RMSE 0.00216 with independent
-    /// pixel samples, 0.00174 with these.
-    fn display_sampler(&self) -> Option<SamplerKind> {
-        (self.display != RadiosityDisplay::Gather).then_some(SamplerKind::Sobol)
-    }
-}
-
-impl Radiosity {
     /// The model: a mesh and its form factors, or the hierarchy.
     fn build(&self, scene: &Scene) -> crate::Result<RadiosityState> {
         if self.solver.matrix().is_none() {

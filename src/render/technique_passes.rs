@@ -100,7 +100,9 @@ impl SolverVisitor for SolverPass<'_> {
             1,
             spp == 1,
             solver.display_sampler().unwrap_or(session.settings.sampler),
-            |scene, ray, _, _, sampler, c| solver.radiance(scene, typed, ray, sampler, c),
+            |scene, ray, pixel, _, sampler, c| {
+                solver.radiance(scene, typed, ray, pixel, sampler, c)
+            },
         );
         (first + spp, u64::from(self.k))
     }

@@ -107,7 +107,15 @@ impl Solver for Halving {
             ..SolverProgress::default()
         }
     }
-    fn radiance(&self, _: &Scene, x: &f64, _: Ray, _: &mut Sampler, _: &mut RayCounts) -> Rgb {
+    fn radiance(
+        &self,
+        _: &Scene,
+        x: &f64,
+        _: Ray,
+        _: PrimaryPixel<'_>,
+        _: &mut Sampler,
+        _: &mut RayCounts,
+    ) -> Rgb {
         Rgb::splat(*x as f32)
     }
     fn display_spp(&self) -> u32 {
