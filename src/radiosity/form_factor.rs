@@ -114,6 +114,57 @@ fn point_on(element: &Element, u: Vec2) -> (Vec3A, Vec3A) {
     (a + e1 + e2, gamma(7) * (a.abs() + e1.abs() + e2.abs()))
 }
 
+/// A uniform point of the part of `j` in front of the plane through `x`
+/// with normal `normal`, and its error bound; `None` where no part is.
+/// Visibility sampled over all of j would count j's hidden part twice when
+/// the contour integral has already clipped it away: a block's side
+/// gathering from a floor element half under the block saw half its light.
+fn point_in_front(x: Vec3A, normal: Vec3A, j: &Element, u: Vec2) -> Option<(Vec3A, Vec3A)> {
+    let height = j.vertices.map(|v| normal.dot(v - x));
+    if height.iter().all(|&h| h > 0.0) {
+        return Some(point_on(j, u));
+    }
+    let mut clipped = [Vec3A::ZERO; 4];
+    let mut count = 0;
+    for a in 0..3 {
+        let b = (a + 1) % 3;
+        if height[a] > 0.0 {
+            clipped[count] = j.vertices[a];
+            count += 1;
+        }
+        if (height[a] > 0.0) != (height[b] > 0.0) {
+            let t = height[a] / (height[a] - height[b]);
+            clipped[count] = j.vertices[a] + t * (j.vertices[b] - j.vertices[a]);
+            count += 1;
+        }
+    }
+    let area = |a: Vec3A, b: Vec3A, c: Vec3A| (b - a).cross(c - a).length();
+    let [p0, p1, p2, p3] = clipped;
+    let (mut u, triangle) = match count {
+        3 => (u, [p0, p1, p2]),
+        4 => {
+            let (first, second) = (area(p0, p1, p2), area(p0, p2, p3));
+            let share = first / (first + second);
+            if !share.is_finite() {
+                return None;
+            }
+            if u.x < share {
+                (Vec2::new(u.x / share, u.y), [p0, p1, p2])
+            } else {
+                (Vec2::new((u.x - share) / (1.0 - share), u.y), [p0, p2, p3])
+            }
+        }
+        _ => return None,
+    };
+    u = u.min(Vec2::splat(1.0 - f32::EPSILON / 2.0));
+    let b = square_to_uniform_triangle(u);
+    let [a, v1, v2] = triangle;
+    let y = a + b.x * (v1 - a) + b.y * (v2 - a);
+    // The clipped corners are j's plane to a few more roundings.
+    let scale = j.vertices[0].abs() + j.vertices[1].abs() + j.vertices[2].abs();
+    Some((y, gamma(12) * scale))
+}
+
 /// A direction from `x` towards `j`, nearly proportional to the cosine at x
 /// (`i_normal`) within the solid angle j subtends, 1 / its density (the
 /// solid angle where the sampling is uniform), and the point of `j` the
@@ -217,7 +268,9 @@ pub fn element_to_element(
                     behind += 1;
                     continue;
                 }
-                let (y, y_error) = point_on(j, u_j);
+                let Some((y, y_error)) = point_in_front(x, i.normal, j, u_j) else {
+                    continue;
+                };
                 (point_to_polygon(x, i.normal, &j.vertices), y, y_error)
             }
         };
@@ -251,7 +304,9 @@ pub fn point_visibility(geometry: &Geometry, x: Vec3A, normal: Vec3A, j: &Elemen
     let mut visible = 0;
     for k in 0..n {
         on_j.start(0, k);
-        let (y, y_error) = point_on(j, on_j.next_2d());
+        let Some((y, y_error)) = point_in_front(x, normal, j, on_j.next_2d()) else {
+            return 0.0;
+        };
         let ray = ray_between(x, x_error, normal, y, y_error, j.normal);
         visible += u32::from(!geometry.occluded(&ray));
     }
