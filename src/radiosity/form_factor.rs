@@ -295,6 +295,50 @@ pub fn element_to_element(
     }
 }
 
+/// The share of element `e` from which light can leave: of `n` stratified
+/// points, those where one of up to four cosine-distributed rays escapes or
+/// meets a surface from its front. A floor point under a block sees only the
+/// block's inside (back faces) and counts as hidden; so does the ceiling
+/// behind a light hung just below it. Returns the share and the rays cast.
+pub fn exposure(geometry: &Geometry, e: &Element, n: u32) -> (f32, u32) {
+    let mut on_e = Sampler::new(SamplerKind::Stratified, 0x5eed_0003, n);
+    let (mut exposed, mut rays) = (0, 0);
+    for k in 0..n {
+        on_e.start(0, k);
+        let (x, x_error) = point_on(e, on_e.next_2d());
+        let (open, cast) = open_at(geometry, x, x_error, e.normal, on_e.next_2d());
+        exposed += u32::from(open);
+        rays += cast;
+    }
+    (exposed as f32 / n as f32, rays)
+}
+
+/// Whether light can leave the point `x` (error bound `x_error`, normal
+/// `normal`): one of four cosine-distributed rays, one per quadrant of the
+/// square jittered by `jitter`, escapes or meets a surface from its front.
+/// Returns that and the rays cast.
+pub fn open_at(
+    geometry: &Geometry,
+    x: Vec3A,
+    x_error: Vec3A,
+    normal: Vec3A,
+    jitter: Vec2,
+) -> (bool, u32) {
+    let frame = crate::math::Frame::from_normal(normal);
+    for d in 0..4 {
+        let u = (Vec2::new((d % 2) as f32, (d / 2) as f32) + jitter) * 0.5;
+        let w = frame.to_world(warp::square_to_cosine_hemisphere(u));
+        let origin = crate::math::offset_ray_origin(x, x_error, normal, w);
+        let open = geometry
+            .intersect(&crate::math::Ray::new(origin, w))
+            .is_none_or(|hit| hit.normal.dot(w) < 0.0);
+        if open {
+            return (true, d + 1);
+        }
+    }
+    (false, 4)
+}
+
 /// The share of `n` shadow rays from the point `x` (normal `normal`) to
 /// stratified points of `j` that arrive: visibility at a point, where a
 /// link's share is the mean over its gatherer.

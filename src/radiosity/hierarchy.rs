@@ -10,10 +10,15 @@
 //! gathers over every link (Jacobi), then pushes what a node gathered down
 //! to its leaves and pulls area-weighted radiance up ("push-pull"), then
 //! refines the links the new radiance makes too coarse. The cost is linear
-//! in the number of links instead of quadratic in the elements.
+//! in the number of links instead of quadratic in the elements. Parts of
+//! patches no light leaves (the floor under a block, the ceiling behind the
+//! light) are measured per node ([`exposure`]): a node sends its reflected
+//! light from its open part only, and keeps links that found it dark, since
+//! its open part may see through them.
 
 use super::form_factor::{
-    Exchange, FormFactorMethod, element_to_element, faces, point_to_polygon, point_visibility,
+    Exchange, FormFactorMethod, element_to_element, exposure, faces, open_at, point_to_polygon,
+    point_visibility,
 };
 use super::mesh::Element;
 use super::reconstruct::{VertexKey, vertex_key};
@@ -21,7 +26,7 @@ use crate::accel::Geometry;
 use crate::math::Rgb;
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
-use glam::Vec3A;
+use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -48,10 +53,18 @@ struct Node {
     gathered: Rgb,
     /// Radiance: emission plus reflected (leaves), area mean (inner nodes).
     radiance: Rgb,
+    /// The share of the node light can leave from ([`exposure`]); NaN until
+    /// measured.
+    exposure: f32,
     links: Vec<Link>,
 }
 
 const NONE: u32 = u32::MAX;
+/// Points per node for its exposure.
+const EXPOSURE_POINTS: u32 = 16;
+/// Below this exposure a node's reflected light is not spread further (it
+/// is nearly all hidden, and so is nearly all its light).
+const MIN_EXPOSURE: f32 = 1.0 / 16.0;
 /// Most patches (input triangles): their pairs are the initial links.
 const MAX_PATCHES: usize = 4096;
 /// Deepest level of a patch's tree.
@@ -87,9 +100,10 @@ pub struct Hierarchy {
     /// Smooth display: per node, its vertices' radiance (leaves only; set
     /// by [`Hierarchy::smooth`]).
     vertex_radiance: Vec<[Rgb; 3]>,
-    /// Per node, the radiance the last step gathered from (children made
-    /// since take their parent's), so that the smooth display's gather
-    /// shows the same bounce as the leaves: one step is direct light.
+    /// Per node, the radiance ([`Hierarchy::exitant`]) the last step
+    /// gathered from (children made since take their parent's), so that the
+    /// smooth display's gather shows the same bounce as the leaves: one step
+    /// is direct light.
     gathered_from: Vec<Rgb>,
 }
 
@@ -164,6 +178,7 @@ impl Hierarchy {
                 children: NONE,
                 gathered: Rgb::ZERO,
                 radiance: material.emission,
+                exposure: f32::NAN,
                 links: Vec::new(),
             });
         }
@@ -217,8 +232,41 @@ impl Hierarchy {
                 p != q && faces(&h.nodes[p as usize].element, &h.nodes[q as usize].element)
             })
             .collect();
+        h.measure_exposure(geometry);
         h.link(geometry, pairs);
         Ok(h)
+    }
+
+    /// The radiance node k sends: its reflected light spread over the part
+    /// light can leave from. A node's radiance is the mean over all of it,
+    /// hidden part included (no light reaches under a block), but what it
+    /// sends leaves from its exposed part alone; sent at the mean, the floor
+    /// around a block lit the block's base too little (its dark band, 28% of
+    /// the squared error at ε 1e-4).
+    fn exitant(&self, k: u32) -> Rgb {
+        let node = &self.nodes[k as usize];
+        let exposure = if node.exposure.is_nan() {
+            1.0
+        } else {
+            node.exposure.max(MIN_EXPOSURE)
+        };
+        node.element.emission + (node.radiance - node.element.emission) / exposure
+    }
+
+    /// Measures the exposure of nodes made since the last call, in parallel.
+    fn measure_exposure(&mut self, geometry: &Geometry) {
+        let new: Vec<u32> = (0..self.nodes.len() as u32)
+            .filter(|&k| self.nodes[k as usize].exposure.is_nan())
+            .collect();
+        let nodes = &self.nodes;
+        let measured: Vec<(f32, u32)> = new
+            .par_iter()
+            .map(|&k| exposure(geometry, &nodes[k as usize].element, EXPOSURE_POINTS))
+            .collect();
+        for (&k, (share, rays)) in new.iter().zip(measured) {
+            self.nodes[k as usize].exposure = share;
+            self.rays += u64::from(rays);
+        }
     }
 
     /// Leaves and links, for reports.
@@ -260,7 +308,7 @@ impl Hierarchy {
     /// relative to the emitted power.
     fn transfer(&self, p: u32, q: u32, f_max: f32) -> f32 {
         let e = &self.nodes[p as usize].element;
-        let light = luminance(e.reflectance * self.nodes[q as usize].radiance);
+        let light = luminance(e.reflectance * self.exitant(q));
         (light as f64 * f_max as f64 * e.area as f64 / self.emitted) as f32
     }
 
@@ -302,6 +350,7 @@ impl Hierarchy {
                 children: NONE,
                 gathered: Rgb::ZERO,
                 radiance: parent.radiance,
+                exposure: f32::NAN,
                 links: Vec::new(),
             });
         }
@@ -325,6 +374,7 @@ impl Hierarchy {
             for (p, q, forced) in pairs.drain(..) {
                 self.refine(p, q, forced, &mut pending);
             }
+            self.measure_exposure(geometry);
             let nodes = &self.nodes;
             let settings = self.settings;
             let exchanges: Vec<Exchange> = pending
@@ -351,7 +401,9 @@ impl Hierarchy {
                 let divisible = self.divisible(p) || self.divisible(q);
                 if self.too_coarse(p, &link) && divisible && !self.budget_spent {
                     pairs.push((p, q, true));
-                } else if x.f > 0.0 {
+                } else if x.f > 0.0 || self.partly_hidden(p) {
+                    // A partly hidden gatherer keeps its dark links: its open
+                    // part may see through them (the ceiling by the light).
                     self.nodes[p as usize].links.push(link);
                 }
             }
@@ -394,7 +446,20 @@ impl Hierarchy {
     fn too_coarse(&self, p: u32, link: &Link) -> bool {
         let transfer = self.transfer(p, link.source, link.f_max);
         transfer > self.settings.epsilon
-            || (transfer > self.settings.epsilon * PARTIAL_SHARE && partly_visible(link.visibility))
+            || (transfer > self.settings.epsilon * PARTIAL_SHARE && self.uncertain(p, link))
+    }
+
+    /// Whether node p is hidden in part (not all of it, not none).
+    fn partly_hidden(&self, p: u32) -> bool {
+        let exposure = self.nodes[p as usize].exposure;
+        exposure > 0.0 && exposure < 1.0
+    }
+
+    /// Whether a link's visibility may differ over its gatherer: some of
+    /// its rays arrived and some did not, or none did from a gatherer that
+    /// is partly hidden, whose points may all have fallen on the hidden part.
+    fn uncertain(&self, p: u32, link: &Link) -> bool {
+        partly_visible(link.visibility) || (link.visibility == 0.0 && self.partly_hidden(p))
     }
 
     /// One step: gather over every link, push-pull, then refine the links
@@ -402,18 +467,20 @@ impl Hierarchy {
     /// (area-weighted, over the emitted power).
     pub fn step(&mut self, geometry: &Geometry) -> f64 {
         self.steps += 1;
-        self.gathered_from.clear();
-        self.gathered_from
-            .extend(self.nodes.iter().map(|n| n.radiance));
+        self.measure_exposure(geometry);
+        let sent: Vec<Rgb> = (0..self.nodes.len() as u32)
+            .map(|k| self.exitant(k))
+            .collect();
         let gathered: Vec<Rgb> = self
             .nodes
             .par_iter()
             .map(|n| {
-                n.links.iter().fold(Rgb::ZERO, |acc, l| {
-                    acc + l.f * self.nodes[l.source as usize].radiance
-                })
+                n.links
+                    .iter()
+                    .fold(Rgb::ZERO, |acc, l| acc + l.f * sent[l.source as usize])
             })
             .collect();
+        self.gathered_from = sent;
         for (n, g) in self.nodes.iter_mut().zip(gathered) {
             n.gathered = g;
         }
@@ -485,8 +552,15 @@ impl Hierarchy {
         let leaves: Vec<u32> = (0..self.nodes.len() as u32)
             .filter(|&k| self.nodes[k as usize].children == NONE)
             .collect();
-        // One gather per vertex, through the smallest leaf that has it (its
-        // links are the finest there); the leaves sharing it read it.
+        // One gather per vertex, through the most exposed, then smallest,
+        // leaf that has it (its links are the finest there); the leaves
+        // sharing it read it. A vertex gathered from inside a hidden leaf
+        // (the ceiling above the light) darkened its open neighbours.
+        self.measure_exposure(geometry);
+        let preference = |k: u32| {
+            let n = &self.nodes[k as usize];
+            (n.exposure, -n.element.area)
+        };
         let mut index: HashMap<VertexKey, usize> = HashMap::new();
         let mut vertices: Vec<(u32, Vec3A)> = Vec::new();
         for &k in &leaves {
@@ -496,18 +570,18 @@ impl Hierarchy {
                     vertices.push((k, v));
                     vertices.len() - 1
                 });
-                if e.area < self.nodes[vertices[slot].0 as usize].element.area {
+                if preference(k) > preference(vertices[slot].0) {
                     vertices[slot].0 = k;
                 }
             }
         }
-        let values: Vec<Rgb> = vertices
+        let values: Vec<(Rgb, bool)> = vertices
             .par_iter()
             .map(|&(k, v)| {
                 let e = &self.nodes[k as usize].element;
                 let centroid = (e.vertices[0] + e.vertices[1] + e.vertices[2]) / 3.0;
                 // Just inside: on a neighbour's edge the integral is singular.
-                let x = v + 1e-3 * (centroid - v);
+                let x = v + 0.05 * (centroid - v);
                 let mut irradiance = Rgb::ZERO;
                 let mut a = k;
                 while a != NONE {
@@ -521,23 +595,44 @@ impl Hierarchy {
                         // Through a shadow boundary the link's mean is not
                         // the vertex's: a leaf half behind the light gave
                         // the ceiling a dark ring around it.
-                        let visibility = if partly_visible(link.visibility) {
+                        let visibility = if self.uncertain(a, link) {
                             point_visibility(geometry, x, e.normal, &q.element, VERTEX_RAYS)
                         } else {
                             link.visibility
                         };
                         let from = self.gathered_from.get(link.source as usize);
-                        irradiance += (visibility * f) * from.copied().unwrap_or(q.radiance);
+                        let sent = from.copied().unwrap_or_else(|| self.exitant(link.source));
+                        irradiance += (visibility * f) * sent;
                     }
                     a = parent[a as usize];
                 }
-                (e.emission + e.reflectance * irradiance).max(Rgb::ZERO)
+                let x_error = crate::math::gamma(7) * x.abs();
+                let (open, _) = open_at(geometry, x, x_error, e.normal, Vec2::splat(0.5));
+                (
+                    (e.emission + e.reflectance * irradiance).max(Rgb::ZERO),
+                    open,
+                )
             })
             .collect();
         let mut per_node = vec![[Rgb::ZERO; 3]; self.nodes.len()];
         for &k in &leaves {
             let e = &self.nodes[k as usize].element;
-            per_node[k as usize] = e.vertices.map(|v| values[index[&vertex_key(v, e)]]);
+            let corners = e.vertices.map(|v| values[index[&vertex_key(v, e)]]);
+            // A leaf partly hidden (the ceiling's edge around the light, the
+            // floor's around a block) shows its open part: hidden corners,
+            // dark, take the open corners' mean instead of shading it
+            // towards black. Cornell box, ε 3e-5: a dark wedge by the light.
+            let (sum, count) = corners
+                .iter()
+                .filter(|c| c.1)
+                .fold((Rgb::ZERO, 0.0), |(s, n), c| (s + c.0, n + 1.0));
+            per_node[k as usize] = corners.map(|(value, is_open)| {
+                if is_open || count == 0.0 {
+                    value
+                } else {
+                    sum / count
+                }
+            });
         }
         self.vertex_radiance = per_node;
     }
