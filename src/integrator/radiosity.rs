@@ -393,7 +393,9 @@ impl Radiosity {
             self.form_factors,
             self.form_factor_samples,
         );
-        let solution = Solution::new(&mesh);
+        let mut form_factors = form_factors;
+        let mut solution = Solution::new(&mesh);
+        form_factors.rays += solution.measure_exposure(&scene.geometry, &mesh);
         let vertex_radiance = if self.display == RadiosityDisplay::Smooth {
             mesh.vertex_radiance(&solution.radiance)
         } else {
@@ -524,8 +526,8 @@ impl Radiosity {
             self.form_factors,
             self.form_factor_samples,
         );
-        counts.shadow += form_factors.rays;
         let mut solution = Solution::new(&mesh);
+        counts.shadow += form_factors.rays + solution.measure_exposure(&scene.geometry, &mesh);
         if self.solver != RadiositySolver::Progressive {
             solution.radiance = origin
                 .iter()

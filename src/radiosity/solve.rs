@@ -6,7 +6,7 @@
 //! ambient term of Cohen et al. 1988 for display.
 
 use super::form_factor::{FormFactorMethod, element_to_element};
-use super::mesh::Mesh;
+use super::mesh::{Element, Mesh};
 use crate::accel::Geometry;
 use crate::math::Rgb;
 use rayon::prelude::*;
@@ -137,8 +137,12 @@ impl FormFactors {
 pub struct Solution {
     /// Radiance per element.
     pub radiance: Vec<Rgb>,
-    /// Progressive refinement: radiance not yet shot.
+    /// Progressive refinement: radiance not yet shot, as sent from each
+    /// element's open part (see `exposure`).
     pub unshot: Vec<Rgb>,
+    /// Per element, the share light can leave from
+    /// ([`super::form_factor::exposure`]); 1 until measured.
+    pub exposure: Vec<f32>,
     /// The ambient term added for display (progressive with ambient).
     pub ambient: Rgb,
     pub steps: u64,
@@ -151,11 +155,36 @@ impl Solution {
         Solution {
             radiance: emission.clone(),
             unshot: emission,
+            exposure: vec![1.0; mesh.elements.len()],
             ambient: Rgb::ZERO,
             steps: 0,
         }
     }
+
+    /// Measures every element's exposure; returns the rays cast.
+    pub fn measure_exposure(&mut self, geometry: &Geometry, mesh: &Mesh) -> u64 {
+        let measured: Vec<(f32, u32)> = mesh
+            .elements
+            .par_iter()
+            .map(|e| super::form_factor::exposure(geometry, e, EXPOSURE_POINTS))
+            .collect();
+        self.exposure = measured.iter().map(|m| m.0).collect();
+        measured.iter().map(|m| u64::from(m.1)).sum()
+    }
+
+    /// The radiance element i sends: its reflected light spread over its
+    /// open part (a floor element half under a block is dark on its hidden
+    /// half, and sends from the other half only).
+    #[inline]
+    fn exitant(&self, i: usize, e: &Element) -> Rgb {
+        e.emission + (self.radiance[i] - e.emission) / self.exposure[i].max(MIN_EXPOSURE)
+    }
 }
+
+/// Points per element for its exposure.
+const EXPOSURE_POINTS: u32 = 16;
+/// Below this exposure an element's reflected light is not spread further.
+const MIN_EXPOSURE: f32 = 1.0 / 16.0;
 
 fn luminance(c: Rgb) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
@@ -184,6 +213,9 @@ pub fn step(
     s.steps += 1;
     match solver {
         MatrixSolver::Jacobi => {
+            let sent: Vec<Rgb> = (0..elements.len())
+                .map(|j| s.exitant(j, &elements[j]))
+                .collect();
             let old = &s.radiance;
             let new: Vec<Rgb> = (0..elements.len())
                 .into_par_iter()
@@ -191,7 +223,7 @@ pub fn step(
                     let gathered = f
                         .row(i)
                         .iter()
-                        .zip(old)
+                        .zip(&sent)
                         .fold(Rgb::ZERO, |acc, (fij, l)| acc + *fij * *l);
                     elements[i].emission + elements[i].reflectance * gathered
                 })
@@ -206,16 +238,21 @@ pub fn step(
             change / emitted
         }
         MatrixSolver::GaussSeidel => {
+            // What each element sends, updated as the sweep goes.
+            let mut sent: Vec<Rgb> = (0..elements.len())
+                .map(|j| s.exitant(j, &elements[j]))
+                .collect();
             let mut change = 0.0;
             for i in 0..elements.len() {
                 let gathered = f
                     .row(i)
                     .iter()
-                    .zip(&s.radiance)
+                    .zip(&sent)
                     .fold(Rgb::ZERO, |acc, (fij, l)| acc + *fij * *l);
                 let new = elements[i].emission + elements[i].reflectance * gathered;
                 change += elements[i].area as f64 * luminance((new - s.radiance[i]).abs()) as f64;
                 s.radiance[i] = new;
+                sent[i] = s.exitant(i, &elements[i]);
             }
             change / emitted
         }
@@ -228,8 +265,8 @@ pub fn step(
                 .max()
                 .unwrap_or(0);
             let mut power = vec![0.0f32; patches];
-            for (e, u) in elements.iter().zip(&s.unshot) {
-                power[e.triangle as usize] += e.area * luminance(*u);
+            for ((e, u), x) in elements.iter().zip(&s.unshot).zip(&s.exposure) {
+                power[e.triangle as usize] += e.area * x * luminance(*u);
             }
             let Some(patch) = (0..patches).max_by(|&a, &b| power[a].total_cmp(&power[b])) else {
                 return 0.0;
@@ -245,13 +282,14 @@ pub fn step(
                     }
                     let received = e.reflectance * shot * fji;
                     s.radiance[j] += received;
-                    s.unshot[j] += received;
+                    s.unshot[j] += received / s.exposure[j].max(MIN_EXPOSURE);
                 }
             }
             let unshot: f64 = elements
                 .iter()
                 .zip(&s.unshot)
-                .map(|(e, u)| e.area as f64 * luminance(*u) as f64)
+                .zip(&s.exposure)
+                .map(|((e, u), x)| e.area as f64 * *x as f64 * luminance(*u) as f64)
                 .sum();
             s.ambient = if ambient {
                 ambient_term(mesh, f, &s.unshot)
