@@ -505,7 +505,7 @@ fn masked_rmse(image: &tracelab::image::Image, reference: &tracelab::image::Imag
 
 /// One step of hierarchical radiosity is direct light: against Mitsuba's
 /// direct-only Cornell box (the goal 0.0021, the peer's figure with
-/// 1 304 leaves). Deterministic like the test above; ε 1e-4 measures 0.00135.
+/// 1 304 leaves). Deterministic like the test above; ε 1e-4 measures 0.00132.
 /// The corner pixel the light covers 5.5% of (reference 0.945) took 0.0026
 /// of RMSE on its own when the display sampled the light's edge instead of
 /// adding the pixel's exact share of it, so the bound fails that display.
