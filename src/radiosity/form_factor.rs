@@ -20,7 +20,7 @@
 
 use super::mesh::Element;
 use crate::accel::Geometry;
-use crate::math::{gamma, ray_between};
+use crate::math::{Rgb, gamma, ray_between};
 use crate::sampling::spherical_triangle;
 use crate::sampling::warp::{self, square_to_uniform_triangle};
 use crate::sampling::{Sampler, SamplerKind};
@@ -293,6 +293,18 @@ pub fn element_to_element(
             visible as f32 / (rays + behind) as f32
         },
     }
+}
+
+/// Points per element (or node) for its [`exposure`].
+pub const EXPOSURE_POINTS: u32 = 16;
+
+/// The radiance an element of mean radiance `radiance` sends: its reflected
+/// light spread over the share `exposure` of it that light can leave from
+/// (an element's mean counts its hidden part's darkness, but nothing leaves
+/// from there). Below 1/16 the reflected light is not spread further.
+#[inline]
+pub fn sent_radiance(radiance: Rgb, emission: Rgb, exposure: f32) -> Rgb {
+    emission + (radiance - emission) / exposure.max(1.0 / 16.0)
 }
 
 /// The share of element `e` from which light can leave: of `n` stratified

@@ -17,8 +17,8 @@
 //! its open part may see through them.
 
 use super::form_factor::{
-    Exchange, FormFactorMethod, element_to_element, exposure, faces, open_at, point_to_polygon,
-    point_visibility,
+    EXPOSURE_POINTS, Exchange, FormFactorMethod, element_to_element, exposure, faces, open_at,
+    point_to_polygon, point_visibility, sent_radiance,
 };
 use super::mesh::Element;
 use super::reconstruct::{VertexKey, vertex_key};
@@ -60,11 +60,6 @@ struct Node {
 }
 
 const NONE: u32 = u32::MAX;
-/// Points per node for its exposure.
-const EXPOSURE_POINTS: u32 = 16;
-/// Below this exposure a node's reflected light is not spread further (it
-/// is nearly all hidden, and so is nearly all its light).
-const MIN_EXPOSURE: f32 = 1.0 / 16.0;
 /// Most patches (input triangles): their pairs are the initial links.
 const MAX_PATCHES: usize = 4096;
 /// Deepest level of a patch's tree.
@@ -245,12 +240,13 @@ impl Hierarchy {
     /// the squared error at ε 1e-4).
     fn exitant(&self, k: u32) -> Rgb {
         let node = &self.nodes[k as usize];
+        // Nodes made by this round's refinement are measured before the next.
         let exposure = if node.exposure.is_nan() {
             1.0
         } else {
-            node.exposure.max(MIN_EXPOSURE)
+            node.exposure
         };
-        node.element.emission + (node.radiance - node.element.emission) / exposure
+        sent_radiance(node.radiance, node.element.emission, exposure)
     }
 
     /// Measures the exposure of nodes made since the last call, in parallel.

@@ -5,7 +5,9 @@
 //! elements shoot together, Cohen et al.'s substructuring), with the
 //! ambient term of Cohen et al. 1988 for display.
 
-use super::form_factor::{FormFactorMethod, element_to_element};
+use super::form_factor::{
+    EXPOSURE_POINTS, FormFactorMethod, element_to_element, exposure, sent_radiance,
+};
 use super::mesh::{Element, Mesh};
 use crate::accel::Geometry;
 use crate::math::Rgb;
@@ -166,7 +168,7 @@ impl Solution {
         let measured: Vec<(f32, u32)> = mesh
             .elements
             .par_iter()
-            .map(|e| super::form_factor::exposure(geometry, e, EXPOSURE_POINTS))
+            .map(|e| exposure(geometry, e, EXPOSURE_POINTS))
             .collect();
         self.exposure = measured.iter().map(|m| m.0).collect();
         measured.iter().map(|m| u64::from(m.1)).sum()
@@ -177,14 +179,9 @@ impl Solution {
     /// half, and sends from the other half only).
     #[inline]
     fn exitant(&self, i: usize, e: &Element) -> Rgb {
-        e.emission + (self.radiance[i] - e.emission) / self.exposure[i].max(MIN_EXPOSURE)
+        sent_radiance(self.radiance[i], e.emission, self.exposure[i])
     }
 }
-
-/// Points per element for its exposure.
-const EXPOSURE_POINTS: u32 = 16;
-/// Below this exposure an element's reflected light is not spread further.
-const MIN_EXPOSURE: f32 = 1.0 / 16.0;
 
 fn luminance(c: Rgb) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
@@ -282,7 +279,7 @@ pub fn step(
                     }
                     let received = e.reflectance * shot * fji;
                     s.radiance[j] += received;
-                    s.unshot[j] += received / s.exposure[j].max(MIN_EXPOSURE);
+                    s.unshot[j] += sent_radiance(received, Rgb::ZERO, s.exposure[j]);
                 }
             }
             let unshot: f64 = elements
