@@ -387,13 +387,12 @@ impl Radiosity {
             });
         }
         let mesh = Mesh::build(scene, self.patch_size, MAX_ELEMENTS).map_err(crate::Error::new)?;
-        let form_factors = FormFactors::compute(
+        let mut form_factors = FormFactors::compute(
             &scene.geometry,
             &mesh,
             self.form_factors,
             self.form_factor_samples,
         );
-        let mut form_factors = form_factors;
         let mut solution = Solution::new(&mesh);
         form_factors.rays += solution.measure_exposure(&scene.geometry, &mesh);
         let vertex_radiance = if self.display == RadiosityDisplay::Smooth {

@@ -617,7 +617,9 @@ impl Hierarchy {
             // A leaf partly hidden (the ceiling's edge around the light, the
             // floor's around a block) shows its open part: hidden corners,
             // dark, take the open corners' mean instead of shading it
-            // towards black. Cornell box, ε 3e-5: a dark wedge by the light.
+            // towards black. Cornell box, masked RMSE without -> with: ε 1e-4
+            // 0.00236 -> 0.00233, 7e-5 0.00222 -> 0.00217 (large leaves);
+            // 1e-5 0.00130 -> 0.00131 (small ones, where it hardly matters).
             let (sum, count) = corners
                 .iter()
                 .filter(|c| c.1)
