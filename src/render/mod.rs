@@ -24,7 +24,7 @@ use crate::scene::Scene;
 use crate::shortcuts::PrimaryPixel;
 use glam::Vec2;
 use rayon::prelude::*;
-use splats::SplatBuffer;
+use splats::{PendingSplats, SplatBuffer};
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -478,22 +478,21 @@ impl Session {
                         Sampler::new(settings.sampler, settings.seed, settings.planned_spp)
                             .with_domains(settings.domains);
                     let mut counts = RayCounts::default();
-                    let mut non_finite = 0u64;
+                    let mut pending = PendingSplats::new();
                     for i in 0..tile_width * tile_height {
                         let (x, y) = (x0 + i % tile_width, y0 + i / tile_width);
                         for s in first..first + spp {
                             sampler.start(y * width + x, s);
                             estimator.trace(scene, (x, y), &mut sampler, &mut counts, |splat| {
-                                if !splats.add(splat.film, splat.value) {
-                                    non_finite += 1;
-                                }
+                                pending.push(&splats, splat.film, splat.value)
                             });
+                            pending.flush(&splats);
                         }
                     }
                     self.add_counts(
                         u64::from(tile_width * tile_height * spp),
                         &counts,
-                        non_finite,
+                        pending.rejected,
                     );
                 });
         });

@@ -28,6 +28,27 @@ impl SplatBuffer {
         }
     }
 
+    /// Asks for the cache line of the pixel containing `film`: splats land
+    /// anywhere on the film, and an atomic add that misses the cache waits
+    /// for the line with nothing else in flight (13% of BDPT's time on
+    /// SmallVCM's scene, 512 x 512).
+    #[inline]
+    fn prefetch(&self, film: Vec2) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            let (x, y) = (film.x as u32, film.y as u32);
+            if x < self.width && y < self.height {
+                let sums = &self.sums[(y * self.width + x) as usize];
+                // SAFETY: prefetching is a hint; it never faults, and the
+                // address is an element of a live vector.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(sums.as_ptr() as *const i8) };
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = film;
+    }
+
     /// Adds `value` to the pixel containing `film`; false (and nothing added)
     /// when the value is not finite, negative or too large to represent.
     pub(crate) fn add(&self, film: Vec2, value: Rgb) -> bool {
@@ -56,5 +77,46 @@ impl SplatBuffer {
     pub(crate) fn get(&self, index: u32) -> [f64; 3] {
         let sums = &self.sums[index as usize];
         [0, 1, 2].map(|c| sums[c].load(Ordering::Relaxed) as f64 / SPLAT_SCALE)
+    }
+}
+
+/// A sample's splats held back until the sample is traced: each one's cache
+/// line is fetched when it is made, and added once the rest of the sample's
+/// work has hidden the fetch.
+pub(crate) struct PendingSplats {
+    splats: [(Vec2, Rgb); PENDING],
+    len: usize,
+    /// Splats that were not finite, negative or too large (not added).
+    pub(crate) rejected: u64,
+}
+
+const PENDING: usize = 64;
+
+impl PendingSplats {
+    pub(crate) fn new() -> Self {
+        PendingSplats {
+            splats: [(Vec2::ZERO, Rgb::ZERO); PENDING],
+            len: 0,
+            rejected: 0,
+        }
+    }
+
+    #[inline]
+    pub(crate) fn push(&mut self, buffer: &SplatBuffer, film: Vec2, value: Rgb) {
+        if self.len == PENDING {
+            self.flush(buffer);
+        }
+        buffer.prefetch(film);
+        self.splats[self.len] = (film, value);
+        self.len += 1;
+    }
+
+    pub(crate) fn flush(&mut self, buffer: &SplatBuffer) {
+        for &(film, value) in &self.splats[..self.len] {
+            if !buffer.add(film, value) {
+                self.rejected += 1;
+            }
+        }
+        self.len = 0;
     }
 }
