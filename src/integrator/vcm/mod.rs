@@ -31,7 +31,7 @@ use super::photon_map::{self, PhotonMap, Stored};
 use super::{IntegratorOptions, MisHeuristic, MultiPassEstimator, RayCounts, Technique};
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb};
-use crate::render::splats::SplatBuffer;
+use crate::render::splats::{PendingSplats, SplatBuffer};
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Sampler, SamplerKind};
 use crate::scene::Scene;
@@ -307,6 +307,7 @@ impl Vcm {
         sampler: &mut Sampler,
         counts: &mut RayCounts,
         vertices: &mut Vec<LightVertex>,
+        splats: &mut PendingSplats,
     ) {
         let Some(emission) = sample_particle(scene, sampler) else {
             return;
@@ -331,7 +332,7 @@ impl Vcm {
             d_vm: d_vc * iteration.vc_factor,
         };
         if !delta_light {
-            self.light_point_to_camera(scene, iteration, &emission, sampler, counts);
+            self.light_point_to_camera(scene, iteration, &emission, sampler, counts, splats);
         }
         let mut ray = emission.ray().at_time(iteration.time);
         counts.bounce += 1;
@@ -358,7 +359,7 @@ impl Vcm {
                     d_vc: walk.d_vc,
                     d_vm: walk.d_vm,
                 };
-                self.connect_to_camera(scene, iteration, &vertex, sampler, counts);
+                self.connect_to_camera(scene, iteration, &vertex, sampler, counts, splats);
                 vertices.push(vertex);
             }
             if segments == self.max_depth {
@@ -408,6 +409,7 @@ impl MultiPassEstimator for Vcm {
                 let mut vertices = Vec::new();
                 let mut ends = Vec::new();
                 let mut rays = RayCounts::default();
+                let mut splats = PendingSplats::new();
                 for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(paths) {
                     sampler.start(index, 0);
                     self.trace_light_path(
@@ -416,7 +418,9 @@ impl MultiPassEstimator for Vcm {
                         &mut sampler,
                         &mut rays,
                         &mut vertices,
+                        &mut splats,
                     );
+                    splats.flush(&iteration.light_image);
                     ends.push(vertices.len() as u32);
                 }
                 (vertices, ends, rays)

@@ -9,6 +9,7 @@ use super::{Iteration, LightVertex, Vcm, Walk};
 use crate::camera::CameraConnection;
 use crate::integrator::RayCounts;
 use crate::math::{Frame, Rgb, ray_between};
+use crate::render::splats::PendingSplats;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::scene::light::EmissionSample;
@@ -37,9 +38,10 @@ impl Vcm {
         emission: &EmissionSample,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
+        splats: &mut PendingSplats,
     ) {
         let at = (emission.point, emission.error, emission.normal);
-        self.splat_through_lens(scene, iteration, at, sampler, counts, |c| {
+        self.splat_through_lens(scene, iteration, at, sampler, counts, splats, |c| {
             let cos = emission.normal.dot(c.wi).abs();
             let value = emission.emitted_towards(c.wi) * (cos * c.weight / emission.pdf_position);
             let camera = self.camera_density(scene, iteration, c, emission.point, cos);
@@ -56,9 +58,10 @@ impl Vcm {
         v: &LightVertex,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
+        splats: &mut PendingSplats,
     ) {
         let at = (v.point, v.error, v.normal);
-        self.splat_through_lens(scene, iteration, at, sampler, counts, |c| {
+        self.splat_through_lens(scene, iteration, at, sampler, counts, splats, |c| {
             let bsdf = scene.materials[v.material as usize].bsdf;
             let frame = Frame::from_normal(v.normal);
             let (f, _, pdf_reverse) =
@@ -74,8 +77,10 @@ impl Vcm {
 
     /// Joins the point `(point, error, normal)` to a lens point and, where
     /// `weighted` (its MIS-weighted value) is positive and the lens is in
-    /// sight, splats it where it lands on the film. A non-finite value is
-    /// dropped by the buffer: the film stays clean.
+    /// sight, splats it where it lands on the film (through `splats`, which
+    /// the light path flushes to the iteration's image when it ends). A
+    /// non-finite value is dropped by the buffer: the film stays clean.
+    #[allow(clippy::too_many_arguments)]
     fn splat_through_lens(
         &self,
         scene: &Scene,
@@ -83,6 +88,7 @@ impl Vcm {
         (point, error, normal): (Vec3A, Vec3A, Vec3A),
         sampler: &mut Sampler,
         counts: &mut RayCounts,
+        splats: &mut PendingSplats,
         weighted: impl FnOnce(&CameraConnection) -> Rgb,
     ) {
         let u_lens = sampler.next_2d_for(Domain::Lens);
@@ -95,7 +101,7 @@ impl Vcm {
         {
             return;
         }
-        iteration.light_image.add(c.film, value);
+        splats.push(&iteration.light_image, c.film, value);
     }
 
     /// The density (area, at `point`) of the camera's rays reaching it, per
