@@ -120,3 +120,35 @@ impl PendingSplats {
         self.len = 0;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Held-back splats, more than the holder keeps at once, land exactly
+    /// where and as direct adds do; rejected ones are counted, not added.
+    #[test]
+    fn pending_splats_sum_like_direct_adds() {
+        let (direct, held) = (SplatBuffer::new(7, 5), SplatBuffer::new(7, 5));
+        let mut pending = PendingSplats::new();
+        let mut rejected = 0;
+        for k in 0..3 * PENDING as u32 + 5 {
+            let film = Vec2::new((k * 5 % 9) as f32 + 0.5, (k * 3 % 6) as f32 + 0.5);
+            let value = if k % 17 == 3 {
+                Rgb::splat(f32::NAN)
+            } else {
+                Rgb::new(0.25 * k as f32, 1.0, 1e-3)
+            };
+            if !direct.add(film, value) {
+                rejected += 1;
+            }
+            pending.push(&held, film, value);
+        }
+        pending.flush(&held);
+        assert_eq!(pending.rejected, rejected);
+        assert!(rejected > 0);
+        for index in 0..7 * 5 {
+            assert_eq!(direct.get(index), held.get(index), "pixel {index}");
+        }
+    }
+}
