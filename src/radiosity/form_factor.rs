@@ -223,19 +223,89 @@ pub fn element_to_element(
     j: &Element,
     method: FormFactorMethod,
     n: u32,
-    (key_i, key_pair): (u32, u32),
+    keys: (u32, u32),
+) -> Exchange {
+    probed_element_to_element(geometry, (i, j), method, n, keys, 0, |_| false)
+}
+
+/// [`element_to_element`], its first `probe` samples shown to `split`
+/// first: where it finds from them that the link will be split anyway, the
+/// rest are not taken and the probe's exchange is returned. Otherwise the
+/// rest continue the probe's sums, to exactly [`element_to_element`]'s.
+pub fn probed_element_to_element(
+    geometry: &Geometry,
+    (i, j): (&Element, &Element),
+    method: FormFactorMethod,
+    n: u32,
+    keys: (u32, u32),
+    probe: u32,
+    split: impl Fn(&Exchange) -> bool,
 ) -> Exchange {
     if !faces(i, j) {
         return Exchange::default();
     }
+    let probe = probe.min(n);
+    let mut sums = ExchangeSums::default();
+    if probe > 0 {
+        sums = exchange_samples(geometry, (i, j), method, n, keys, 0..probe, sums);
+        let early = sums.exchange(probe);
+        if split(&early) {
+            return early;
+        }
+    }
+    exchange_samples(geometry, (i, j), method, n, keys, probe..n, sums).exchange(n)
+}
+
+/// The running sums of an exchange's samples: a first few can decide that
+/// a link is to be split before the rest are taken, and the rest continue
+/// from them to exactly what [`element_to_element`] gives.
+#[derive(Clone, Copy, Debug, Default)]
+struct ExchangeSums {
+    sum: f64,
+    rays: u32,
+    visible: u32,
+    /// Pairs that j's back faces count as tested and dark: the link is then
+    /// partly visible, so refinement and the smooth display's vertex rays
+    /// find the edge of j's plane (a block standing on the floor).
+    behind: u32,
+}
+
+impl ExchangeSums {
+    /// The exchange these sums estimate with `n` samples.
+    fn exchange(&self, n: u32) -> Exchange {
+        let tested = self.rays + self.behind;
+        Exchange {
+            f: (self.sum / f64::from(n)) as f32,
+            rays: self.rays,
+            visibility: if tested == 0 {
+                1.0
+            } else {
+                self.visible as f32 / tested as f32
+            },
+        }
+    }
+}
+
+/// Samples `samples` (of `n`) of F_ij, continuing from `sums`; i and j
+/// face each other.
+fn exchange_samples(
+    geometry: &Geometry,
+    (i, j): (&Element, &Element),
+    method: FormFactorMethod,
+    n: u32,
+    (key_i, key_pair): (u32, u32),
+    samples: std::ops::Range<u32>,
+    sums: ExchangeSums,
+) -> ExchangeSums {
     let mut on_i = Sampler::new(SamplerKind::Stratified, 0x5eed, n);
     let mut on_j = Sampler::new(SamplerKind::Stratified, 0x5eed_0001, n);
-    let mut sum = 0.0f64;
-    // Pairs that j's back faces count as tested and dark: the link is then
-    // partly visible, so refinement and the smooth display's vertex rays
-    // find the edge of j's plane (a block standing on the floor).
-    let (mut rays, mut visible, mut behind) = (0, 0, 0);
-    for k in 0..n {
+    let ExchangeSums {
+        mut sum,
+        mut rays,
+        mut visible,
+        mut behind,
+    } = sums;
+    for k in samples {
         on_i.start(key_i, k);
         on_j.start(key_pair, k);
         let (x, x_error) = point_on(i, on_i.next_2d());
@@ -284,14 +354,11 @@ pub fn element_to_element(
             visible += 1;
         }
     }
-    Exchange {
-        f: (sum / f64::from(n)) as f32,
+    ExchangeSums {
+        sum,
         rays,
-        visibility: if rays + behind == 0 {
-            1.0
-        } else {
-            visible as f32 / (rays + behind) as f32
-        },
+        visible,
+        behind,
     }
 }
 

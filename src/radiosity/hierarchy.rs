@@ -17,8 +17,8 @@
 //! its open part may see through them.
 
 use super::form_factor::{
-    EXPOSURE_POINTS, Exchange, FormFactorMethod, element_to_element, exposure, faces, open_at,
-    point_to_polygon, point_visibility, sent_radiance,
+    EXPOSURE_POINTS, Exchange, FormFactorMethod, exposure, faces, open_at, point_to_polygon,
+    point_visibility, probed_element_to_element, sent_radiance,
 };
 use super::mesh::Element;
 use super::reconstruct::{VertexKey, vertex_key};
@@ -29,6 +29,8 @@ use crate::scene::material::Bsdf;
 use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
 use std::collections::HashMap;
+
+mod queries;
 
 /// A link: the node gathers from `source` with form factor `f`, of which
 /// the share `visibility` of its shadow rays arrived; `f_max` is the
@@ -110,6 +112,9 @@ pub struct Hierarchy {
 /// masked RMSE 0.00327 without, 0.00250 at 1/16, 0.00223 at 1/100 (twice
 /// the time).
 const PARTIAL_SHARE: f32 = 1.0 / 16.0;
+
+/// Samples of a new link's exchange that may decide its split on their own.
+const PROBE_SAMPLES: u32 = 4;
 
 /// Shadow rays per partly visible link at a vertex of the smooth display.
 const VERTEX_RAYS: u32 = 4;
@@ -371,31 +376,33 @@ impl Hierarchy {
                 self.refine(p, q, forced, &mut pending);
             }
             self.measure_exposure(geometry);
-            let nodes = &self.nodes;
-            let settings = self.settings;
+            let (nodes, settings) = (&self.nodes, self.settings);
+            let link = |(q, f_max), x: &Exchange| Link {
+                source: q,
+                f: x.f,
+                visibility: x.visibility,
+                f_max,
+            };
+            // A link whose first rays already disagree is split whatever the
+            // rest say (17% of the exchanges at ε 7e-5): same links, fewer rays.
             let exchanges: Vec<Exchange> = pending
                 .par_iter()
-                .map(|&(p, q, _)| {
-                    element_to_element(
+                .map(|&(p, q, f_max)| {
+                    probed_element_to_element(
                         geometry,
-                        &nodes[p as usize].element,
-                        &nodes[q as usize].element,
+                        (&nodes[p as usize].element, &nodes[q as usize].element),
                         settings.method,
                         settings.samples,
                         (p, p ^ (q << 16)),
+                        PROBE_SAMPLES,
+                        |x| self.splits(p, &link((q, f_max), x)),
                     )
                 })
                 .collect();
             for (&(p, q, f_max), x) in pending.iter().zip(exchanges) {
                 self.rays += x.rays as u64;
-                let link = Link {
-                    source: q,
-                    f: x.f,
-                    visibility: x.visibility,
-                    f_max,
-                };
-                let divisible = self.divisible(p) || self.divisible(q);
-                if self.too_coarse(p, &link) && divisible && !self.budget_spent {
+                let link = link((q, f_max), &x);
+                if self.splits(p, &link) {
                     pairs.push((p, q, true));
                 } else if x.f > 0.0 || self.partly_hidden(p) {
                     // A partly hidden gatherer keeps its dark links: its open
@@ -435,6 +442,12 @@ impl Hierarchy {
                 self.refine(gatherer, source, false, pending);
             }
         }
+    }
+
+    /// Whether a link is to be replaced by finer ones (see `too_coarse`).
+    fn splits(&self, p: u32, link: &Link) -> bool {
+        let divisible = self.divisible(p) || self.divisible(link.source);
+        self.too_coarse(p, link) && divisible && !self.budget_spent
     }
 
     /// Whether a link is too coarse for the current radiance: its transfer
@@ -633,65 +646,5 @@ impl Hierarchy {
             });
         }
         self.vertex_radiance = per_node;
-    }
-
-    /// The leaf of scene triangle `triangle` at its barycentrics (b1, b2):
-    /// its radiance, element, vertex radiance once [`Hierarchy::smooth`] ran,
-    /// and depth in the patch's tree.
-    pub fn leaf_at(
-        &self,
-        triangle: usize,
-        b1: f32,
-        b2: f32,
-    ) -> Option<(Rgb, &Element, Option<[Rgb; 3]>, u8)> {
-        let mut k = *self.roots.get(triangle)?;
-        if k == NONE {
-            return None;
-        }
-        let mut b = [1.0 - b1 - b2, b1, b2];
-        while self.nodes[k as usize].children != NONE {
-            let child = super::mesh::child_at(&mut b);
-            k = self.nodes[k as usize].children + child as u32;
-        }
-        let n = &self.nodes[k as usize];
-        Some((
-            n.radiance,
-            &n.element,
-            self.vertex_radiance.get(k as usize).copied(),
-            n.depth,
-        ))
-    }
-
-    /// Per leaf, the sum of the form factors over its links and its
-    /// ancestors': the share of its hemisphere it gathers from (1 in a
-    /// closed scene, if no light is counted twice or missed).
-    pub fn gathered_share(&self) -> Vec<f32> {
-        let mut out = Vec::new();
-        let mut stack: Vec<(u32, f32)> = self
-            .roots
-            .iter()
-            .filter(|&&r| r != NONE)
-            .map(|&r| (r, 0.0))
-            .collect();
-        while let Some((k, above)) = stack.pop() {
-            let n = &self.nodes[k as usize];
-            let share = above + n.links.iter().map(|l| l.f).sum::<f32>();
-            if n.children == NONE {
-                out.push(share);
-            } else {
-                for c in n.children..n.children + 4 {
-                    stack.push((c, share));
-                }
-            }
-        }
-        out
-    }
-
-    /// The leaves' elements and radiance (for tests and displays).
-    pub fn leaves(&self) -> impl Iterator<Item = (&Element, Rgb)> {
-        self.nodes
-            .iter()
-            .filter(|n| n.children == NONE)
-            .map(|n| (&n.element, n.radiance))
     }
 }

@@ -1,0 +1,69 @@
+//! What the display and the tests read from a hierarchy: the leaf under a
+//! point, the leaves, and the share of the hemisphere each gathers from.
+
+use super::{Hierarchy, NONE};
+use crate::math::Rgb;
+use crate::radiosity::Element;
+use crate::radiosity::mesh::child_at;
+
+impl Hierarchy {
+    /// The leaf of scene triangle `triangle` at its barycentrics (b1, b2):
+    /// its radiance, element, vertex radiance once [`Hierarchy::smooth`] ran,
+    /// and depth in the patch's tree.
+    pub fn leaf_at(
+        &self,
+        triangle: usize,
+        b1: f32,
+        b2: f32,
+    ) -> Option<(Rgb, &Element, Option<[Rgb; 3]>, u8)> {
+        let mut k = *self.roots.get(triangle)?;
+        if k == NONE {
+            return None;
+        }
+        let mut b = [1.0 - b1 - b2, b1, b2];
+        while self.nodes[k as usize].children != NONE {
+            let child = child_at(&mut b);
+            k = self.nodes[k as usize].children + child as u32;
+        }
+        let n = &self.nodes[k as usize];
+        Some((
+            n.radiance,
+            &n.element,
+            self.vertex_radiance.get(k as usize).copied(),
+            n.depth,
+        ))
+    }
+
+    /// Per leaf, the sum of the form factors over its links and its
+    /// ancestors': the share of its hemisphere it gathers from (1 in a
+    /// closed scene, if no light is counted twice or missed).
+    pub fn gathered_share(&self) -> Vec<f32> {
+        let mut out = Vec::new();
+        let mut stack: Vec<(u32, f32)> = self
+            .roots
+            .iter()
+            .filter(|&&r| r != NONE)
+            .map(|&r| (r, 0.0))
+            .collect();
+        while let Some((k, above)) = stack.pop() {
+            let n = &self.nodes[k as usize];
+            let share = above + n.links.iter().map(|l| l.f).sum::<f32>();
+            if n.children == NONE {
+                out.push(share);
+            } else {
+                for c in n.children..n.children + 4 {
+                    stack.push((c, share));
+                }
+            }
+        }
+        out
+    }
+
+    /// The leaves' elements and radiance (for tests and displays).
+    pub fn leaves(&self) -> impl Iterator<Item = (&Element, Rgb)> {
+        self.nodes
+            .iter()
+            .filter(|n| n.children == NONE)
+            .map(|n| (&n.element, n.radiance))
+    }
+}
