@@ -9,7 +9,7 @@ use tracelab::accel::{Geometry, TriangleInput};
 use tracelab::integrator::radiosity::{MAX_ELEMENTS, Radiosity};
 use tracelab::integrator::{IntegratorKind, IntegratorOptions, Solver};
 use tracelab::math::Rgb;
-use tracelab::radiosity::form_factor::element_to_element;
+use tracelab::radiosity::form_factor::{element_to_element, probed_element_to_element};
 use tracelab::radiosity::{Element, FormFactorMethod, Mesh, RadiositySolver};
 use tracelab::scene::Scene;
 
@@ -125,6 +125,39 @@ fn form_factors_between_squares_match_closed_forms() {
             "{name}: RMS falls slower than Monte Carlo: {curve:?}"
         );
         assert!(curve[3].1 < 1e-3, "{name} at 1024 pairs: {curve:?}");
+    }
+}
+
+/// A probe that does not split resumes to exactly the full estimate; one
+/// that splits stops after its own samples. Between two parallel squares
+/// half hidden by a third, so that rays disagree.
+#[test]
+fn a_probed_exchange_resumes_to_the_full_one() {
+    let (x, y, z) = (Vec3A::X, Vec3A::Y, Vec3A::Z);
+    let (bottom, top) = (square(Vec3A::ZERO, x, y), square(z, y, x));
+    let blocker = square(Vec3A::new(0.5, -0.5, 0.5), 2.0 * y, x);
+    let inputs: Vec<TriangleInput> = bottom
+        .iter()
+        .chain(&top)
+        .chain(&blocker)
+        .map(|e| TriangleInput {
+            vertices: e.vertices,
+            material: 0,
+        })
+        .collect();
+    let geometry = Geometry::build(&inputs, vec![]);
+    let (i, j) = (&bottom[0], &top[1]);
+    for method in [FormFactorMethod::Analytic, FormFactorMethod::RayCast] {
+        let full = element_to_element(&geometry, i, j, method, 16, (3, 7));
+        assert!(full.visibility > 0.0 && full.visibility < 1.0, "{full:?}");
+        let resumed =
+            probed_element_to_element(&geometry, (i, j), method, 16, (3, 7), 4, |_| false);
+        assert_eq!(full, resumed);
+        let probe = probed_element_to_element(&geometry, (i, j), method, 16, (3, 7), 4, |_| true);
+        assert!(
+            probe.rays <= 4 && probe.rays < full.rays,
+            "{probe:?} {full:?}"
+        );
     }
 }
 
