@@ -372,9 +372,7 @@ impl Hierarchy {
         let mut pending = Vec::new();
         while !pairs.is_empty() {
             pending.clear();
-            for (p, q, forced) in pairs.drain(..) {
-                self.refine(p, q, forced, &mut pending);
-            }
+            self.refine(std::mem::take(&mut pairs), &mut pending);
             self.measure_exposure(geometry);
             let (nodes, settings) = (&self.nodes, self.settings);
             let link = |(q, f_max), x: &Exchange| Link {
@@ -413,34 +411,42 @@ impl Hierarchy {
         }
     }
 
-    /// Refines the pair p (gatherer), q (source) down to the links the
-    /// oracle accepts, which go to `pending` with their bound.
-    fn refine(&mut self, p: u32, q: u32, forced: bool, pending: &mut Vec<(u32, u32, f32)>) {
-        let f_max = self.f_max(p, q);
-        let coarse = forced || self.transfer(p, q, f_max) > self.settings.epsilon;
-        let (can_p, can_q) = (self.divisible(p), self.divisible(q));
-        let (ap, aq) = (
-            self.nodes[p as usize].element.area,
-            self.nodes[q as usize].element.area,
-        );
-        let split_q = can_q && (aq > ap || !can_p);
-        let children = if coarse && (can_p || can_q) {
-            self.subdivide(if split_q { q } else { p })
-        } else {
-            None
-        };
-        let Some(first) = children else {
-            pending.push((p, q, f_max));
-            return;
-        };
-        for c in first..first + 4 {
-            let (gatherer, source) = if split_q { (p, c) } else { (c, q) };
-            if faces(
-                &self.nodes[gatherer as usize].element,
-                &self.nodes[source as usize].element,
-            ) {
-                self.refine(gatherer, source, false, pending);
+    /// Refines the pairs (gatherer, source, forced) down to the links the
+    /// oracle accepts, which go to `pending` with their bound; level by
+    /// level, so that the oracle's contour integrals of a level run in
+    /// parallel (serial, they were 20% of the solve at ε 7e-5).
+    fn refine(&mut self, mut wave: Vec<(u32, u32, bool)>, pending: &mut Vec<(u32, u32, f32)>) {
+        while !wave.is_empty() {
+            let bounds: Vec<f32> = wave.par_iter().map(|&(p, q, _)| self.f_max(p, q)).collect();
+            let mut next = Vec::new();
+            for (&(p, q, forced), f_max) in wave.iter().zip(bounds) {
+                let coarse = forced || self.transfer(p, q, f_max) > self.settings.epsilon;
+                let (can_p, can_q) = (self.divisible(p), self.divisible(q));
+                let (ap, aq) = (
+                    self.nodes[p as usize].element.area,
+                    self.nodes[q as usize].element.area,
+                );
+                let split_q = can_q && (aq > ap || !can_p);
+                let children = if coarse && (can_p || can_q) {
+                    self.subdivide(if split_q { q } else { p })
+                } else {
+                    None
+                };
+                let Some(first) = children else {
+                    pending.push((p, q, f_max));
+                    continue;
+                };
+                for c in first..first + 4 {
+                    let (gatherer, source) = if split_q { (p, c) } else { (c, q) };
+                    if faces(
+                        &self.nodes[gatherer as usize].element,
+                        &self.nodes[source as usize].element,
+                    ) {
+                        next.push((gatherer, source, false));
+                    }
+                }
             }
+            wave = next;
         }
     }
 
