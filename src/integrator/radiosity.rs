@@ -290,6 +290,21 @@ impl Solver for Radiosity {
 }
 
 impl Radiosity {
+    /// The form factors of `mesh` and a first solution with every element's
+    /// exposure measured; the form factors' ray count includes the
+    /// exposure's rays.
+    fn matrix_system(&self, scene: &Scene, mesh: &Mesh) -> (FormFactors, Solution) {
+        let mut form_factors = FormFactors::compute(
+            &scene.geometry,
+            mesh,
+            self.form_factors,
+            self.form_factor_samples,
+        );
+        let mut solution = Solution::new(mesh);
+        form_factors.rays += solution.measure_exposure(&scene.geometry, mesh);
+        (form_factors, solution)
+    }
+
     /// The solution seen along a camera ray, through mirrors and glass;
     /// `seen_known`: the first hit's emission is accounted for elsewhere.
     fn look_up(
@@ -387,14 +402,7 @@ impl Radiosity {
             });
         }
         let mesh = Mesh::build(scene, self.patch_size, MAX_ELEMENTS).map_err(crate::Error::new)?;
-        let mut form_factors = FormFactors::compute(
-            &scene.geometry,
-            &mesh,
-            self.form_factors,
-            self.form_factor_samples,
-        );
-        let mut solution = Solution::new(&mesh);
-        form_factors.rays += solution.measure_exposure(&scene.geometry, &mesh);
+        let (form_factors, solution) = self.matrix_system(scene, &mesh);
         let vertex_radiance = if self.display == RadiosityDisplay::Smooth {
             mesh.vertex_radiance(&solution.radiance)
         } else {
@@ -519,14 +527,8 @@ impl Radiosity {
             return;
         }
         let (mesh, origin) = m.mesh.refine(&steep);
-        let form_factors = FormFactors::compute(
-            &scene.geometry,
-            &mesh,
-            self.form_factors,
-            self.form_factor_samples,
-        );
-        let mut solution = Solution::new(&mesh);
-        counts.shadow += form_factors.rays + solution.measure_exposure(&scene.geometry, &mesh);
+        let (form_factors, mut solution) = self.matrix_system(scene, &mesh);
+        counts.shadow += form_factors.rays;
         if self.solver != RadiositySolver::Progressive {
             solution.radiance = origin
                 .iter()

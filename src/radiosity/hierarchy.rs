@@ -375,7 +375,7 @@ impl Hierarchy {
             self.refine(std::mem::take(&mut pairs), &mut pending);
             self.measure_exposure(geometry);
             let (nodes, settings) = (&self.nodes, self.settings);
-            let link = |(q, f_max), x: &Exchange| Link {
+            let link_of = |(q, f_max), x: &Exchange| Link {
                 source: q,
                 f: x.f,
                 visibility: x.visibility,
@@ -393,13 +393,13 @@ impl Hierarchy {
                         settings.samples,
                         (p, p ^ (q << 16)),
                         PROBE_SAMPLES,
-                        |x| self.splits(p, &link((q, f_max), x)),
+                        |x| self.splits(p, &link_of((q, f_max), x)),
                     )
                 })
                 .collect();
             for (&(p, q, f_max), x) in pending.iter().zip(exchanges) {
                 self.rays += x.rays as u64;
-                let link = link((q, f_max), &x);
+                let link = link_of((q, f_max), &x);
                 if self.splits(p, &link) {
                     pairs.push((p, q, true));
                 } else if x.f > 0.0 || self.partly_hidden(p) {
