@@ -10,6 +10,7 @@ use tracelab::integrator::radiosity::{MAX_ELEMENTS, Radiosity};
 use tracelab::integrator::{IntegratorKind, IntegratorOptions, Solver};
 use tracelab::math::Rgb;
 use tracelab::radiosity::form_factor::{element_to_element, probed_element_to_element};
+use tracelab::radiosity::shaft::Blockers;
 use tracelab::radiosity::{Element, FormFactorMethod, Mesh, RadiositySolver};
 use tracelab::scene::Scene;
 
@@ -93,22 +94,23 @@ fn form_factors_between_squares_match_closed_forms() {
         (mean, rms, rms / (runs as f64).sqrt())
     };
     for (name, a, b, exact) in cases {
-        // The contour integral is exact in the inner integral; the outer
-        // one's RMS error at 1024 stratified points is 4.5e-5 to 1.5e-4
-        // (the 2x2 squares), at 4096 below 1e-4 for all three.
-        let (mean, rms, standard_error) = errors(a, b, FormFactorMethod::Analytic, 4096, 16, exact);
-        eprintln!("{name}: analytic at 4096 points, mean error {mean:.1e}, RMS {rms:.1e}");
-        assert!(rms < 1e-4, "{name}: analytic RMS {rms}");
-        assert!(
-            mean.abs() < 4.0 * standard_error + 1e-6,
-            "{name}: bias {mean}"
-        );
+        // The contour integral is exact in the inner integral and the points
+        // of i are a fixed rule's: nothing blocks these squares, so the
+        // estimate is deterministic and its error the rule's. At the
+        // default 16 pairs (Dunavant's 6 points) 2.5e-5, 6.5e-6 and 9.3e-4
+        // (the 2x2 squares); at 4096 (384 points) below 1e-6.
+        for (n, tolerance) in [(16, 1e-3), (4096, 1e-4)] {
+            let (mean, rms, _) = errors(a, b, FormFactorMethod::Analytic, n, 2, exact);
+            eprintln!("{name}: analytic at {n} pairs, error {mean:.1e}, RMS {rms:.1e}");
+            assert!(rms < tolerance, "{name}: analytic at {n} pairs, RMS {rms}");
+        }
         // Point pairs, the second point by solid angle with the cosine warped
-        // in: unbiased at every n, the RMS error falling as n^-0.6 to n^-0.9
-        // (stratified on both elements; printed). Measured RMS at the default
-        // 16 pairs: 2.3e-3 (parallel unit squares), 6.0e-3 (perpendicular),
-        // 9.4e-3 (2x2): the 1e-3 at the default count is missed; it
-        // takes 64 pairs (6.0e-4), 1024 (4.8e-4) and 256 (7.2e-4).
+        // in, Sobol points per point of the rule: the rule's bias (as above)
+        // is below the spread, the RMS error falling as n^-0.54 to n^-0.62
+        // (printed). Measured RMS at the default 16 pairs: 8.7e-4 (parallel
+        // unit squares), 2.7e-3 (perpendicular), 4.7e-3 (2x2): the issue's
+        // 1e-3 at the default count holds for the first only; the others
+        // take 64 (1.2e-3) to 256 pairs (5.5e-4, 7.8e-4).
         let mut curve = Vec::new();
         for n in [16, 64, 256, 1024] {
             let (mean, rms, standard_error) = errors(a, b, FormFactorMethod::RayCast, n, 32, exact);
@@ -150,12 +152,15 @@ fn a_probed_exchange_resumes_to_the_full_one() {
     for method in [FormFactorMethod::Analytic, FormFactorMethod::RayCast] {
         let full = element_to_element(&geometry, i, j, method, 16, (3, 7));
         assert!(full.visibility > 0.0 && full.visibility < 1.0, "{full:?}");
-        let resumed =
-            probed_element_to_element(&geometry, (i, j), method, 16, (3, 7), 4, |_| false);
-        assert_eq!(full, resumed);
-        let probe = probed_element_to_element(&geometry, (i, j), method, 16, (3, 7), 4, |_| true);
+        let probed = |split: bool| {
+            let unknown = Blockers::Unknown;
+            probed_element_to_element(&geometry, (i, j), method, 16, (3, 7), unknown, 4, |_| split)
+        };
+        assert_eq!(full, probed(false));
+        // The probe takes the first two of the rule's six points (3 pairs each).
+        let probe = probed(true);
         assert!(
-            probe.rays <= 4 && probe.rays < full.rays,
+            probe.rays <= 6 && probe.rays < full.rays,
             "{probe:?} {full:?}"
         );
     }

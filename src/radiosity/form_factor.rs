@@ -14,11 +14,15 @@
 //!   factor of j from x by Lambert's contour integral, times the visibility
 //!   of one point of j.
 //!
-//! Points come from the renderer's stratified sampler warped onto the
-//! triangles; shadow rays leave and reach surfaces by their error bounds, so
-//! nothing depends on the scene's units.
+//! The points x on i are those of a fixed quadrature rule ([`Rule`]), each
+//! with its share of the n pairs; the points y on j come from the
+//! renderer's Sobol sampler warped onto the triangle. Shadow rays leave and
+//! reach surfaces by their error bounds, so nothing depends on the scene's
+//! units; where the shaft between i and j holds nothing that can block them
+//! ([`super::shaft`]) none are cast.
 
 use super::mesh::Element;
+use super::shaft::Blockers;
 use crate::accel::Geometry;
 use crate::math::{Rgb, gamma, ray_between};
 use crate::sampling::spherical_triangle;
@@ -211,12 +215,13 @@ pub fn faces(i: &Element, j: &Element) -> bool {
     above(i, j) && above(j, i)
 }
 
-/// F_ij with `n` samples. The points on i depend on `key_i` only, so that
-/// every form factor of row i is estimated at the same points: with the
-/// contour integral, whose values at a point sum to 1 over a closed
-/// surrounding, the row sums of a closed scene are 1 to rounding. The
-/// points on j depend on `key_pair`. Returns the estimate and the shadow
-/// rays cast.
+/// F_ij from `n` point pairs. The points on i are those of a fixed rule
+/// ([`Rule`]), the same for every form factor of row i: with the contour
+/// integral, whose values at a point sum to 1 over a closed surrounding,
+/// the row sums of a closed scene are 1 to rounding. The points on j, one
+/// per pair, are stratified per point of i and depend on `keys.1` (the
+/// pair's key); `keys.0` (the gatherer's) is kept for callers that vary it.
+/// Returns the estimate and the shadow rays cast.
 pub fn element_to_element(
     geometry: &Geometry,
     i: &Element,
@@ -225,141 +230,313 @@ pub fn element_to_element(
     n: u32,
     keys: (u32, u32),
 ) -> Exchange {
-    probed_element_to_element(geometry, (i, j), method, n, keys, 0, |_| false)
+    probed_element_to_element(
+        geometry,
+        (i, j),
+        method,
+        n,
+        keys,
+        Blockers::Unknown,
+        0,
+        |_| false,
+    )
 }
 
-/// [`element_to_element`], its first `probe` samples shown to `split`
-/// first: where it finds from them that the link will be split anyway, the
-/// rest are not taken and the probe's exchange is returned. Otherwise the
-/// rest continue the probe's sums, to exactly [`element_to_element`]'s.
+/// [`element_to_element`] with what may block its rays known
+/// ([`super::shaft`]), its first points (those of at least `probe` pairs)
+/// shown to `split` first: where it finds from them that the link will be
+/// split anyway, the rest are not taken and the probe's exchange is
+/// returned. Otherwise the rest continue the probe's sums, to exactly the
+/// whole estimate. A link nothing can block casts no rays and is not probed.
+#[allow(clippy::too_many_arguments)]
 pub fn probed_element_to_element(
     geometry: &Geometry,
     (i, j): (&Element, &Element),
     method: FormFactorMethod,
     n: u32,
-    keys: (u32, u32),
+    (_, key_pair): (u32, u32),
+    blockers: Blockers,
     probe: u32,
     split: impl Fn(&Exchange) -> bool,
 ) -> Exchange {
     if !faces(i, j) {
         return Exchange::default();
     }
-    let probe = probe.min(n);
+    let n = n.max(1);
+    let rule = Rule::for_pairs(n);
     let mut sums = ExchangeSums::default();
-    if probe > 0 {
-        sums = exchange_samples(geometry, (i, j), method, n, keys, 0..probe, sums);
-        let early = sums.exchange(probe);
+    let mut first = 0;
+    if probe > 0 && blockers != Blockers::None {
+        while first < rule.len() && rule.pairs_before(first, n) < probe.min(n) {
+            first += 1;
+        }
+        let pass = (geometry, (i, j), method, key_pair, &blockers);
+        sums = exchange_points(pass, rule, n, 0..first, sums);
+        let early = sums.exchange();
         if split(&early) {
             return early;
         }
     }
-    exchange_samples(geometry, (i, j), method, n, keys, probe..n, sums).exchange(n)
+    let pass = (geometry, (i, j), method, key_pair, &blockers);
+    exchange_points(pass, rule, n, first..rule.len(), sums).exchange()
 }
 
-/// The running sums of an exchange's samples: a first few can decide that
+/// The points of i at which an exchange is evaluated: a symmetric rule on
+/// the triangle (Dunavant's of degree 2 with 3 points or degree 4 with 6),
+/// on i itself or on each of its 4^level subtriangles, so that the most
+/// points serve n pairs. The contour integral's unoccluded form factor is
+/// smooth over i: between unit squares the 6 points are within 2.5e-5 of
+/// the closed form (parallel) and 6.5e-6 (perpendicular), 16 stratified
+/// random points within 2-6e-3 (RMS), and over random Cornell-like element
+/// pairs 6 points beat 16 random ones 3-1000 times, more the farther apart.
+#[derive(Clone, Copy, Debug)]
+struct Rule {
+    base: &'static [([f32; 3], f32)],
+    level: u32,
+}
+
+/// Dunavant's degree-2 rule: barycentrics and weights.
+const THREE_POINTS: [([f32; 3], f32); 3] = [
+    ([2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0], 1.0 / 3.0),
+    ([1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0], 1.0 / 3.0),
+    ([1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0], 1.0 / 3.0),
+];
+
+/// Dunavant's degree-4 rule.
+const SIX_POINTS: [([f32; 3], f32); 6] = {
+    let (a, b, w) = (0.445_948_5, 0.108_103_02, 0.223_381_59);
+    let (c, d, v) = (0.091_576_214, 0.816_847_6, 0.109_951_744);
+    [
+        ([a, a, b], w),
+        ([a, b, a], w),
+        ([b, a, a], w),
+        ([c, c, d], v),
+        ([c, d, c], v),
+        ([d, c, c], v),
+    ]
+};
+
+/// The centroid.
+const ONE_POINT: [([f32; 3], f32); 1] = [([1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0], 1.0)];
+
+/// Pairs per point below which a rule is not subdivided further.
+const PAIRS_PER_POINT: u32 = 4;
+
+/// Deepest subdivision of a rule (6 x 4^5 points).
+const MAX_RULE_LEVEL: u32 = 5;
+
+impl Rule {
+    /// The rule for n pairs: at least one pair per point, and subdivided
+    /// only while each point keeps [`PAIRS_PER_POINT`]. The rule's error
+    /// falls fast with its points (2x2 squares: 9e-4 at 6, 1e-5 at 24), the
+    /// error of a point's stratified pairs (ray casting's inner integral,
+    /// visibility) as their number, but only as its square root with more
+    /// points of few pairs each.
+    fn for_pairs(n: u32) -> Rule {
+        let base: &'static [([f32; 3], f32)] = match n {
+            0..=2 => &ONE_POINT,
+            3..=5 => &THREE_POINTS,
+            _ => &SIX_POINTS,
+        };
+        let mut level = 0;
+        while level < MAX_RULE_LEVEL
+            && (base.len() as u32) << (2 * (level + 1)) <= n / PAIRS_PER_POINT
+        {
+            level += 1;
+        }
+        Rule { base, level }
+    }
+
+    fn len(&self) -> u32 {
+        (self.base.len() as u32) << (2 * self.level)
+    }
+
+    /// The pairs of point k: n spread as evenly as the points allow.
+    fn pairs(&self, k: u32, n: u32) -> u32 {
+        n / self.len() + u32::from(k < n % self.len())
+    }
+
+    /// The pairs of the points before k.
+    fn pairs_before(&self, k: u32, n: u32) -> u32 {
+        k * (n / self.len()) + k.min(n % self.len())
+    }
+
+    /// Point k's barycentrics (b1, b2) in the element and its weight.
+    fn point(&self, k: u32) -> (Vec2, f32) {
+        let (corner, weight) = self.base[(k % self.base.len() as u32) as usize];
+        // The subtriangle: base-4 digits of k / base, coarsest first, in the
+        // numbering of `mesh::children`.
+        let mut t = [Vec2::ZERO, Vec2::X, Vec2::Y];
+        let sub = k / self.base.len() as u32;
+        for d in (0..self.level).rev() {
+            t = super::mesh::children(t)[(sub >> (2 * d) & 3) as usize];
+        }
+        let b = corner[0] * t[0] + corner[1] * t[1] + corner[2] * t[2];
+        (b, weight / (1u32 << (2 * self.level)) as f32)
+    }
+}
+
+/// The running sums of an exchange's points: a first few can decide that
 /// a link is to be split before the rest are taken, and the rest continue
-/// from them to exactly what [`element_to_element`] gives.
+/// from them to exactly the whole estimate.
 #[derive(Clone, Copy, Debug, Default)]
 struct ExchangeSums {
     sum: f64,
+    /// Weights of the points taken (1 once all are).
+    weights: f64,
     rays: u32,
+    /// Pairs whose visibility is known: by a ray, by the shaft, or dark
+    /// because i's point lies behind j's plane. A link some of whose pairs
+    /// are dark that way is partly visible, so refinement and the smooth
+    /// display's vertex rays find the edge of j's plane (a block standing
+    /// on the floor).
+    tested: u32,
     visible: u32,
-    /// Pairs that j's back faces count as tested and dark: the link is then
-    /// partly visible, so refinement and the smooth display's vertex rays
-    /// find the edge of j's plane (a block standing on the floor).
-    behind: u32,
 }
 
 impl ExchangeSums {
-    /// The exchange these sums estimate with `n` samples.
-    fn exchange(&self, n: u32) -> Exchange {
-        let tested = self.rays + self.behind;
+    fn exchange(&self) -> Exchange {
         Exchange {
-            f: (self.sum / f64::from(n)) as f32,
+            f: if self.weights > 0.0 {
+                (self.sum / self.weights) as f32
+            } else {
+                0.0
+            },
             rays: self.rays,
-            visibility: if tested == 0 {
+            visibility: if self.tested == 0 {
                 1.0
             } else {
-                self.visible as f32 / tested as f32
+                self.visible as f32 / self.tested as f32
             },
         }
     }
 }
 
-/// Samples `samples` (of `n`) of F_ij, continuing from `sums`; i and j
-/// face each other.
-fn exchange_samples(
-    geometry: &Geometry,
-    (i, j): (&Element, &Element),
-    method: FormFactorMethod,
+/// What every point of one exchange shares.
+type Pass<'a> = (
+    &'a Geometry,
+    (&'a Element, &'a Element),
+    FormFactorMethod,
+    u32,
+    &'a Blockers,
+);
+
+/// The rule's points `points` of F_ij (n pairs in all), continuing from
+/// `sums`; i and j face each other.
+fn exchange_points(
+    (geometry, (i, j), method, key_pair, blockers): Pass,
+    rule: Rule,
     n: u32,
-    (key_i, key_pair): (u32, u32),
-    samples: std::ops::Range<u32>,
-    sums: ExchangeSums,
+    points: std::ops::Range<u32>,
+    mut sums: ExchangeSums,
 ) -> ExchangeSums {
-    let mut on_i = Sampler::new(SamplerKind::Stratified, 0x5eed, n);
-    let mut on_j = Sampler::new(SamplerKind::Stratified, 0x5eed_0001, n);
-    let ExchangeSums {
-        mut sum,
-        mut rays,
-        mut visible,
-        mut behind,
-    } = sums;
-    for k in samples {
-        on_i.start(key_i, k);
-        on_j.start(key_pair, k);
-        let (x, x_error) = point_on(i, on_i.next_2d());
-        let u_j = on_j.next_2d();
-        let (value, y, y_error) = match method {
-            FormFactorMethod::RayCast => match toward(x, i.normal, j, u_j) {
-                Some((w, solid_angle, y, y_error)) => {
-                    let cos_i = i.normal.dot(w);
-                    if cos_i <= 0.0 || j.normal.dot(w) >= 0.0 {
-                        continue;
-                    }
-                    (solid_angle * cos_i / PI, y, y_error)
-                }
-                None => {
-                    let (y, y_error) = point_on(j, u_j);
-                    let d = y - x;
-                    let r2 = d.length_squared();
-                    let (cos_i, cos_j) = (i.normal.dot(d), -j.normal.dot(d));
-                    if cos_i <= 0.0 || cos_j <= 0.0 || r2 == 0.0 {
-                        continue;
-                    }
-                    (cos_i * cos_j / (PI * r2 * r2) * j.area, y, y_error)
-                }
-            },
+    let scale = i.vertices[0].abs() + i.vertices[1].abs() + i.vertices[2].abs();
+    for k in points {
+        let (b, weight) = rule.point(k);
+        let pairs = rule.pairs(k, n);
+        sums.weights += f64::from(weight);
+        let [a, v1, v2] = i.vertices;
+        let x = a + b.x * (v1 - a) + b.y * (v2 - a);
+        let x_error = gamma(7) * scale;
+        // Each point's pairs stratified among themselves.
+        let mut on_j = Sampler::new(SamplerKind::Sobol, 0x5eed_0001, pairs);
+        let key = key_pair ^ k.wrapping_mul(0x9e37_79b9);
+        let mut arrived = 0.0f64;
+        match method {
             FormFactorMethod::Analytic => {
                 // j is one-sided: from behind its plane (a floor point under
                 // a block, behind the block's side) it sends nothing. The
                 // contour integral clips to x's hemisphere only.
                 if j.normal.dot(x - j.vertices[0]) <= 0.0 {
-                    behind += 1;
+                    sums.tested += pairs;
                     continue;
                 }
-                let Some((y, y_error)) = point_in_front(x, i.normal, j, u_j) else {
+                let value = point_to_polygon(x, i.normal, &j.vertices);
+                if value == 0.0 {
                     continue;
-                };
-                (point_to_polygon(x, i.normal, &j.vertices), y, y_error)
+                }
+                let mut seen = 0;
+                if *blockers == Blockers::None {
+                    (seen, sums.tested) = (pairs, sums.tested + pairs);
+                }
+                for r in (0..pairs).filter(|_| *blockers != Blockers::None) {
+                    on_j.start(key, r);
+                    let Some((y, y_error)) = point_in_front(x, i.normal, j, on_j.next_2d()) else {
+                        continue;
+                    };
+                    seen += u32::from(visible(
+                        geometry,
+                        blockers,
+                        (x, x_error, i),
+                        (y, y_error, j),
+                        &mut sums.rays,
+                    ));
+                    sums.tested += 1;
+                }
+                sums.visible += seen;
+                arrived = f64::from(value) * f64::from(seen) / f64::from(pairs);
             }
-        };
-        if value == 0.0 {
-            continue;
+            FormFactorMethod::RayCast => {
+                for r in 0..pairs {
+                    on_j.start(key, r);
+                    let u_j = on_j.next_2d();
+                    let (value, y, y_error) = match toward(x, i.normal, j, u_j) {
+                        Some((w, solid_angle, y, y_error)) => {
+                            let cos_i = i.normal.dot(w);
+                            if cos_i <= 0.0 || j.normal.dot(w) >= 0.0 {
+                                continue;
+                            }
+                            (solid_angle * cos_i / PI, y, y_error)
+                        }
+                        None => {
+                            let (y, y_error) = point_on(j, u_j);
+                            let d = y - x;
+                            let r2 = d.length_squared();
+                            let (cos_i, cos_j) = (i.normal.dot(d), -j.normal.dot(d));
+                            if cos_i <= 0.0 || cos_j <= 0.0 || r2 == 0.0 {
+                                continue;
+                            }
+                            (cos_i * cos_j / (PI * r2 * r2) * j.area, y, y_error)
+                        }
+                    };
+                    if value == 0.0 {
+                        continue;
+                    }
+                    sums.tested += 1;
+                    if visible(
+                        geometry,
+                        blockers,
+                        (x, x_error, i),
+                        (y, y_error, j),
+                        &mut sums.rays,
+                    ) {
+                        sums.visible += 1;
+                        arrived += f64::from(value);
+                    }
+                }
+                arrived /= f64::from(pairs);
+            }
         }
-        rays += 1;
-        let ray = ray_between(x, x_error, i.normal, y, y_error, j.normal);
-        if !geometry.occluded(&ray) {
-            sum += f64::from(value);
-            visible += 1;
-        }
+        sums.sum += f64::from(weight) * arrived;
     }
-    ExchangeSums {
-        sum,
-        rays,
-        visible,
-        behind,
+    sums
+}
+
+/// Whether the ray from x on i to y on j arrives; counts the rays cast.
+#[inline(always)]
+fn visible(
+    geometry: &Geometry,
+    blockers: &Blockers,
+    (x, x_error, i): (Vec3A, Vec3A, &Element),
+    (y, y_error, j): (Vec3A, Vec3A, &Element),
+    rays: &mut u32,
+) -> bool {
+    if *blockers == Blockers::None {
+        return true;
     }
+    *rays += 1;
+    let ray = ray_between(x, x_error, i.normal, y, y_error, j.normal);
+    !blockers.occluded(geometry, &ray)
 }
 
 /// Points per element (or node) for its [`exposure`].

@@ -328,8 +328,13 @@ impl Mesh {
 }
 
 /// The four children of triangle `v` by midpoint subdivision: corner
-/// children 0, 1, 2 (at the vertex of that index), then the middle one.
-pub fn children(v: [Vec3A; 3]) -> [[Vec3A; 3]; 4] {
+/// children 0, 1, 2 (at the vertex of that index), then the middle one;
+/// points in space or barycentric coordinates in the plane.
+pub fn children<T>(v: [T; 3]) -> [[T; 3]; 4]
+where
+    T: Copy + std::ops::Add<Output = T>,
+    f32: std::ops::Mul<T, Output = T>,
+{
     // m[k] is the midpoint of the edge opposite vertex k.
     let m = [
         0.5 * (v[1] + v[2]),
