@@ -10,7 +10,6 @@ use tracelab::integrator::radiosity::{MAX_ELEMENTS, Radiosity};
 use tracelab::integrator::{IntegratorKind, IntegratorOptions, Solver};
 use tracelab::math::Rgb;
 use tracelab::radiosity::form_factor::{element_to_element, probed_element_to_element};
-use tracelab::radiosity::shaft::Blockers;
 use tracelab::radiosity::{Element, FormFactorMethod, Mesh, RadiositySolver};
 use tracelab::scene::Scene;
 
@@ -153,8 +152,7 @@ fn a_probed_exchange_resumes_to_the_full_one() {
         let full = element_to_element(&geometry, i, j, method, 16, (3, 7));
         assert!(full.visibility > 0.0 && full.visibility < 1.0, "{full:?}");
         let probed = |split: bool| {
-            let unknown = Blockers::Unknown;
-            probed_element_to_element(&geometry, (i, j), method, 16, (3, 7), unknown, 4, |_| split)
+            probed_element_to_element(&geometry, (i, j), method, 16, (3, 7), 4, |_| split)
         };
         assert_eq!(full, probed(false));
         // The probe takes the first two of the rule's six points (3 pairs each).

@@ -31,12 +31,6 @@ impl Geometry {
         }
     }
 
-    /// True when rays leave surfaces by their error bounds (not a fixed
-    /// epsilon).
-    pub fn has_robust_offsets(&self) -> bool {
-        self.offset == OffsetMode::Robust
-    }
-
     /// True when the segment of `ray` up to its `t_max` lies inside a
     /// static soup's box, and rays leave surfaces by robust offsets (a fixed
     /// epsilon may end a shadow ray farther off a light than a shortcut's

@@ -18,11 +18,9 @@
 //! with its share of the n pairs; the points y on j come from the
 //! renderer's Sobol sampler warped onto the triangle. Shadow rays leave and
 //! reach surfaces by their error bounds, so nothing depends on the scene's
-//! units; where the shaft between i and j holds nothing that can block them
-//! ([`super::shaft`]) none are cast.
+//! units.
 
 use super::mesh::Element;
-use super::shaft::Blockers;
 use crate::accel::Geometry;
 use crate::math::{Rgb, gamma, ray_between};
 use crate::sampling::spherical_triangle;
@@ -230,32 +228,20 @@ pub fn element_to_element(
     n: u32,
     keys: (u32, u32),
 ) -> Exchange {
-    probed_element_to_element(
-        geometry,
-        (i, j),
-        method,
-        n,
-        keys,
-        Blockers::Unknown,
-        0,
-        |_| false,
-    )
+    probed_element_to_element(geometry, (i, j), method, n, keys, 0, |_| false)
 }
 
-/// [`element_to_element`] with what may block its rays known
-/// ([`super::shaft`]), its first points (those of at least `probe` pairs)
-/// shown to `split` first: where it finds from them that the link will be
-/// split anyway, the rest are not taken and the probe's exchange is
+/// [`element_to_element`], its first points (those of at least `probe`
+/// pairs) shown to `split` first: where it finds from them that the link
+/// will be split anyway, the rest are not taken and the probe's exchange is
 /// returned. Otherwise the rest continue the probe's sums, to exactly the
-/// whole estimate. A link nothing can block casts no rays and is not probed.
-#[allow(clippy::too_many_arguments)]
+/// whole estimate.
 pub fn probed_element_to_element(
     geometry: &Geometry,
     (i, j): (&Element, &Element),
     method: FormFactorMethod,
     n: u32,
     (_, key_pair): (u32, u32),
-    blockers: Blockers,
     probe: u32,
     split: impl Fn(&Exchange) -> bool,
 ) -> Exchange {
@@ -266,19 +252,30 @@ pub fn probed_element_to_element(
     let rule = Rule::for_pairs(n);
     let mut sums = ExchangeSums::default();
     let mut first = 0;
-    if probe > 0 && blockers != Blockers::None {
+    if probe > 0 {
         while first < rule.len() && rule.pairs_before(first, n) < probe.min(n) {
             first += 1;
         }
-        let pass = (geometry, (i, j), method, key_pair, &blockers);
-        sums = exchange_points(pass, rule, n, 0..first, sums);
+        sums = exchange_points(
+            (geometry, (i, j), method, key_pair),
+            rule,
+            n,
+            0..first,
+            sums,
+        );
         let early = sums.exchange();
         if split(&early) {
             return early;
         }
     }
-    let pass = (geometry, (i, j), method, key_pair, &blockers);
-    exchange_points(pass, rule, n, first..rule.len(), sums).exchange()
+    exchange_points(
+        (geometry, (i, j), method, key_pair),
+        rule,
+        n,
+        first..rule.len(),
+        sums,
+    )
+    .exchange()
 }
 
 /// The points of i at which an exchange is evaluated: a symmetric rule on
@@ -385,7 +382,7 @@ struct ExchangeSums {
     /// Weights of the points taken (1 once all are).
     weights: f64,
     rays: u32,
-    /// Pairs whose visibility is known: by a ray, by the shaft, or dark
+    /// Pairs whose visibility is known: by a ray, or dark
     /// because i's point lies behind j's plane. A link some of whose pairs
     /// are dark that way is partly visible, so refinement and the smooth
     /// display's vertex rays find the edge of j's plane (a block standing
@@ -418,13 +415,12 @@ type Pass<'a> = (
     (&'a Element, &'a Element),
     FormFactorMethod,
     u32,
-    &'a Blockers,
 );
 
 /// The rule's points `points` of F_ij (n pairs in all), continuing from
 /// `sums`; i and j face each other.
 fn exchange_points(
-    (geometry, (i, j), method, key_pair, blockers): Pass,
+    (geometry, (i, j), method, key_pair): Pass,
     rule: Rule,
     n: u32,
     points: std::ops::Range<u32>,
@@ -456,21 +452,13 @@ fn exchange_points(
                     continue;
                 }
                 let mut seen = 0;
-                if *blockers == Blockers::None {
-                    (seen, sums.tested) = (pairs, sums.tested + pairs);
-                }
-                for r in (0..pairs).filter(|_| *blockers != Blockers::None) {
+                for r in 0..pairs {
                     on_j.start(key, r);
                     let Some((y, y_error)) = point_in_front(x, i.normal, j, on_j.next_2d()) else {
                         continue;
                     };
-                    seen += u32::from(visible(
-                        geometry,
-                        blockers,
-                        (x, x_error, i),
-                        (y, y_error, j),
-                        &mut sums.rays,
-                    ));
+                    seen += u32::from(visible(geometry, (x, x_error, i), (y, y_error, j)));
+                    sums.rays += 1;
                     sums.tested += 1;
                 }
                 sums.visible += seen;
@@ -503,13 +491,8 @@ fn exchange_points(
                         continue;
                     }
                     sums.tested += 1;
-                    if visible(
-                        geometry,
-                        blockers,
-                        (x, x_error, i),
-                        (y, y_error, j),
-                        &mut sums.rays,
-                    ) {
+                    sums.rays += 1;
+                    if visible(geometry, (x, x_error, i), (y, y_error, j)) {
                         sums.visible += 1;
                         arrived += f64::from(value);
                     }
@@ -522,21 +505,14 @@ fn exchange_points(
     sums
 }
 
-/// Whether the ray from x on i to y on j arrives; counts the rays cast.
+/// Whether the shadow ray from x on i to y on j arrives.
 #[inline(always)]
 fn visible(
     geometry: &Geometry,
-    blockers: &Blockers,
     (x, x_error, i): (Vec3A, Vec3A, &Element),
     (y, y_error, j): (Vec3A, Vec3A, &Element),
-    rays: &mut u32,
 ) -> bool {
-    if *blockers == Blockers::None {
-        return true;
-    }
-    *rays += 1;
-    let ray = ray_between(x, x_error, i.normal, y, y_error, j.normal);
-    !blockers.occluded(geometry, &ray)
+    !geometry.occluded(&ray_between(x, x_error, i.normal, y, y_error, j.normal))
 }
 
 /// Points per element (or node) for its [`exposure`].

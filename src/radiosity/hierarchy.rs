@@ -22,7 +22,6 @@ use super::form_factor::{
 };
 use super::mesh::Element;
 use super::reconstruct::{VertexKey, vertex_key};
-use super::shaft::{Blockers, Shafts};
 use crate::accel::Geometry;
 use crate::math::Rgb;
 use crate::scene::Scene;
@@ -63,10 +62,6 @@ struct Node {
 }
 
 const NONE: u32 = u32::MAX;
-
-/// A pair to link: gatherer, source, whether it is to be split regardless
-/// of the oracle, and what may block rays between elements holding them.
-type Pair = (u32, u32, bool, Blockers);
 /// Most patches (input triangles): their pairs are the initial links.
 const MAX_PATCHES: usize = 4096;
 /// Deepest level of a patch's tree.
@@ -96,8 +91,6 @@ pub struct Hierarchy {
     /// Shadow rays cast for form factors so far.
     pub rays: u64,
     pub steps: u64,
-    /// What may block each link's rays, where the geometry allows culling.
-    shafts: Option<Shafts>,
     /// What is not a patch, and whether refinement hit the node budget.
     pub notes: Vec<String>,
     budget_spent: bool,
@@ -213,7 +206,6 @@ impl Hierarchy {
             settings,
             rays: 0,
             steps: 0,
-            shafts: Shafts::of(geometry),
             notes: Vec::new(),
             budget_spent: false,
             vertex_radiance: Vec::new(),
@@ -234,9 +226,9 @@ impl Hierarchy {
             ));
         }
         let patches = h.nodes.len() as u32;
-        let pairs: Vec<Pair> = (0..patches)
-            .flat_map(|p| (0..patches).map(move |q| (p, q, false, Blockers::Unknown)))
-            .filter(|&(p, q, _, _)| {
+        let pairs: Vec<(u32, u32, bool)> = (0..patches)
+            .flat_map(|p| (0..patches).map(move |q| (p, q, false)))
+            .filter(|&(p, q, _)| {
                 p != q && faces(&h.nodes[p as usize].element, &h.nodes[q as usize].element)
             })
             .collect();
@@ -376,7 +368,7 @@ impl Hierarchy {
     /// estimated in parallel between rounds of refinement; a partly visible
     /// link whose transfer is above [`PARTIAL_SHARE`] of ε goes back for
     /// another round, split.
-    fn link(&mut self, geometry: &Geometry, mut pairs: Vec<Pair>) {
+    fn link(&mut self, geometry: &Geometry, mut pairs: Vec<(u32, u32, bool)>) {
         let mut pending = Vec::new();
         while !pairs.is_empty() {
             pending.clear();
@@ -393,24 +385,23 @@ impl Hierarchy {
             // rest say (17% of the exchanges at ε 7e-5): same links, fewer rays.
             let exchanges: Vec<Exchange> = pending
                 .par_iter()
-                .map(|&(p, q, f_max, blockers)| {
+                .map(|&(p, q, f_max)| {
                     probed_element_to_element(
                         geometry,
                         (&nodes[p as usize].element, &nodes[q as usize].element),
                         settings.method,
                         settings.samples,
                         (p, p ^ (q << 16)),
-                        blockers,
                         PROBE_SAMPLES,
                         |x| self.splits(p, &link_of((q, f_max), x)),
                     )
                 })
                 .collect();
-            for (&(p, q, f_max, blockers), x) in pending.iter().zip(exchanges) {
+            for (&(p, q, f_max), x) in pending.iter().zip(exchanges) {
                 self.rays += x.rays as u64;
                 let link = link_of((q, f_max), &x);
                 if self.splits(p, &link) {
-                    pairs.push((p, q, true, blockers));
+                    pairs.push((p, q, true));
                 } else if x.f > 0.0 || self.partly_hidden(p) {
                     // A partly hidden gatherer keeps its dark links: its open
                     // part may see through them (the ceiling by the light).
@@ -420,29 +411,15 @@ impl Hierarchy {
         }
     }
 
-    /// Refines the pairs down to the links the oracle accepts, which go to
-    /// `pending` with their bound and what may block their rays; level by
-    /// level, so that the oracle's contour integrals and the shafts of a
-    /// level run in parallel (serial, the integrals were 20% of the solve at
-    /// ε 7e-5). A pair's shaft tests only what its parent's could not rule out.
-    fn refine(&mut self, mut wave: Vec<Pair>, pending: &mut Vec<(u32, u32, f32, Blockers)>) {
+    /// Refines the pairs (gatherer, source, forced) down to the links the
+    /// oracle accepts, which go to `pending` with their bound; level by
+    /// level, so that the oracle's contour integrals of a level run in
+    /// parallel (serial, they were 20% of the solve at ε 7e-5).
+    fn refine(&mut self, mut wave: Vec<(u32, u32, bool)>, pending: &mut Vec<(u32, u32, f32)>) {
         while !wave.is_empty() {
-            let bounds: Vec<(f32, Blockers)> = wave
-                .par_iter()
-                .map(|&(p, q, _, within)| {
-                    let (i, j) = (
-                        &self.nodes[p as usize].element,
-                        &self.nodes[q as usize].element,
-                    );
-                    let blockers = self
-                        .shafts
-                        .as_ref()
-                        .map_or(Blockers::Unknown, |shafts| shafts.between(i, j, within));
-                    (self.f_max(p, q), blockers)
-                })
-                .collect();
+            let bounds: Vec<f32> = wave.par_iter().map(|&(p, q, _)| self.f_max(p, q)).collect();
             let mut next = Vec::new();
-            for (&(p, q, forced, _), (f_max, blockers)) in wave.iter().zip(bounds) {
+            for (&(p, q, forced), f_max) in wave.iter().zip(bounds) {
                 let coarse = forced || self.transfer(p, q, f_max) > self.settings.epsilon;
                 let (can_p, can_q) = (self.divisible(p), self.divisible(q));
                 let (ap, aq) = (
@@ -456,7 +433,7 @@ impl Hierarchy {
                     None
                 };
                 let Some(first) = children else {
-                    pending.push((p, q, f_max, blockers));
+                    pending.push((p, q, f_max));
                     continue;
                 };
                 for c in first..first + 4 {
@@ -465,7 +442,7 @@ impl Hierarchy {
                         &self.nodes[gatherer as usize].element,
                         &self.nodes[source as usize].element,
                     ) {
-                        next.push((gatherer, source, false, blockers));
+                        next.push((gatherer, source, false));
                     }
                 }
             }
@@ -538,14 +515,14 @@ impl Hierarchy {
             let before = coarse.len();
             for l in &self.nodes[p as usize].links {
                 if self.too_coarse(p, l) && (self.divisible(p) || self.divisible(l.source)) {
-                    coarse.push((p, l.source, false, Blockers::Unknown));
+                    coarse.push((p, l.source, false));
                 }
             }
             if coarse.len() > before {
                 let removed = &coarse[before..];
                 self.nodes[p as usize]
                     .links
-                    .retain(|l| !removed.iter().any(|&(_, q, _, _)| q == l.source));
+                    .retain(|l| !removed.iter().any(|&(_, q, _)| q == l.source));
             }
         }
         self.link(geometry, coarse);

@@ -6,7 +6,6 @@ pub mod form_factor;
 pub mod hierarchy;
 pub mod mesh;
 pub mod reconstruct;
-pub mod shaft;
 pub mod solve;
 
 pub use form_factor::FormFactorMethod;
