@@ -109,7 +109,7 @@ fn form_factors_between_squares_match_closed_forms() {
         // (printed). Measured RMS at the default 16 pairs: 8.7e-4 (parallel
         // unit squares), 2.7e-3 (perpendicular), 4.7e-3 (2x2): the issue's
         // 1e-3 at the default count holds for the first only; the others
-        // take 64 (1.2e-3) to 256 pairs (5.5e-4, 7.8e-4).
+        // take 256 pairs (5.5e-4, 7.8e-4).
         let mut curve = Vec::new();
         for n in [16, 64, 256, 1024] {
             let (mean, rms, standard_error) = errors(a, b, FormFactorMethod::RayCast, n, 32, exact);
