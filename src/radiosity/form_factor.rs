@@ -217,9 +217,10 @@ pub fn faces(i: &Element, j: &Element) -> bool {
 /// ([`Rule`]), the same for every form factor of row i: with the contour
 /// integral, whose values at a point sum to 1 over a closed surrounding,
 /// the row sums of a closed scene are 1 to rounding. The points on j, one
-/// per pair, are stratified per point of i and depend on `keys.1` (the
-/// pair's key); `keys.0` (the gatherer's) is kept for callers that vary it.
-/// Returns the estimate and the shadow rays cast.
+/// per pair, are Sobol points per point of i and depend on `keys.1` (the
+/// pair's key); `keys.0` (the gatherer's) picked the points of i when they
+/// were random and no longer changes anything. Returns the estimate and the
+/// shadow rays cast.
 pub fn element_to_element(
     geometry: &Geometry,
     i: &Element,
