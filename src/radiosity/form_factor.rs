@@ -326,10 +326,10 @@ const MAX_RULE_LEVEL: u32 = 5;
 impl Rule {
     /// The rule for n pairs: at least one pair per point, and subdivided
     /// only while each point keeps [`PAIRS_PER_POINT`]. The rule's error
-    /// falls fast with its points (2x2 squares: 9e-4 at 6, 1e-5 at 24), the
-    /// error of a point's stratified pairs (ray casting's inner integral,
-    /// visibility) as their number, but only as its square root with more
-    /// points of few pairs each.
+    /// falls fast with its points (2x2 squares: 9e-4 at 6, 1e-5 at 24); the
+    /// error of a point's own Sobol pairs (ray casting's inner integral,
+    /// visibility) falls nearly as their number, but only as its square root
+    /// over more points of few pairs each.
     fn for_pairs(n: u32) -> Rule {
         let base: &'static [([f32; 3], f32)] = match n {
             0..=2 => &ONE_POINT,
