@@ -579,3 +579,83 @@ fn hierarchical_cornell_box(
         steps,
     )
 }
+
+/// A lamp facing up under a panel facing down; the camera above the panel
+/// or below it, looking at it.
+fn lit_panel(twin: bool, camera_above: bool, name: &str) -> Scene {
+    let (eye, look_at) = if camera_above {
+        ([0.0, 3.0, 0.01], [0.0, 0.0, 0.0])
+    } else {
+        ([0.0, 0.2, 0.01], [0.0, 1.0, 0.0])
+    };
+    let mut text = format!(
+        "[camera]\neye = {eye:?}\nlook_at = {look_at:?}\nfov_y = 20\nwidth = 16\nheight = 16\n\n\
+         [materials.white]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\n\
+         [materials.lamp]\ntype = \"diffuse\"\nalbedo = [0.0, 0.0, 0.0]\nemission = [4.0, 4.0, 4.0]\n\n\
+         [[quad]]\ncorner = [-0.25, 0.0, -0.25]\nu = [0.0, 0.0, 0.5]\nv = [0.5, 0.0, 0.0]\nmaterial = \"lamp\"\n\n"
+    );
+    // The twin (facing up) first: of equal hits the first stored wins.
+    if twin {
+        text.push_str(
+            "[[quad]]\ncorner = [-0.5, 1.0, -0.5]\nu = [0.0, 0.0, 1.0]\nv = [1.0, 0.0, 0.0]\nmaterial = \"white\"\n\n",
+        );
+    }
+    text.push_str(
+        "[[quad]]\ncorner = [-0.5, 1.0, -0.5]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 0.0, 1.0]\nmaterial = \"white\"\n",
+    );
+    let path = temp_dir(name).join("panel.toml");
+    std::fs::write(&path, text).unwrap();
+    Scene::load(&path).expect("the panel loads")
+}
+
+/// Patches are one-sided. Seen from behind, a thin panel lit on its front
+/// must not show its front's light (path tracing finds none there: nothing
+/// lights its top; the display showed 0.14 before it gathered there), and of
+/// two coincident quads facing apart the one facing the camera is shown,
+/// whichever the ray met.
+#[test]
+fn radiosity_shows_a_thin_panel_from_either_side() {
+    let image = |scene: Scene| {
+        let options = IntegratorOptions {
+            kind: IntegratorKind::Radiosity,
+            radiosity_solver: RadiositySolver::Hierarchical,
+            radiosity_epsilon: 1e-4,
+            patch_size: 0.05,
+            radiosity_display: tracelab::integrator::radiosity::RadiosityDisplay::Smooth,
+            ..IntegratorOptions::default()
+        };
+        crate::common::render_with(
+            scene,
+            options.build(),
+            tracelab::sampling::SamplerKind::Independent,
+            16,
+            0,
+            0,
+            16,
+        )
+        .0
+        .image
+    };
+    let top = image(lit_panel(false, true, "panel-top"));
+    let brightest = top.pixels.iter().flatten().fold(0.0f32, |m, &v| m.max(v));
+    assert!(brightest < 1e-6, "the panel's unlit top shows {brightest}");
+    // From below the panel fills the view: its lit face, E ρ F about 0.14.
+    let lit = image(lit_panel(false, false, "panel-below"));
+    let twins = image(lit_panel(true, false, "panel-twins"));
+    eprintln!(
+        "panel from below: {:?}, with its twin quad {:?}",
+        lit.mean(),
+        twins.mean()
+    );
+    assert!(lit.mean()[0] > 0.1, "{:?}", lit.mean());
+    // The same solution pixel by pixel, whichever quad a ray met. Gathering
+    // where a ray met the twin from behind is right only on average: its
+    // noise moved pixels by up to 1.4% (the mean by 0.6%).
+    let worst = lit
+        .pixels
+        .iter()
+        .zip(&twins.pixels)
+        .map(|(a, b)| (a[0] - b[0]).abs())
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-5, "pixels differ by up to {worst}");
+}

@@ -24,21 +24,29 @@
 
 use super::{IntegratorOptions, RayCounts, Solver, SolverProgress, Technique};
 use crate::math::{Frame, Ray, Rgb};
+use crate::radiosity::mesh::back_twins;
 use crate::radiosity::{
     Element, FormFactorMethod, FormFactors, Hierarchy, HierarchySettings, Mesh, RadiositySolver,
     Solution, solve,
 };
 use crate::sampling::SamplerKind;
-use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
 use crate::shortcuts::PrimaryPixel;
+use lookup::{facing_surface, gather, level_colour, on_edge};
+
+mod lookup;
 
 /// Most elements (the form factor matrix of 16 384 elements takes 1 GiB).
 pub const MAX_ELEMENTS: usize = 16_384;
 /// Specular bounces a display ray follows to reach a diffuse surface.
 const SPECULAR_DEPTH: u32 = 8;
+
+/// Gathers per display sample where a camera ray meets a patch's back (see
+/// `look_up`): one left the outside of indirect.toml's lamp shade speckled
+/// by the bright ceiling above it at 16 samples per pixel.
+const BACK_GATHERS: u32 = 16;
 
 /// Settings of the radiosity technique.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -167,6 +175,9 @@ pub struct RadiosityState {
     /// Steps and elements the display was last prepared for: a converged
     /// solution's further passes only add samples to its image.
     displayed: Option<(u64, usize)>,
+    /// Per scene triangle, the coincident one facing the other way
+    /// ([`crate::radiosity::mesh::back_twins`]).
+    back_twins: Vec<u32>,
 }
 
 impl RadiosityState {
@@ -339,7 +350,9 @@ impl Radiosity {
                     ray = hit.spawn_ray(frame.to_world(s.wi));
                 }
                 _ => {
-                    let Some(surface) = surface_at(scene, state, &hit) else {
+                    let Some((surface, from_front)) =
+                        facing_surface(scene, state, &hit, ray.direction)
+                    else {
                         // Spheres are not patches: their own emission only.
                         return weight * material.emitted(hit.normal, -ray.direction);
                     };
@@ -347,14 +360,26 @@ impl Radiosity {
                     if self.wireframe && on_edge(scene, &surface, travelled) {
                         return weight * level_colour(surface.level);
                     }
-                    let seen_emission = if depth == 0 && seen_known {
-                        Rgb::ZERO
-                    } else if e.normal.dot(ray.direction) < 0.0 {
+                    let seen_emission = if from_front && !(depth == 0 && seen_known) {
                         e.emission
                     } else {
                         Rgb::ZERO
                     };
                     let ambient = e.reflectance * surface.ambient;
+                    // Patches are one-sided: the solution has nothing for a
+                    // patch's back, which a thin surface shows (the outside
+                    // of indirect.toml's lamp shade, whose inside the lamp
+                    // lights: it read 28 where path tracing finds 0.15).
+                    // There the display gathers (light sampled, one bounce
+                    // into the solution), whatever its mode.
+                    if !from_front && self.display != RadiosityDisplay::Gather {
+                        let mut sum = Rgb::ZERO;
+                        for _ in 0..BACK_GATHERS {
+                            let wo = -ray.direction;
+                            sum += gather(scene, state, &hit, e.reflectance, wo, sampler, counts);
+                        }
+                        return weight * (sum / BACK_GATHERS as f32 + ambient);
+                    }
                     let reflected = match (self.display, surface.vertices) {
                         (RadiosityDisplay::Gather, _) => gather(
                             scene,
@@ -399,6 +424,7 @@ impl Radiosity {
                 solve_seconds: 0.0,
                 display_seconds: 0.0,
                 displayed: None,
+                back_twins: back_twins(&scene.geometry),
             });
         }
         let mesh = Mesh::build(scene, self.patch_size, MAX_ELEMENTS).map_err(crate::Error::new)?;
@@ -422,6 +448,7 @@ impl Radiosity {
             solve_seconds: 0.0,
             display_seconds: 0.0,
             displayed: None,
+            back_twins: back_twins(&scene.geometry),
         })
     }
 
@@ -542,139 +569,4 @@ impl Radiosity {
         state.residual = 1.0;
         state.settled = state.rounds >= self.adaptive_rounds;
     }
-}
-
-/// What the solution says at a surface point.
-struct Surface {
-    /// The element's radiance (emission included).
-    radiance: Rgb,
-    element: Element,
-    /// The point's barycentrics in the element.
-    barycentrics: glam::Vec2,
-    /// Smooth display: the element's vertex radiance.
-    vertices: Option<[Rgb; 3]>,
-    ambient: Rgb,
-    /// Subdivision level of the element (0: the scene triangle).
-    level: u8,
-}
-
-/// Whether a point at `distance` from the camera lies within about a pixel
-/// of its element's edges (the wireframe overlay).
-fn on_edge(scene: &Scene, surface: &Surface, distance: f32) -> bool {
-    let camera = &scene.camera;
-    let pixel = distance * 2.0 * camera.tan_half_fov_y / camera.height.max(1) as f32;
-    let [a, b, c] = surface.element.vertices;
-    let bary = surface.barycentrics;
-    let weights = [1.0 - bary.x - bary.y, bary.x, bary.y];
-    // Distance to the edge opposite vertex k: b_k times the height on it.
-    let opposite = [(c - b).length(), (a - c).length(), (b - a).length()];
-    (0..3).any(|k| weights[k] * 2.0 * surface.element.area / opposite[k] < 0.6 * pixel)
-}
-
-/// The wireframe's colour for elements of subdivision `level`.
-fn level_colour(level: u8) -> Rgb {
-    const COLOURS: [[f32; 3]; 8] = [
-        [1.0, 1.0, 1.0],
-        [1.0, 0.9, 0.1],
-        [1.0, 0.5, 0.0],
-        [1.0, 0.1, 0.1],
-        [0.9, 0.1, 0.9],
-        [0.2, 0.3, 1.0],
-        [0.1, 0.9, 1.0],
-        [0.1, 1.0, 0.2],
-    ];
-    let [r, g, b] = COLOURS[level as usize % COLOURS.len()];
-    Rgb::new(r, g, b)
-}
-
-/// The element a hit lies in and its solution (None for spheres and
-/// surfaces that are not patches).
-fn surface_at(
-    scene: &Scene,
-    state: &RadiosityState,
-    hit: &crate::accel::SurfaceHit,
-) -> Option<Surface> {
-    let triangle = hit.primitive as usize;
-    let [a, b, c] = *scene.geometry.triangles().get(triangle)?;
-    let (b1, b2) = barycentrics(hit.point, [a, b, c]);
-    let (b1, b2) = (b1.clamp(0.0, 1.0), b2.clamp(0.0, 1.0 - b1.clamp(0.0, 1.0)));
-    let (radiance, element, vertices, ambient, level) = match &state.model {
-        Model::Matrix(m) => {
-            let k = m.mesh.element_at(triangle, b1, b2)?;
-            (
-                m.solution.radiance[k],
-                m.mesh.elements[k],
-                m.vertex_radiance.get(k).copied(),
-                m.solution.ambient,
-                m.mesh.levels[k],
-            )
-        }
-        Model::Hierarchical(h) => {
-            let (radiance, element, vertices, level) = h.leaf_at(triangle, b1, b2)?;
-            (radiance, *element, vertices, Rgb::ZERO, level)
-        }
-    };
-    let (e1, e2) = barycentrics(hit.point, element.vertices);
-    Some(Surface {
-        radiance,
-        element,
-        barycentrics: glam::Vec2::new(e1, e2),
-        vertices,
-        ambient,
-        level,
-    })
-}
-
-/// Barycentrics (b1, b2) of `p` in the triangle `v`, by sub-triangle areas.
-fn barycentrics(p: glam::Vec3A, [a, b, c]: [glam::Vec3A; 3]) -> (f32, f32) {
-    let n = (b - a).cross(c - a);
-    let inv = 1.0 / n.length_squared();
-    (
-        (p - a).cross(c - a).dot(n) * inv,
-        (b - a).cross(p - a).dot(n) * inv,
-    )
-}
-
-/// Reflected radiance at a diffuse hit: direct light by one light sample,
-/// indirect by one cosine-sampled ray reading the solution (L - E) where it lands.
-fn gather(
-    scene: &Scene,
-    state: &RadiosityState,
-    hit: &crate::accel::SurfaceHit,
-    reflectance: Rgb,
-    wo: glam::Vec3A,
-    sampler: &mut Sampler,
-    counts: &mut RayCounts,
-) -> Rgb {
-    // The side the camera ray came from.
-    let normal = if hit.normal.dot(wo) < 0.0 {
-        -hit.normal
-    } else {
-        hit.normal
-    };
-    let mut direct = Rgb::ZERO;
-    let u_select = sampler.next_1d_for(Domain::Light);
-    let u_light = sampler.next_2d_for(Domain::Light);
-    if let Some(ls) = scene.lights.sample(hit.point, u_select, u_light) {
-        let cos = normal.dot(ls.wi);
-        if cos > 0.0 {
-            counts.shadow += 1;
-            if !scene.geometry.occluded(&super::path::shadow_ray(hit, &ls)) {
-                // f = ρ/π (Lambert).
-                direct = reflectance * ls.radiance * (cos / (std::f32::consts::PI * ls.pdf));
-            }
-        }
-    }
-    let local = square_to_cosine_hemisphere(sampler.next_2d_for(Domain::Bsdf));
-    let ray = hit.spawn_ray(Frame::from_normal(normal).to_world(local));
-    counts.bounce += 1;
-    let indirect = match scene.geometry.intersect(&ray) {
-        Some(next) => match surface_at(scene, state, &next) {
-            Some(s) => s.radiance - s.element.emission,
-            None => Rgb::ZERO,
-        },
-        None => Rgb::ZERO,
-    };
-    // Cosine sampling: f cos / p = ρ.
-    direct + reflectance * indirect
 }

@@ -7,6 +7,7 @@
 //! quadtree of its elements.
 
 use super::reconstruct::vertex_key;
+use crate::accel::Geometry;
 use crate::math::Rgb;
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
@@ -410,4 +411,39 @@ mod tests {
             }
         }
     }
+}
+
+/// Per scene triangle, its back twin: the triangle with the same corners
+/// facing the other way (a table top made of two quads, one per side), or
+/// `u32::MAX`. A camera ray may meet either of two coincident triangles;
+/// met from behind, one shows its twin's solution. Corners match to a
+/// millionth of the scene's diagonal, so units do not matter.
+pub fn back_twins(geometry: &Geometry) -> Vec<u32> {
+    let bounds = geometry.bounds();
+    let step = 1e-6 * (bounds.max - bounds.min).length().max(f32::MIN_POSITIVE);
+    let key = |v: [Vec3A; 3]| {
+        let mut corners = v.map(|p| (p / step).round().as_ivec3().to_array());
+        corners.sort_unstable();
+        corners
+    };
+    let triangles = geometry.triangles();
+    let mut by_corners = std::collections::HashMap::with_capacity(triangles.len());
+    for (t, v) in triangles.iter().enumerate() {
+        by_corners
+            .entry(key(*v))
+            .or_insert_with(Vec::new)
+            .push(t as u32);
+    }
+    let normal = |v: &[Vec3A; 3]| (v[1] - v[0]).cross(v[2] - v[0]);
+    triangles
+        .iter()
+        .map(|v| {
+            let n = normal(v);
+            by_corners[&key(*v)]
+                .iter()
+                .copied()
+                .find(|&o| normal(&triangles[o as usize]).dot(n) < 0.0)
+                .unwrap_or(u32::MAX)
+        })
+        .collect()
 }

@@ -1,0 +1,176 @@
+//! What a radiosity solution shows where a ray lands: the element and its
+//! radiance, the wireframe overlay, and the final gather.
+
+use super::{Model, RadiosityState};
+use crate::accel::SurfaceHit;
+use crate::integrator::RayCounts;
+use crate::math::{Frame, Rgb};
+use crate::radiosity::Element;
+use crate::sampling::warp::square_to_cosine_hemisphere;
+use crate::sampling::{Domain, Sampler};
+use crate::scene::Scene;
+
+/// What the solution says at a surface point.
+pub(super) struct Surface {
+    /// The element's radiance (emission included).
+    pub(super) radiance: Rgb,
+    pub(super) element: Element,
+    /// The point's barycentrics in the element.
+    pub(super) barycentrics: glam::Vec2,
+    /// Smooth display: the element's vertex radiance.
+    pub(super) vertices: Option<[Rgb; 3]>,
+    pub(super) ambient: Rgb,
+    /// Subdivision level of the element (0: the scene triangle).
+    pub(super) level: u8,
+}
+
+/// Whether a point at `distance` from the camera lies within about a pixel
+/// of its element's edges (the wireframe overlay).
+pub(super) fn on_edge(scene: &Scene, surface: &Surface, distance: f32) -> bool {
+    let camera = &scene.camera;
+    let pixel = distance * 2.0 * camera.tan_half_fov_y / camera.height.max(1) as f32;
+    let [a, b, c] = surface.element.vertices;
+    let bary = surface.barycentrics;
+    let weights = [1.0 - bary.x - bary.y, bary.x, bary.y];
+    // Distance to the edge opposite vertex k: b_k times the height on it.
+    let opposite = [(c - b).length(), (a - c).length(), (b - a).length()];
+    (0..3).any(|k| weights[k] * 2.0 * surface.element.area / opposite[k] < 0.6 * pixel)
+}
+
+/// The wireframe's colour for elements of subdivision `level`.
+pub(super) fn level_colour(level: u8) -> Rgb {
+    const COLOURS: [[f32; 3]; 8] = [
+        [1.0, 1.0, 1.0],
+        [1.0, 0.9, 0.1],
+        [1.0, 0.5, 0.0],
+        [1.0, 0.1, 0.1],
+        [0.9, 0.1, 0.9],
+        [0.2, 0.3, 1.0],
+        [0.1, 0.9, 1.0],
+        [0.1, 1.0, 0.2],
+    ];
+    let [r, g, b] = COLOURS[level as usize % COLOURS.len()];
+    Rgb::new(r, g, b)
+}
+
+/// The element a hit lies in and its solution (None for spheres and
+/// surfaces that are not patches).
+pub(super) fn surface_at(
+    scene: &Scene,
+    state: &RadiosityState,
+    hit: &SurfaceHit,
+) -> Option<Surface> {
+    let triangle = hit.primitive as usize;
+    let [a, b, c] = *scene.geometry.triangles().get(triangle)?;
+    let (b1, b2) = barycentrics(hit.point, [a, b, c]);
+    let (b1, b2) = (b1.clamp(0.0, 1.0), b2.clamp(0.0, 1.0 - b1.clamp(0.0, 1.0)));
+    let (radiance, element, vertices, ambient, level) = match &state.model {
+        Model::Matrix(m) => {
+            let k = m.mesh.element_at(triangle, b1, b2)?;
+            (
+                m.solution.radiance[k],
+                m.mesh.elements[k],
+                m.vertex_radiance.get(k).copied(),
+                m.solution.ambient,
+                m.mesh.levels[k],
+            )
+        }
+        Model::Hierarchical(h) => {
+            let (radiance, element, vertices, level) = h.leaf_at(triangle, b1, b2)?;
+            (radiance, *element, vertices, Rgb::ZERO, level)
+        }
+    };
+    let (e1, e2) = barycentrics(hit.point, element.vertices);
+    Some(Surface {
+        radiance,
+        element,
+        barycentrics: glam::Vec2::new(e1, e2),
+        vertices,
+        ambient,
+        level,
+    })
+}
+
+/// The patch a ray travelling along `direction` meets at `hit`, and whether
+/// it meets its front. Of two coincident triangles facing apart
+/// ([`back_twins`]: indirect.toml's table), the ray may have met the one
+/// facing away: then it is the other's front.
+pub(super) fn facing_surface(
+    scene: &Scene,
+    state: &RadiosityState,
+    hit: &SurfaceHit,
+    direction: glam::Vec3A,
+) -> Option<(Surface, bool)> {
+    let surface = surface_at(scene, state, hit)?;
+    if surface.element.normal.dot(direction) < 0.0 {
+        return Some((surface, true));
+    }
+    let twin = state.back_twins.get(hit.primitive as usize).copied();
+    let across = twin.filter(|&t| t != u32::MAX).and_then(|t| {
+        let hit = SurfaceHit {
+            primitive: t,
+            normal: -hit.normal,
+            ..*hit
+        };
+        surface_at(scene, state, &hit)
+    });
+    Some(across.map_or((surface, false), |s| (s, true)))
+}
+
+/// Barycentrics (b1, b2) of `p` in the triangle `v`, by sub-triangle areas.
+fn barycentrics(p: glam::Vec3A, [a, b, c]: [glam::Vec3A; 3]) -> (f32, f32) {
+    let n = (b - a).cross(c - a);
+    let inv = 1.0 / n.length_squared();
+    (
+        (p - a).cross(c - a).dot(n) * inv,
+        (b - a).cross(p - a).dot(n) * inv,
+    )
+}
+
+/// Reflected radiance at a diffuse hit: direct light by one light sample,
+/// indirect by one cosine-sampled ray reading the solution (L - E) where it lands.
+pub(super) fn gather(
+    scene: &Scene,
+    state: &RadiosityState,
+    hit: &SurfaceHit,
+    reflectance: Rgb,
+    wo: glam::Vec3A,
+    sampler: &mut Sampler,
+    counts: &mut RayCounts,
+) -> Rgb {
+    // The side the camera ray came from.
+    let normal = if hit.normal.dot(wo) < 0.0 {
+        -hit.normal
+    } else {
+        hit.normal
+    };
+    let mut direct = Rgb::ZERO;
+    let u_select = sampler.next_1d_for(Domain::Light);
+    let u_light = sampler.next_2d_for(Domain::Light);
+    if let Some(ls) = scene.lights.sample(hit.point, u_select, u_light) {
+        let cos = normal.dot(ls.wi);
+        if cos > 0.0 {
+            counts.shadow += 1;
+            if !scene
+                .geometry
+                .occluded(&crate::integrator::path::shadow_ray(hit, &ls))
+            {
+                // f = ρ/π (Lambert).
+                direct = reflectance * ls.radiance * (cos / (std::f32::consts::PI * ls.pdf));
+            }
+        }
+    }
+    let local = square_to_cosine_hemisphere(sampler.next_2d_for(Domain::Bsdf));
+    let ray = hit.spawn_ray(Frame::from_normal(normal).to_world(local));
+    counts.bounce += 1;
+    // A patch's back sends nothing: the solution has its front only.
+    let indirect = match scene.geometry.intersect(&ray) {
+        Some(next) => match facing_surface(scene, state, &next, ray.direction) {
+            Some((s, true)) => s.radiance - s.element.emission,
+            _ => Rgb::ZERO,
+        },
+        None => Rgb::ZERO,
+    };
+    // Cosine sampling: f cos / p = ρ.
+    direct + reflectance * indirect
+}
