@@ -373,9 +373,8 @@ impl Radiosity {
                     // There the display gathers (light sampled, one bounce
                     // into the solution), whatever its mode.
                     if !from_front && self.display != RadiosityDisplay::Gather {
-                        let mut sum = Rgb::ZERO;
+                        let (mut sum, wo) = (Rgb::ZERO, -ray.direction);
                         for _ in 0..BACK_GATHERS {
-                            let wo = -ray.direction;
                             sum += gather(scene, state, &hit, e.reflectance, wo, sampler, counts);
                         }
                         return weight * (sum / BACK_GATHERS as f32 + ambient);
