@@ -63,9 +63,10 @@ pub struct RadiosityFlags {
     /// emitted power (smaller: more links, more accuracy, more time).
     #[arg(long, default_value_t = 1e-4)]
     epsilon: f32,
-    /// Radiosity: samples (point pairs or points) per element pair for form factors.
-    #[arg(long, default_value_t = 16)]
-    ff_rays: u32,
+    /// Radiosity: samples (point pairs or points) per element pair for form
+    /// factors [default: 16 analytic, 256 ray-cast].
+    #[arg(long)]
+    ff_rays: Option<u32>,
     /// Radiosity: how the solution is shown (`flat`, `smooth`, or `gather`:
     /// direct light sampled, indirect read from the solution).
     #[arg(long, value_enum, default_value = "gather")]
@@ -99,11 +100,10 @@ impl RadiosityFlags {
             },
             radiosity_epsilon: self.epsilon,
             patch_size: self.patch_size,
-            form_factor_method: match self.ff_method {
-                FormFactorArg::Analytic => FormFactorMethod::Analytic,
-                FormFactorArg::RayCast => FormFactorMethod::RayCast,
-            },
-            form_factor_samples: self.ff_rays,
+            form_factor_method: self.form_factor_method(),
+            form_factor_samples: self
+                .ff_rays
+                .unwrap_or(self.form_factor_method().default_samples()),
             radiosity_ambient: self.ambient_term,
             radiosity_iterations: self.iterations,
             adaptive_rounds: self.adaptive_rounds,
@@ -115,6 +115,13 @@ impl RadiosityFlags {
                 DisplayArg::Gather => RadiosityDisplay::Gather,
             },
             ..IntegratorOptions::default()
+        }
+    }
+
+    fn form_factor_method(&self) -> FormFactorMethod {
+        match self.ff_method {
+            FormFactorArg::Analytic => FormFactorMethod::Analytic,
+            FormFactorArg::RayCast => FormFactorMethod::RayCast,
         }
     }
 
@@ -132,10 +139,12 @@ impl RadiosityFlags {
                 self.adaptive_tolerance
             )));
         }
-        if !(self.patch_size > 0.0 && self.patch_size <= 1.0) || self.ff_rays == 0 {
+        if !(self.patch_size > 0.0 && self.patch_size <= 1.0) || self.ff_rays == Some(0) {
             return Err(Error::new(format!(
                 "--patch-size must be in (0, 1] (got {}) and --ff-rays at least 1 (got {})",
-                self.patch_size, self.ff_rays
+                self.patch_size,
+                self.ff_rays
+                    .unwrap_or(self.form_factor_method().default_samples())
             )));
         }
         Ok(())

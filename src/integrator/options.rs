@@ -97,7 +97,7 @@ impl Default for IntegratorOptions {
             radiosity_solver: RadiositySolver::GaussSeidel,
             patch_size: 0.1,
             form_factor_method: FormFactorMethod::Analytic,
-            form_factor_samples: 16,
+            form_factor_samples: FormFactorMethod::Analytic.default_samples(),
             radiosity_ambient: true,
             radiosity_iterations: 0,
             radiosity_display: RadiosityDisplay::Gather,

@@ -288,6 +288,7 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
             );
             ui.horizontal(|ui| {
                 ui.label("Form factors");
+                let before = options.form_factor_method;
                 ui.radio_value(
                     &mut options.form_factor_method,
                     FormFactorMethod::Analytic,
@@ -298,6 +299,10 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                     FormFactorMethod::RayCast,
                     "Ray casting",
                 );
+                // Each method starts from the count at which it is accurate.
+                if options.form_factor_method != before {
+                    options.form_factor_samples = options.form_factor_method.default_samples();
+                }
             });
             ui.horizontal(|ui| {
                 ui.label("Display");
@@ -306,7 +311,7 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                 }
             });
             ui.add(
-                egui::Slider::new(&mut options.form_factor_samples, 1..=256)
+                egui::Slider::new(&mut options.form_factor_samples, 1..=1024)
                     .logarithmic(true)
                     .text("Samples per pair"),
             );
