@@ -100,6 +100,82 @@ fn radiosity_reports_rows_and_refuses_bad_input() {
     assert_fails(&o, 1, &["--patch-size"]);
 }
 
+/// A sweep prints one converged row per value and the slope of links
+/// against elements, writes them and the plot, and refuses what it cannot do.
+#[test]
+fn radiosity_sweeps_report_the_scaling_of_links() {
+    let dir = temp_dir("radiosity-sweep");
+    let (csv, plot) = (dir.join("sweep.csv"), dir.join("links.svg"));
+    let scene = repo_path("scenes/cornell_box.toml");
+    let reference = repo_path("tests/data/cornell_box_path_ref.exr");
+    let base = [
+        "radiosity",
+        scene.to_str().unwrap(),
+        "--reference",
+        reference.to_str().unwrap(),
+        "--display",
+        "flat",
+    ];
+    let with = |extra: &[&str]| {
+        let mut all = base.to_vec();
+        all.extend_from_slice(extra);
+        tracelab(&all)
+    };
+    let o = with(&[
+        "--solver",
+        "hierarchical",
+        "--patch-size",
+        "0.05",
+        "--sweep-epsilon",
+        "1e-3,3e-4",
+        "--sweep-patch-size",
+        "0.2,0.1",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--scaling-plot",
+        plot.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("over the epsilon sweep") && out.contains("over the patch size sweep"),
+        "{out}"
+    );
+    let rows = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = rows.lines().collect();
+    assert_eq!(lines.len(), 5, "{rows}");
+    assert!(
+        lines[1].starts_with("epsilon,0.001,") && lines[4].starts_with("patch size,0.1,"),
+        "{rows}"
+    );
+    // A smaller epsilon and a smaller patch size both refine: more elements.
+    let elements = |line: &str| line.split(',').nth(3).unwrap().parse::<u64>().unwrap();
+    assert!(
+        elements(lines[2]) > elements(lines[1]) && elements(lines[4]) > elements(lines[3]),
+        "{rows}"
+    );
+    assert!(
+        std::fs::read_to_string(&plot)
+            .unwrap()
+            .contains("links against elements")
+    );
+    assert_fails(
+        &with(&["--sweep-epsilon", "1e-3"]),
+        1,
+        &["needs --solver hierarchical"],
+    );
+    assert_fails(
+        &with(&["--sweep-patch-size", "0"]),
+        1,
+        &["--sweep-patch-size values"],
+    );
+    assert_fails(
+        &with(&["--scaling-plot", plot.to_str().unwrap()]),
+        1,
+        &["--scaling-plot needs"],
+    );
+}
+
 #[test]
 fn bidirectional_and_photon_settings_are_checked() {
     let scene = repo_path("scenes/cornell_box.toml");

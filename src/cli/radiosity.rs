@@ -12,7 +12,7 @@ use std::sync::Arc;
 use tracelab::image::{Image, check_writable};
 use tracelab::integrator::radiosity::RadiosityDisplay;
 use tracelab::integrator::{IntegratorKind, IntegratorOptions};
-use tracelab::plot::{PlotFormat, Series, SeriesStyle, log_log_plot};
+use tracelab::plot::{Figure, PlotFormat, Series, SeriesStyle, log_log_plot, write_figure};
 use tracelab::radiosity::{FormFactorMethod, RadiositySolver};
 use tracelab::render::{RenderSettings, Session};
 use tracelab::sampling::SamplerKind;
@@ -171,6 +171,18 @@ pub struct RadiosityArgs {
     /// are left out of the masked RMSE.
     #[arg(long, default_value_t = 1.0)]
     mask_above: f32,
+    /// Hierarchical: solve once per epsilon (comma-separated) to
+    /// convergence, printing the converged rows and the slope of links
+    /// against elements.
+    #[arg(long, value_delimiter = ',')]
+    sweep_epsilon: Vec<f32>,
+    /// Solve once per patch size (comma-separated): the smallest element
+    /// (hierarchical) or the mesh (the other solvers).
+    #[arg(long, value_delimiter = ',')]
+    sweep_patch_size: Vec<f32>,
+    /// Plot the sweeps' links against elements here (log-log, .svg or .png).
+    #[arg(long)]
+    scaling_plot: Option<PathBuf>,
     #[command(flatten)]
     radiosity: RadiosityFlags,
 }
@@ -195,12 +207,14 @@ fn rmse(image: &Image, reference: &Image, mask_above: f32) -> (f64, f64, usize) 
 /// bytes, solve seconds, residual, RMSE, masked RMSE, display seconds.
 type Row = (u64, u64, u64, u64, u64, f64, f64, f64, f64, f64);
 
-/// Solves with `options`, printing and returning a row after each pass.
+/// Solves with `options`, returning a row after each pass and printing it
+/// if `echo`.
 fn run(
     scene: Arc<Scene>,
     reference: &Image,
     options: IntegratorOptions,
     args: &RadiosityArgs,
+    echo: bool,
 ) -> Result<Vec<Row>> {
     let settings = RenderSettings {
         integrator: options.build(),
@@ -213,9 +227,38 @@ fn run(
         clamp: None,
     };
     let session = Session::new(scene, settings)?;
+    if echo {
+        print_header("steps");
+    }
+    let mut rows = Vec::new();
+    drive_solver(&session, |stats, progress| {
+        let (all, masked, _) = rmse(&session.snapshot().image, reference, args.mask_above);
+        // The solver's own time (form factors included), without drawing the image.
+        let row = (
+            progress.steps,
+            progress.elements,
+            progress.links,
+            stats.rays.shadow,
+            progress.memory,
+            progress.solve_seconds,
+            progress.residual,
+            all,
+            masked,
+            progress.display_seconds,
+        );
+        if echo {
+            print_row(&format!("{}", row.0), &row);
+        }
+        rows.push(row);
+    })?;
+    Ok(rows)
+}
+
+/// The rows' header, the first column named `first`.
+fn print_header(first: &str) {
     println!(
-        "{:>7} {:>9} {:>11} {:>9} {:>9} {:>9} {:>10} {:>11} {:>9} {:>13}",
-        "steps",
+        "{:>10} {:>9} {:>11} {:>9} {:>9} {:>9} {:>10} {:>11} {:>9} {:>13}",
+        first,
         "elements",
         "links",
         "rays M",
@@ -226,44 +269,37 @@ fn run(
         "RMSE",
         "masked RMSE"
     );
-    let mut rows = Vec::new();
-    drive_solver(&session, |stats, progress| {
-        let (all, masked, _) = rmse(&session.snapshot().image, reference, args.mask_above);
-        // The solver's own time (form factors included), without drawing the image.
-        let seconds = progress.solve_seconds;
-        println!(
-            "{:>7} {:>9} {:>11} {:>9.2} {:>9.1} {:>9.3} {:>10.3} {:>11.3e} {:>9.5} {:>13.5}",
-            progress.steps,
-            progress.elements,
-            progress.links,
-            stats.rays.shadow as f64 * 1e-6,
-            progress.memory as f64 * 1e-6,
-            seconds,
-            progress.display_seconds,
-            progress.residual,
-            all,
-            masked
-        );
-        rows.push((
-            progress.steps,
-            progress.elements,
-            progress.links,
-            stats.rays.shadow,
-            progress.memory,
-            seconds,
-            progress.residual,
-            all,
-            masked,
-            progress.display_seconds,
-        ));
-    })?;
-    Ok(rows)
+}
+
+/// One row, its first column `first`.
+fn print_row(first: &str, row: &Row) {
+    let &(_, elements, links, rays, bytes, seconds, residual, all, masked, display) = row;
+    println!(
+        "{:>10} {:>9} {:>11} {:>9.2} {:>9.1} {:>9.3} {:>10.3} {:>11.3e} {:>9.5} {:>13.5}",
+        first,
+        elements,
+        links,
+        rays as f64 * 1e-6,
+        bytes as f64 * 1e-6,
+        seconds,
+        display,
+        residual,
+        all,
+        masked
+    );
 }
 
 pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
     args.radiosity.check()?;
-    for path in [&args.csv, &args.plot].into_iter().flatten() {
+    check_sweeps(args)?;
+    for path in [&args.csv, &args.plot, &args.scaling_plot]
+        .into_iter()
+        .flatten()
+    {
         check_writable(path)?;
+    }
+    if let Some(plot) = &args.scaling_plot {
+        PlotFormat::of(plot)?;
     }
     if let Some(plot) = &args.plot {
         PlotFormat::of(plot)?;
@@ -282,7 +318,10 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
         ..args.radiosity.options()
     };
     let scene = Arc::new(scene);
-    let rows = run(scene.clone(), &reference, options, args)?;
+    if !args.sweep_epsilon.is_empty() || !args.sweep_patch_size.is_empty() {
+        return sweep(scene, &reference, options, args);
+    }
+    let rows = run(scene.clone(), &reference, options, args, true)?;
     // Progressive refinement: the plot shows both ambient settings.
     let other = if options.radiosity_solver == RadiositySolver::Progressive && args.plot.is_some() {
         let other = IntegratorOptions {
@@ -297,7 +336,7 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
                 "without"
             }
         );
-        Some(run(scene, &reference, other, args)?)
+        Some(run(scene, &reference, other, args, true)?)
     } else {
         None
     };
@@ -358,6 +397,160 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
             "RMSE / residual",
             &series,
         )?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// Refuses sweeps that mean nothing: values out of range, epsilon without
+/// the hierarchy, and plots that do not go with them.
+fn check_sweeps(args: &RadiosityArgs) -> Result<()> {
+    let sweeping = !args.sweep_epsilon.is_empty() || !args.sweep_patch_size.is_empty();
+    if let Some(e) = args
+        .sweep_epsilon
+        .iter()
+        .find(|e| !(**e > 0.0 && e.is_finite()))
+    {
+        return Err(Error::new(format!(
+            "--sweep-epsilon values must be positive, got {e}"
+        )));
+    }
+    if let Some(s) = args
+        .sweep_patch_size
+        .iter()
+        .find(|s| !(**s > 0.0 && **s <= 1.0))
+    {
+        return Err(Error::new(format!(
+            "--sweep-patch-size values must be in (0, 1], got {s}"
+        )));
+    }
+    if !args.sweep_epsilon.is_empty() && !matches!(args.radiosity.solver, SolverArg::Hierarchical) {
+        return Err(Error::new(
+            "--sweep-epsilon needs --solver hierarchical (epsilon is its oracle's)",
+        ));
+    }
+    if sweeping && args.plot.is_some() {
+        return Err(Error::new(
+            "--plot draws one solve's steps; with a sweep, use --scaling-plot",
+        ));
+    }
+    if !sweeping && args.scaling_plot.is_some() {
+        return Err(Error::new(
+            "--scaling-plot needs --sweep-epsilon or --sweep-patch-size",
+        ));
+    }
+    Ok(())
+}
+
+/// Solves once per swept value to convergence; prints the converged rows
+/// and, per sweep, the slope of links against elements on log-log (the
+/// scaling of hierarchical radiosity: 2 for a full matrix, 1 for
+/// Hanrahan's O(n)); writes the rows as CSV and the plot.
+fn sweep(
+    scene: Arc<Scene>,
+    reference: &Image,
+    options: IntegratorOptions,
+    args: &RadiosityArgs,
+) -> Result<()> {
+    let runs: Vec<(&str, Vec<(f32, IntegratorOptions)>)> = [
+        (
+            "epsilon",
+            args.sweep_epsilon
+                .iter()
+                .map(|&e| {
+                    let run = IntegratorOptions {
+                        radiosity_epsilon: e,
+                        ..options
+                    };
+                    (e, run)
+                })
+                .collect::<Vec<_>>(),
+        ),
+        (
+            "patch size",
+            args.sweep_patch_size
+                .iter()
+                .map(|&s| {
+                    let run = IntegratorOptions {
+                        patch_size: s,
+                        ..options
+                    };
+                    (s, run)
+                })
+                .collect(),
+        ),
+    ]
+    .into_iter()
+    .filter(|(_, runs)| !runs.is_empty())
+    .collect();
+    let mut csv = String::from(
+        "sweep,value,steps,elements,links,shadow_rays,bytes,solve_seconds,display_seconds,\
+         residual,rmse,masked_rmse\n",
+    );
+    let mut series = Vec::new();
+    for (name, values) in runs {
+        println!("{name} sweep (converged):");
+        print_header(name);
+        let mut points = Vec::new();
+        for (value, run_options) in values {
+            let rows = run(scene.clone(), reference, run_options, args, false)?;
+            let Some(last) = rows.last() else { continue };
+            let label = if name == "epsilon" {
+                format!("{value:e}")
+            } else {
+                format!("{value}")
+            };
+            print_row(&label, last);
+            let (steps, elements, links, rays, bytes, seconds, residual, all, masked, display) =
+                *last;
+            csv.push_str(&format!(
+                "{name},{value},{steps},{elements},{links},{rays},{bytes},{seconds},{display},\
+                 {residual},{all},{masked}\n"
+            ));
+            points.push((elements as f64, links as f64));
+        }
+        let slope = tracelab::lab::stats::log_log_slope(&points);
+        let label = if slope.is_finite() {
+            println!("links grow as elements^{slope:.2} over the {name} sweep");
+            format!("{name} sweep (slope {slope:.2})")
+        } else {
+            format!("{name} sweep")
+        };
+        series.push(Series::new(
+            &label,
+            SeriesStyle::Line,
+            series.len(),
+            &points,
+        ));
+    }
+    if let Some(path) = &args.csv {
+        tracelab::image::write_atomically(path, |tmp| {
+            std::fs::write(tmp, &csv).map_err(|e| e.to_string())
+        })?;
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.scaling_plot {
+        // Guides of slope 1 (Hanrahan's O(n)) and 2 (a full matrix) from
+        // the first point.
+        let all: Vec<(f64, f64)> = series.iter().flat_map(|s| s.points.clone()).collect();
+        if let Some(&(x0, y0)) = all.first() {
+            let x1 = all.iter().map(|p| p.0).fold(x0, f64::max);
+            for (guide, slope) in [("links ~ elements", 1.0), ("links ~ elements²", 2.0)] {
+                series.push(Series::new(
+                    guide,
+                    SeriesStyle::Guide,
+                    7,
+                    &[(x0, y0), (x1, y0 * (x1 / x0).powf(slope))],
+                ));
+            }
+        }
+        let figure = Figure::log_log(
+            "Radiosity: links against elements",
+            "elements (leaves)",
+            "links",
+            series,
+        );
+        write_figure(path, &figure)?;
         eprintln!("wrote {}", path.display());
     }
     Ok(())
