@@ -27,7 +27,7 @@ use crate::math::{Frame, Ray, Rgb};
 use crate::radiosity::mesh::back_twins;
 use crate::radiosity::{
     Element, FormFactorMethod, FormFactors, Hierarchy, HierarchySettings, Mesh, RadiositySolver,
-    Solution, solve,
+    Solution, VertexField, solve,
 };
 use crate::sampling::SamplerKind;
 use crate::sampling::{Domain, Sampler};
@@ -150,8 +150,8 @@ pub struct MatrixModel {
     pub mesh: Mesh,
     pub form_factors: FormFactors,
     pub solution: Solution,
-    /// Smooth display: per element, its three vertices' radiance.
-    vertex_radiance: Vec<[Rgb; 3]>,
+    /// Smooth display: the radiance at the elements' vertices.
+    vertex_radiance: VertexField,
 }
 
 /// What a radiosity solver works on.
@@ -379,7 +379,7 @@ impl Radiosity {
                         }
                         return weight * (sum / BACK_GATHERS as f32 + ambient);
                     }
-                    let reflected = match (self.display, surface.vertices) {
+                    let reflected = match (self.display, surface.smooth) {
                         (RadiosityDisplay::Gather, _) => gather(
                             scene,
                             state,
@@ -389,10 +389,8 @@ impl Radiosity {
                             sampler,
                             counts,
                         ),
-                        (RadiosityDisplay::Smooth, Some([l0, l1, l2])) => {
-                            let b = surface.barycentrics;
-                            ((1.0 - b.x - b.y) * l0 + b.x * l1 + b.y * l2 - e.emission)
-                                .max(Rgb::ZERO)
+                        (RadiosityDisplay::Smooth, Some(smooth)) => {
+                            (smooth - e.emission).max(Rgb::ZERO)
                         }
                         _ => surface.radiance - e.emission,
                     };
@@ -431,7 +429,7 @@ impl Radiosity {
         let vertex_radiance = if self.display == RadiosityDisplay::Smooth {
             mesh.vertex_radiance(&solution.radiance)
         } else {
-            Vec::new()
+            VertexField::default()
         };
         Ok(RadiosityState {
             model: Model::Matrix(MatrixModel {

@@ -16,6 +16,7 @@
 //! light from its open part only, and keeps links that found it dark, since
 //! its open part may see through them.
 
+use super::VertexField;
 use super::form_factor::{
     EXPOSURE_POINTS, Exchange, FormFactorMethod, exposure, faces, open_at, point_to_polygon,
     point_visibility, probed_element_to_element, sent_radiance,
@@ -96,7 +97,7 @@ pub struct Hierarchy {
     budget_spent: bool,
     /// Smooth display: per node, its vertices' radiance (leaves only; set
     /// by [`Hierarchy::smooth`]).
-    vertex_radiance: Vec<[Rgb; 3]>,
+    vertex_radiance: VertexField,
     /// Per node, the radiance ([`Hierarchy::exitant`]) the last step
     /// gathered from (children made since take their parent's), so that the
     /// smooth display's gather shows the same bounce as the leaves: one step
@@ -221,7 +222,7 @@ impl Hierarchy {
             steps: 0,
             notes: Vec::new(),
             budget_spent: false,
-            vertex_radiance: Vec::new(),
+            vertex_radiance: VertexField::default(),
             gathered_from: Vec::new(),
         };
         if specular > 0 {
@@ -296,7 +297,7 @@ impl Hierarchy {
         self.nodes.len() * std::mem::size_of::<Node>()
             + links * std::mem::size_of::<Link>()
             + self.gathered_from.len() * std::mem::size_of::<Rgb>()
-            + self.vertex_radiance.len() * std::mem::size_of::<[Rgb; 3]>()
+            + self.vertex_radiance.memory_bytes()
     }
 
     /// The oracle: a bound on the light a link from q to p carries, and so
@@ -673,6 +674,9 @@ impl Hierarchy {
                 }
             });
         }
-        self.vertex_radiance = per_node;
+        let elements = leaves
+            .iter()
+            .map(|&k| (k as usize, &self.nodes[k as usize].element));
+        self.vertex_radiance = VertexField::new(elements, per_node);
     }
 }

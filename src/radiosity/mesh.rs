@@ -6,6 +6,7 @@
 //! the solution changes fast between neighbours, so each patch keeps a
 //! quadtree of its elements.
 
+use super::VertexField;
 use super::reconstruct::vertex_key;
 use crate::accel::Geometry;
 use crate::math::Rgb;
@@ -302,10 +303,13 @@ impl Mesh {
             .collect()
     }
 
-    /// Per element, the radiance at its three vertices for the smooth
-    /// display ([`super::reconstruct::vertex_radiance`]).
-    pub fn vertex_radiance(&self, radiance: &[Rgb]) -> Vec<[Rgb; 3]> {
-        super::reconstruct::vertex_radiance(self.elements.iter().zip(radiance.iter().copied()))
+    /// The smooth display's radiance: per element, its three vertices'
+    /// ([`super::reconstruct::vertex_radiance`]), and the T-vertices of an
+    /// adaptive mesh ([`VertexField`]).
+    pub fn vertex_radiance(&self, radiance: &[Rgb]) -> VertexField {
+        let corners =
+            super::reconstruct::vertex_radiance(self.elements.iter().zip(radiance.iter().copied()));
+        VertexField::new(self.elements.iter().enumerate(), corners)
     }
 
     /// The element of scene triangle `triangle` that contains the point at

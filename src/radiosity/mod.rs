@@ -7,8 +7,10 @@ pub mod hierarchy;
 pub mod mesh;
 pub mod reconstruct;
 pub mod solve;
+pub mod vertex_field;
 
 pub use form_factor::FormFactorMethod;
 pub use hierarchy::{Hierarchy, HierarchySettings};
 pub use mesh::{Element, Mesh};
 pub use solve::{FormFactors, RadiositySolver, Solution};
+pub use vertex_field::VertexField;

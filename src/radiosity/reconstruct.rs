@@ -7,10 +7,10 @@
 //! values (as finite-volume schemes reconstruct cell averages), and a vertex
 //! takes the area-weighted mean of its elements' planes there: exact for a
 //! linear field, so the error falls as the element size squared, and shared
-//! by every element at the vertex, so the image has no cracks (bar the
-//! T-vertices of an adaptive mesh, where the coarser element interpolates
-//! its own corners). Hierarchies gather their vertices over their links
-//! instead ([`super::hierarchy::Hierarchy::smooth`]).
+//! by every element at the vertex, so the image has no cracks (at the
+//! T-vertices of an adaptive mesh, [`super::VertexField`] interpolates the
+//! coarser element through them). Hierarchies gather their vertices over
+//! their links instead ([`super::hierarchy::Hierarchy::smooth`]).
 
 use super::mesh::Element;
 use crate::math::Rgb;

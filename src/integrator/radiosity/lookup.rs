@@ -17,8 +17,8 @@ pub(super) struct Surface {
     pub(super) element: Element,
     /// The point's barycentrics in the element.
     pub(super) barycentrics: glam::Vec2,
-    /// Smooth display: the element's vertex radiance.
-    pub(super) vertices: Option<[Rgb; 3]>,
+    /// Smooth display: the radiance interpolated over the element.
+    pub(super) smooth: Option<Rgb>,
     pub(super) ambient: Rgb,
     /// Subdivision level of the element (0: the scene triangle).
     pub(super) level: u8,
@@ -64,20 +64,21 @@ pub(super) fn surface_at(
     let [a, b, c] = *scene.geometry.triangles().get(triangle)?;
     let (b1, b2) = barycentrics(hit.point, [a, b, c]);
     let (b1, b2) = (b1.clamp(0.0, 1.0), b2.clamp(0.0, 1.0 - b1.clamp(0.0, 1.0)));
-    let (radiance, element, vertices, ambient, level) = match &state.model {
+    let (k, radiance, element, field, ambient, level) = match &state.model {
         Model::Matrix(m) => {
             let k = m.mesh.element_at(triangle, b1, b2)?;
             (
+                k,
                 m.solution.radiance[k],
                 m.mesh.elements[k],
-                m.vertex_radiance.get(k).copied(),
+                &m.vertex_radiance,
                 m.solution.ambient,
                 m.mesh.levels[k],
             )
         }
         Model::Hierarchical(h) => {
-            let (radiance, element, vertices, level) = h.leaf_at(triangle, b1, b2)?;
-            (radiance, *element, vertices, Rgb::ZERO, level)
+            let (k, radiance, element, level) = h.leaf_at(triangle, b1, b2)?;
+            (k, radiance, *element, h.vertex_field(), Rgb::ZERO, level)
         }
     };
     let (e1, e2) = barycentrics(hit.point, element.vertices);
@@ -85,7 +86,7 @@ pub(super) fn surface_at(
         radiance,
         element,
         barycentrics: glam::Vec2::new(e1, e2),
-        vertices,
+        smooth: field.at(k, [1.0 - e1 - e2, e1, e2]),
         ambient,
         level,
     })

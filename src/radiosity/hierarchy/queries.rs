@@ -3,19 +3,13 @@
 
 use super::{Hierarchy, NONE};
 use crate::math::Rgb;
-use crate::radiosity::Element;
 use crate::radiosity::mesh::child_at;
+use crate::radiosity::{Element, VertexField};
 
 impl Hierarchy {
     /// The leaf of scene triangle `triangle` at its barycentrics (b1, b2):
-    /// its radiance, element, vertex radiance once [`Hierarchy::smooth`] ran,
-    /// and depth in the patch's tree.
-    pub fn leaf_at(
-        &self,
-        triangle: usize,
-        b1: f32,
-        b2: f32,
-    ) -> Option<(Rgb, &Element, Option<[Rgb; 3]>, u8)> {
+    /// its node, radiance, element and depth in the patch's tree.
+    pub fn leaf_at(&self, triangle: usize, b1: f32, b2: f32) -> Option<(usize, Rgb, &Element, u8)> {
         let mut k = *self.roots.get(triangle)?;
         if k == NONE {
             return None;
@@ -26,12 +20,13 @@ impl Hierarchy {
             k = self.nodes[k as usize].children + child as u32;
         }
         let n = &self.nodes[k as usize];
-        Some((
-            n.radiance,
-            &n.element,
-            self.vertex_radiance.get(k as usize).copied(),
-            n.depth,
-        ))
+        Some((k as usize, n.radiance, &n.element, n.depth))
+    }
+
+    /// The smooth display's radiance over the leaves, once
+    /// [`Hierarchy::smooth`] ran (by node).
+    pub fn vertex_field(&self) -> &VertexField {
+        &self.vertex_radiance
     }
 
     /// Per leaf, the sum of the form factors over its links and its
