@@ -11,7 +11,9 @@ mod furnace;
 mod chi2;
 // The Monte Carlo lab's experiments meet their closed-form statements.
 mod lab;
-// Radiosity: form factors and a closed box against closed forms, at any scale.
+// Form factors between squares and discs against closed forms; reciprocity.
+mod form_factors;
+// Radiosity: a closed box against its closed form at any scale, the Cornell box.
 mod radiosity;
 // BSDF energy conservation, reciprocity and sample/eval/pdf consistency.
 mod bsdf;

@@ -45,7 +45,7 @@ impl FormFactorMethod {
     /// a form factor between unit-sized squares is within 1e-3. The
     /// contour integral is there at 16 points (its error is the quadrature
     /// rule's); point pairs take 256 (at 16: 2.7e-3 for perpendicular
-    /// squares, 4.7e-3 for parallel 2 x 2 ones at distance 1; `tests/radiosity.rs`).
+    /// squares, 4.7e-3 for parallel 2 x 2 ones at distance 1; `tests/form_factors.rs`).
     pub fn default_samples(self) -> u32 {
         match self {
             FormFactorMethod::Analytic => 16,
