@@ -75,6 +75,8 @@ pub struct LiveView {
     /// ([`Session::shortcut_report`]; made on the render thread, which
     /// builds the camera lists).
     pub shortcuts: Arc<Vec<String>>,
+    /// A solver's notes on the scene ([`Session::solver_notes`]).
+    pub notes: Arc<Vec<String>>,
 }
 
 /// Everything published after a pass.
@@ -279,6 +281,7 @@ fn render_loop(shared: &Shared, commands: &Receiver<Command>, pool: &Arc<rayon::
                         done: false,
                         failure: None,
                         shortcuts: Arc::new(s.shortcut_report()),
+                        notes: Arc::new(Vec::new()),
                     })
                     .collect();
                 job = Some(Job {
@@ -411,6 +414,10 @@ impl Job {
         view.snapshot = Arc::new(snapshot);
         view.stats = stats;
         view.failure = session.failure().map(|e| e.to_string());
+        let notes = session.solver_notes();
+        if *view.notes != notes {
+            view.notes = Arc::new(notes);
+        }
         let target_reached = self.targets[index].is_some_and(|t| stats.spp >= t);
         // A solver is done once converged and its image has the target's
         // samples (until then its passes add samples to the same image).

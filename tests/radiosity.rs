@@ -506,3 +506,69 @@ fn radiosity_shows_a_thin_panel_from_either_side() {
         .fold(0.0f32, f32::max);
     assert!(worst < 1e-5, "pixels differ by up to {worst}");
 }
+
+/// A lamp on a floor, facing up, under a thin panel whose front faces up:
+/// the lamp lights the panel's back, which lights the floor. Seen from the
+/// side, the floor beside the lamp gets all its light from that back.
+fn panel_over_lamp(name: &str) -> Scene {
+    let text = "[camera]\neye = [1.8, 0.6, 0.0]\nlook_at = [1.0, 0.0, 0.0]\nfov_y = 20\nwidth = 16\nheight = 16\n\n\
+         [materials.white]\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\n\
+         [materials.lamp]\ntype = \"diffuse\"\nalbedo = [0.0, 0.0, 0.0]\nemission = [4.0, 4.0, 4.0]\n\n\
+         [[quad]]\ncorner = [-2.0, -0.001, -2.0]\nu = [0.0, 0.0, 4.0]\nv = [4.0, 0.0, 0.0]\nmaterial = \"white\"\n\n\
+         [[quad]]\ncorner = [-0.25, 0.0, -0.25]\nu = [0.0, 0.0, 0.5]\nv = [0.5, 0.0, 0.0]\nmaterial = \"lamp\"\n\n\
+         [[quad]]\ncorner = [-0.5, 1.0, -0.5]\nu = [0.0, 0.0, 1.0]\nv = [1.0, 0.0, 0.0]\nmaterial = \"white\"\n";
+    let path = temp_dir(name).join("panel.toml");
+    std::fs::write(&path, text).unwrap();
+    Scene::load(&path).expect("the scene loads")
+}
+
+/// The back of a thin surface lit from behind is a patch of its own: the
+/// floor it lights agrees with path tracing (one-sided patches left it
+/// black). Path tracing's image mean at 4 096 Sobol samples per pixel moves
+/// by 0.1% between seeds; measured, Gauss–Seidel (patch 0.05) is within
+/// 0.1% of it and the hierarchy (ε 1e-5, patch 0.02) 0.6% above. 6% is the
+/// mesh's error allowed (constant elements on a floor lit by a 1 m panel).
+#[test]
+fn the_back_of_a_thin_surface_reflects_light() {
+    let scene = panel_over_lamp("panel-over-lamp");
+    let two_sided = tracelab::radiosity::mesh::exposed_backs(&scene);
+    // The floor's back sees nothing, the lamp emits one way, the panel's
+    // back sees the floor around the lamp.
+    assert_eq!(two_sided, [false, false, false, false, true, true]);
+    let render = |options: IntegratorOptions, spp, seed| {
+        crate::common::render_with(
+            scene.clone(),
+            options.build(),
+            tracelab::sampling::SamplerKind::Sobol,
+            spp,
+            seed,
+            0,
+            spp,
+        )
+        .0
+        .image
+        .mean()[0]
+    };
+    let path = render(IntegratorOptions::default(), 4096, 0);
+    for (solver, patch_size) in [
+        (RadiositySolver::GaussSeidel, 0.05),
+        (RadiositySolver::Hierarchical, 0.02),
+    ] {
+        let options = IntegratorOptions {
+            kind: IntegratorKind::Radiosity,
+            radiosity_solver: solver,
+            radiosity_epsilon: 1e-5,
+            patch_size,
+            radiosity_display: tracelab::integrator::radiosity::RadiosityDisplay::Smooth,
+            ..IntegratorOptions::default()
+        };
+        let radiosity = render(options, 16, 0);
+        eprintln!(
+            "floor lit by the panel's back: {solver:?} {radiosity:.5}, path tracing {path:.5}"
+        );
+        assert!(
+            (radiosity / path - 1.0).abs() < 0.06,
+            "{solver:?}: {radiosity} against {path}"
+        );
+    }
+}

@@ -34,6 +34,9 @@ pub(crate) fn drive_solver(
     if let Some(e) = session.failure() {
         return Err(e);
     }
+    for note in session.solver_notes() {
+        eprintln!("note: {note}");
+    }
     Ok(session.stats())
 }
 

@@ -206,6 +206,11 @@ pub trait Solver: Technique {
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb;
+    /// What the user should know about how the scene was taken (surfaces
+    /// left out, materials approximated), one line each.
+    fn notes(&self, _state: &Self::State) -> Vec<String> {
+        Vec::new()
+    }
     /// Samples per pixel of one image of the solution (ray-cast display
     /// with antialiasing, say); 1 for a deterministic display.
     fn display_spp(&self) -> u32;

@@ -288,6 +288,13 @@ impl Solver for Radiosity {
         looked_up + seen.unwrap_or(Rgb::ZERO)
     }
 
+    fn notes(&self, state: &RadiosityState) -> Vec<String> {
+        match &state.model {
+            Model::Matrix(m) => m.mesh.notes.clone(),
+            Model::Hierarchical(h) => h.notes.clone(),
+        }
+    }
+
     fn display_spp(&self) -> u32 {
         16
     }

@@ -550,13 +550,13 @@ pub fn sent_radiance(radiance: Rgb, emission: Rgb, exposure: f32) -> Rgb {
 /// meets a surface from its front. A floor point under a block sees only the
 /// block's inside (back faces) and counts as hidden; so does the ceiling
 /// behind a light hung just below it. Returns the share and the rays cast.
-pub fn exposure(geometry: &Geometry, e: &Element, n: u32) -> (f32, u32) {
+pub fn exposure(geometry: &Geometry, two_sided: &[bool], e: &Element, n: u32) -> (f32, u32) {
     let mut on_e = Sampler::new(SamplerKind::Stratified, 0x5eed_0003, n);
     let (mut exposed, mut rays) = (0, 0);
     for k in 0..n {
         on_e.start(0, k);
         let (x, x_error) = point_on(e, on_e.next_2d());
-        let (open, cast) = open_at(geometry, x, x_error, e.normal, on_e.next_2d());
+        let (open, cast) = open_at(geometry, two_sided, x, x_error, e.normal, on_e.next_2d());
         exposed += u32::from(open);
         rays += cast;
     }
@@ -565,10 +565,12 @@ pub fn exposure(geometry: &Geometry, e: &Element, n: u32) -> (f32, u32) {
 
 /// Whether light can leave the point `x` (error bound `x_error`, normal
 /// `normal`): one of four cosine-distributed rays, one per quadrant of the
-/// square jittered by `jitter`, escapes or meets a surface from its front.
+/// square jittered by `jitter`, escapes or meets a surface from its front,
+/// or the back of a triangle that is `two_sided` (its back is a patch).
 /// Returns that and the rays cast.
 pub fn open_at(
     geometry: &Geometry,
+    two_sided: &[bool],
     x: Vec3A,
     x_error: Vec3A,
     normal: Vec3A,
@@ -581,7 +583,9 @@ pub fn open_at(
         let origin = crate::math::offset_ray_origin(x, x_error, normal, w);
         let open = geometry
             .intersect(&crate::math::Ray::new(origin, w))
-            .is_none_or(|hit| hit.normal.dot(w) < 0.0);
+            .is_none_or(|hit| {
+                hit.normal.dot(w) < 0.0 || two_sided.get(hit.primitive as usize) == Some(&true)
+            });
         if open {
             return (true, d + 1);
         }

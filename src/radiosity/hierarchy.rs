@@ -18,20 +18,18 @@
 
 use super::VertexField;
 use super::form_factor::{
-    EXPOSURE_POINTS, Exchange, FormFactorMethod, exposure, faces, open_at, point_to_polygon,
-    point_visibility, probed_element_to_element, sent_radiance,
+    EXPOSURE_POINTS, Exchange, FormFactorMethod, exposure, faces, point_to_polygon,
+    probed_element_to_element, sent_radiance,
 };
-use super::mesh::Element;
-use super::reconstruct::{VertexKey, vertex_key};
+use super::mesh::{Element, back_of, exposed_backs};
 use crate::accel::Geometry;
 use crate::math::Rgb;
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
-use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
-use std::collections::HashMap;
 
 mod queries;
+mod smooth;
 
 /// A link: the node gathers from `source` with form factor `f`, of which
 /// the share `visibility` of its shadow rays arrived; `f_max` is the
@@ -84,8 +82,12 @@ pub struct HierarchySettings {
 /// The trees, their links and the solution.
 pub struct Hierarchy {
     nodes: Vec<Node>,
-    /// Per scene triangle, its root node (`NONE` if not a patch).
+    /// Per scene triangle, its root node (`NONE` if not a patch), and that
+    /// of its back ([`exposed_backs`]; empty if no triangle has one).
     roots: Vec<u32>,
+    back_roots: Vec<u32>,
+    /// Per scene triangle, whether its back is a patch of its own.
+    two_sided: Vec<bool>,
     min_area: f32,
     emitted: f64,
     settings: HierarchySettings,
@@ -196,6 +198,22 @@ impl Hierarchy {
                 links: Vec::new(),
             });
         }
+        let two_sided = exposed_backs(scene);
+        let mut back_roots = Vec::new();
+        if two_sided.contains(&true) {
+            back_roots = vec![NONE; roots.len()];
+            for (i, &root) in roots.iter().enumerate() {
+                if two_sided[i] && root != NONE {
+                    let front = nodes[root as usize].clone();
+                    back_roots[i] = nodes.len() as u32;
+                    nodes.push(Node {
+                        element: back_of(&front.element, roots.len()),
+                        radiance: Rgb::ZERO,
+                        ..front
+                    });
+                }
+            }
+        }
         if nodes.is_empty() {
             return Err("radiosity needs diffuse surfaces: the scene has none".into());
         }
@@ -214,6 +232,8 @@ impl Hierarchy {
         let mut h = Hierarchy {
             nodes,
             roots,
+            back_roots,
+            two_sided,
             // The area of an equilateral triangle of edge min_size.
             min_area: 0.433 * min_size * min_size,
             emitted,
@@ -225,6 +245,12 @@ impl Hierarchy {
             vertex_radiance: VertexField::default(),
             gathered_from: Vec::new(),
         };
+        let backs = h.back_roots.iter().filter(|&&r| r != NONE).count();
+        if backs > 0 {
+            h.notes.push(format!(
+                "{backs} thin triangles lit from behind are patches on both sides"
+            ));
+        }
         if specular > 0 {
             h.notes.push(format!(
                 "{specular} mirror and glass triangles are not patches: they block light between \
@@ -276,7 +302,14 @@ impl Hierarchy {
         let nodes = &self.nodes;
         let measured: Vec<(f32, u32)> = new
             .par_iter()
-            .map(|&k| exposure(geometry, &nodes[k as usize].element, EXPOSURE_POINTS))
+            .map(|&k| {
+                exposure(
+                    geometry,
+                    &self.two_sided,
+                    &nodes[k as usize].element,
+                    EXPOSURE_POINTS,
+                )
+            })
             .collect();
         for (&k, (share, rays)) in new.iter().zip(measured) {
             self.nodes[k as usize].exposure = share;
@@ -520,8 +553,12 @@ impl Hierarchy {
             n.gathered = g;
         }
         let mut change = 0.0;
-        for r in 0..self.roots.len() {
-            let root = self.roots[r];
+        for r in 0..self.roots.len() + self.back_roots.len() {
+            let root = self
+                .roots
+                .get(r)
+                .copied()
+                .unwrap_or_else(|| self.back_roots[r - self.roots.len()]);
             if root != NONE {
                 let old = self.nodes[root as usize].radiance;
                 let new = self.push_pull(root, Rgb::ZERO);
@@ -570,113 +607,5 @@ impl Hierarchy {
         };
         self.nodes[k as usize].radiance = radiance;
         radiance
-    }
-
-    /// Computes the leaves' vertex radiance for the smooth display: at each
-    /// vertex, E + ρ Σ B_q F(x → q) V over the links of the leaf and of its
-    /// ancestors, F the point-to-polygon form factor at the vertex and V the
-    /// link's share of visible shadow rays. A link's transfer is constant
-    /// over its gatherer (the constant basis) but its kernel is not, so a
-    /// coarse link that lights a whole wall still shades it smoothly where
-    /// pushing its constant down would leave steps the size of the link;
-    /// Cornell box, ε 1e-5: masked RMSE 0.00450 with per-leaf gradients.
-    pub fn smooth(&mut self, geometry: &Geometry) {
-        let mut parent = vec![NONE; self.nodes.len()];
-        for (k, n) in self.nodes.iter().enumerate() {
-            if n.children != NONE {
-                parent[n.children as usize..n.children as usize + 4].fill(k as u32);
-            }
-        }
-        let leaves: Vec<u32> = (0..self.nodes.len() as u32)
-            .filter(|&k| self.nodes[k as usize].children == NONE)
-            .collect();
-        // One gather per vertex, through the most exposed, then smallest,
-        // leaf that has it (its links are the finest there); the leaves
-        // sharing it read it. A vertex gathered from inside a hidden leaf
-        // (the ceiling above the light) darkened its open neighbours.
-        self.measure_exposure(geometry);
-        let preference = |k: u32| {
-            let n = &self.nodes[k as usize];
-            (n.exposure, -n.element.area)
-        };
-        let mut index: HashMap<VertexKey, usize> = HashMap::new();
-        let mut vertices: Vec<(u32, Vec3A)> = Vec::new();
-        for &k in &leaves {
-            let e = &self.nodes[k as usize].element;
-            for v in e.vertices {
-                let slot = *index.entry(vertex_key(v, e)).or_insert_with(|| {
-                    vertices.push((k, v));
-                    vertices.len() - 1
-                });
-                if preference(k) > preference(vertices[slot].0) {
-                    vertices[slot].0 = k;
-                }
-            }
-        }
-        let values: Vec<(Rgb, bool)> = vertices
-            .par_iter()
-            .map(|&(k, v)| {
-                let e = &self.nodes[k as usize].element;
-                let centroid = (e.vertices[0] + e.vertices[1] + e.vertices[2]) / 3.0;
-                // Just inside: on a neighbour's edge the integral is singular.
-                let x = v + 0.05 * (centroid - v);
-                let mut irradiance = Rgb::ZERO;
-                let mut a = k;
-                while a != NONE {
-                    for link in &self.nodes[a as usize].links {
-                        let q = &self.nodes[link.source as usize];
-                        // One-sided sources send nothing behind their plane.
-                        if q.element.normal.dot(x - q.element.vertices[0]) <= 0.0 {
-                            continue;
-                        }
-                        let f = point_to_polygon(x, e.normal, &q.element.vertices);
-                        // Through a shadow boundary the link's mean is not
-                        // the vertex's: a leaf half behind the light gave
-                        // the ceiling a dark ring around it.
-                        let visibility = if self.uncertain(a, link) {
-                            point_visibility(geometry, x, e.normal, &q.element, VERTEX_RAYS)
-                        } else {
-                            link.visibility
-                        };
-                        let from = self.gathered_from.get(link.source as usize);
-                        let sent = from.copied().unwrap_or_else(|| self.exitant(link.source));
-                        irradiance += (visibility * f) * sent;
-                    }
-                    a = parent[a as usize];
-                }
-                let x_error = crate::math::gamma(7) * x.abs();
-                let (open, _) = open_at(geometry, x, x_error, e.normal, Vec2::splat(0.5));
-                (
-                    (e.emission + e.reflectance * irradiance).max(Rgb::ZERO),
-                    open,
-                )
-            })
-            .collect();
-        let mut per_node = vec![[Rgb::ZERO; 3]; self.nodes.len()];
-        for &k in &leaves {
-            let e = &self.nodes[k as usize].element;
-            let corners = e.vertices.map(|v| values[index[&vertex_key(v, e)]]);
-            // A leaf partly hidden (the ceiling's edge around the light, the
-            // floor's around a block) shows its open part: hidden corners,
-            // dark, take the open corners' mean instead of shading it
-            // towards black. Cornell box, masked RMSE without -> with: ε 1e-4
-            // 0.00236 -> 0.00233, 7e-5 0.00222 -> 0.00217 (large leaves);
-            // 1e-5 0.00130 -> 0.00131 (small ones, where it hardly matters).
-            let (sum, count) = corners
-                .iter()
-                .filter(|c| c.1)
-                .fold((Rgb::ZERO, 0.0), |(s, n), c| (s + c.0, n + 1.0));
-            per_node[k as usize] = corners.map(|(value, is_open)| {
-                if is_open || count == 0.0 {
-                    value
-                } else {
-                    sum / count
-                }
-            });
-        }
-        let elements = leaves
-            .iter()
-            .map(|&k| (k as usize, &self.nodes[k as usize].element));
-        self.vertex_radiance = VertexField::new(elements, per_node);
     }
 }

@@ -44,9 +44,13 @@ pub struct Mesh {
     pub elements: Vec<Element>,
     /// Per element, its subdivision level (0: the scene triangle itself).
     pub levels: Vec<u8>,
-    /// Per scene triangle, its root cell (`NONE` where it is not a patch).
+    /// Per scene triangle, its root cell (`NONE` where it is not a patch),
+    /// and that of its back ([`exposed_backs`]; empty if no triangle has one).
     roots: Vec<u32>,
+    back_roots: Vec<u32>,
     cells: Vec<Cell>,
+    /// Per scene triangle, whether its back is a patch of its own.
+    pub two_sided: Vec<bool>,
     /// Triangles left out and why (mirrors and glass are traced through).
     pub notes: Vec<String>,
 }
@@ -79,6 +83,7 @@ impl Mesh {
         let bounds = geometry.bounds();
         let target = size * (bounds.max - bounds.min).length();
         let triangles = geometry.triangles();
+        let two_sided = exposed_backs(scene);
         let mut depths = Vec::with_capacity(triangles.len());
         let (mut glossy, mut specular) = (0usize, 0usize);
         let mut total = 0usize;
@@ -108,7 +113,7 @@ impl Mesh {
             while depth < MAX_DEPTH && longest / (1u32 << depth) as f32 > target {
                 depth += 1;
             }
-            total += 1usize << (2 * depth);
+            total += (1usize << (2 * depth)) * (1 + usize::from(two_sided[i]));
             depths.push(Some(depth));
         }
         if total == 0 {
@@ -129,9 +134,14 @@ impl Mesh {
             elements: Vec::with_capacity(total),
             levels: Vec::with_capacity(total),
             roots: Vec::with_capacity(triangles.len()),
+            back_roots: Vec::new(),
             cells: Vec::new(),
+            two_sided,
             notes: Vec::new(),
         };
+        if mesh.two_sided.contains(&true) {
+            mesh.back_roots = vec![NONE; triangles.len()];
+        }
         for (i, (v, depth)) in triangles.iter().zip(depths).enumerate() {
             let Some(depth) = depth else {
                 mesh.roots.push(NONE);
@@ -154,6 +164,22 @@ impl Mesh {
             mesh.roots.push(mesh.cells.len() as u32);
             mesh.cells.push(Cell::Leaf(NONE));
             mesh.grow(mesh.roots[i], root, 0, depth);
+            if mesh.two_sided[i] {
+                mesh.back_roots[i] = mesh.cells.len() as u32;
+                mesh.cells.push(Cell::Leaf(NONE));
+                mesh.grow(
+                    mesh.back_roots[i],
+                    back_of(&root, triangles.len()),
+                    0,
+                    depth,
+                );
+            }
+        }
+        let backs = mesh.back_roots.iter().filter(|&&r| r != NONE).count();
+        if backs > 0 {
+            mesh.notes.push(format!(
+                "{backs} thin triangles lit from behind are patches on both sides"
+            ));
         }
         if glossy > 0 {
             mesh.notes.push(format!(
@@ -210,24 +236,28 @@ impl Mesh {
             elements: Vec::with_capacity(self.elements.len()),
             levels: Vec::with_capacity(self.elements.len()),
             roots: Vec::with_capacity(self.roots.len()),
+            back_roots: Vec::with_capacity(self.back_roots.len()),
             cells: Vec::with_capacity(self.cells.len()),
+            two_sided: self.two_sided.clone(),
             notes: self.notes.clone(),
         };
         let mut origin = Vec::with_capacity(self.elements.len());
-        for &root in &self.roots {
-            if root == NONE {
-                mesh.roots.push(NONE);
-                continue;
+        for (roots, back) in [(&self.roots, false), (&self.back_roots, true)] {
+            for &root in roots {
+                let copy = if root == NONE {
+                    NONE
+                } else {
+                    let copy = mesh.cells.len() as u32;
+                    mesh.cells.push(Cell::Leaf(NONE));
+                    self.copy_cell(root, copy, &mut mesh, split, &mut origin);
+                    copy
+                };
+                if back {
+                    mesh.back_roots.push(copy);
+                } else {
+                    mesh.roots.push(copy);
+                }
             }
-            mesh.roots.push(mesh.cells.len() as u32);
-            mesh.cells.push(Cell::Leaf(NONE));
-            self.copy_cell(
-                root,
-                mesh.roots[mesh.roots.len() - 1],
-                &mut mesh,
-                split,
-                &mut origin,
-            );
         }
         (mesh, origin)
     }
@@ -312,14 +342,21 @@ impl Mesh {
         VertexField::new(self.elements.iter().enumerate(), corners)
     }
 
-    /// The element of scene triangle `triangle` that contains the point at
-    /// barycentrics (b1, b2) of the triangle, if the triangle is a patch.
-    pub fn element_at(&self, triangle: usize, b1: f32, b2: f32) -> Option<usize> {
-        let mut cell = *self.roots.get(triangle)?;
+    /// The element of scene triangle `triangle`, or of its back, that
+    /// contains the point at barycentrics (b1, b2) of the triangle, if that
+    /// side is a patch.
+    pub fn element_at(&self, triangle: usize, back: bool, b1: f32, b2: f32) -> Option<usize> {
+        let roots = if back { &self.back_roots } else { &self.roots };
+        let mut cell = *roots.get(triangle)?;
         if cell == NONE {
             return None;
         }
-        let mut b = [1.0 - b1 - b2, b1, b2];
+        // A back's root lists the triangle's corners 0, 2, 1.
+        let mut b = if back {
+            [1.0 - b1 - b2, b2, b1]
+        } else {
+            [1.0 - b1 - b2, b1, b2]
+        };
         loop {
             match self.cells[cell as usize] {
                 Cell::Leaf(e) => return Some(e as usize),
@@ -403,7 +440,7 @@ mod tests {
             for j in 0..40 - i {
                 let (b1, b2) = ((i as f32 + 0.3) / 41.0, (j as f32 + 0.3) / 41.0);
                 let p = v[0] + b1 * v[1] + b2 * v[2];
-                let k = mesh.element_at(0, b1, b2).unwrap();
+                let k = mesh.element_at(0, false, b1, b2).unwrap();
                 // p inside the element and its origin: all edge functions agree in sign.
                 let inside = |[a, b, c]: [Vec3A; 3]| {
                     let side = |x: Vec3A, y: Vec3A| (y - x).cross(p - x).z;
@@ -449,5 +486,92 @@ pub fn back_twins(geometry: &Geometry) -> Vec<u32> {
                 .find(|&o| normal(&triangles[o as usize]).dot(n) < 0.0)
                 .unwrap_or(u32::MAX)
         })
+        .collect()
+}
+
+/// The back of patch `front` (of scene triangle `front.triangle` among
+/// `triangles`): its corners 0, 2, 1, facing the other way, reflecting
+/// alike and emitting nothing (emitters are one-sided). Its patch number is
+/// the triangle's plus the triangle count, so that shooting keeps the two
+/// sides apart.
+pub fn back_of(front: &Element, triangles: usize) -> Element {
+    let [a, b, c] = front.vertices;
+    Element {
+        triangle: front.triangle + triangles as u32,
+        vertices: [a, c, b],
+        normal: -front.normal,
+        emission: Rgb::ZERO,
+        ..*front
+    }
+}
+
+/// Rays from a triangle's back that decide whether it is a patch of its own.
+const BACK_RAYS: u32 = 16;
+
+/// Per scene triangle, whether its back is a patch of its own (a thin
+/// surface lit on both sides: a lamp shade, a panel, a single-quad table):
+/// diffuse, emitting nothing, without a coincident twin facing the other
+/// way ([`back_twins`]), and such that one of [`BACK_RAYS`] cosine rays from
+/// its back meets the front of a diffuse surface at a point light can
+/// leave. Walls seen from outside a room see nothing; a block's faces seen
+/// from inside it see only the floor under it, which no light reaches.
+pub fn exposed_backs(scene: &Scene) -> Vec<bool> {
+    use super::form_factor::open_at;
+    use crate::sampling::{Sampler, SamplerKind};
+    let geometry = &scene.geometry;
+    let twins = back_twins(geometry);
+    let diffuse = |material: u32| {
+        let m = &scene.materials[material as usize];
+        matches!(m.bsdf, Bsdf::Diffuse { .. } | Bsdf::Glossy { .. })
+    };
+    let none = vec![false; geometry.triangles().len()];
+    let exposed = |i: usize, v: &[Vec3A; 3]| -> bool {
+        let material = geometry.triangle_material(i);
+        let n = (v[1] - v[0]).cross(v[2] - v[0]);
+        if twins[i] != u32::MAX
+            || !diffuse(material)
+            || scene.materials[material as usize].emission.max_element() > 0.0
+            || !(n.length() > 0.0)
+        {
+            return false;
+        }
+        let back = -n.normalize();
+        let frame = crate::math::Frame::from_normal(back);
+        let mut sampler = Sampler::new(SamplerKind::Stratified, 0x5eed_0004, BACK_RAYS);
+        (0..BACK_RAYS).any(|k| {
+            sampler.start(i as u32, k);
+            let u = sampler.next_2d();
+            let (b1, b2) = if u.x + u.y > 1.0 {
+                (1.0 - u.x, 1.0 - u.y)
+            } else {
+                (u.x, u.y)
+            };
+            let x = v[0] + b1 * (v[1] - v[0]) + b2 * (v[2] - v[0]);
+            let x_error = crate::math::gamma(7) * (v[0].abs() + v[1].abs() + v[2].abs());
+            let w = frame.to_world(crate::sampling::warp::square_to_cosine_hemisphere(
+                sampler.next_2d(),
+            ));
+            let origin = crate::math::offset_ray_origin(x, x_error, back, w);
+            let Some(hit) = geometry.intersect(&crate::math::Ray::new(origin, w)) else {
+                return false;
+            };
+            hit.normal.dot(w) < 0.0
+                && diffuse(hit.material)
+                && open_at(
+                    geometry,
+                    &none,
+                    hit.point,
+                    hit.error,
+                    hit.normal,
+                    sampler.next_2d(),
+                )
+                .0
+        })
+    };
+    geometry
+        .triangles()
+        .iter()
+        .enumerate()
+        .map(|(i, v)| exposed(i, v))
         .collect()
 }

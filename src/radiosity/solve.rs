@@ -168,7 +168,7 @@ impl Solution {
         let measured: Vec<(f32, u32)> = mesh
             .elements
             .par_iter()
-            .map(|e| exposure(geometry, e, EXPOSURE_POINTS))
+            .map(|e| exposure(geometry, &mesh.two_sided, e, EXPOSURE_POINTS))
             .collect();
         self.exposure = measured.iter().map(|m| m.0).collect();
         measured.iter().map(|m| u64::from(m.1)).sum()

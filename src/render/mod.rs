@@ -121,6 +121,8 @@ pub struct Session {
     /// ([`Solver::State`]); `None` until the first pass.
     solver_state: Mutex<Option<Box<dyn std::any::Any + Send + Sync>>>,
     solver_progress: Mutex<Option<SolverProgress>>,
+    /// A solver's notes on the scene ([`crate::integrator::Solver::notes`]).
+    solver_notes: Mutex<Vec<String>>,
     /// Why the technique could not run (a solver's set-up failed).
     failure: Mutex<Option<Error>>,
 }
@@ -179,6 +181,7 @@ impl Session {
             pass_plan: Mutex::new(None),
             solver_state: Mutex::new(None),
             solver_progress: Mutex::new(None),
+            solver_notes: Mutex::new(Vec::new()),
             failure: Mutex::new(None),
         }
     }
@@ -531,6 +534,12 @@ impl Session {
         let Session { scene, film, .. } = self;
         drop(scene);
         film.into_final()
+    }
+
+    /// A solver's notes on the scene after its last pass (surfaces left
+    /// out, materials approximated), one line each.
+    pub fn solver_notes(&self) -> Vec<String> {
+        lock(&self.solver_notes).clone()
     }
 
     /// Which small-scene shortcuts apply to this render, or why not, one

@@ -80,6 +80,7 @@ impl SolverVisitor for SolverPass<'_> {
             .install(|| solver.step(scene, typed, self.k, &mut counts));
         session.add_counts(0, &counts, 0);
         *lock(&session.solver_progress) = Some(progress);
+        *lock(&session.solver_notes) = solver.notes(typed);
         // A converged solution that this pass left as it was keeps its
         // image, which gains samples (the gather display's noise falls);
         // any other pass draws the new solution on a clear film.

@@ -39,6 +39,11 @@ pub fn stats_panel(ui: &mut egui::Ui, app: &mut ViewerApp) {
                 .monospace(),
             );
         }
+        if !view.notes.is_empty() {
+            let text = format!("{name} notes: {}", view.notes.join(" | "));
+            ui.add(egui::Label::new(egui::RichText::new(text).weak()).truncate())
+                .on_hover_text(view.notes.join("\n"));
+        }
         if !view.shortcuts.is_empty() {
             let text = format!("{name} shortcuts: {}", view.shortcuts.join(" | "));
             ui.add(egui::Label::new(egui::RichText::new(text).weak()).truncate())

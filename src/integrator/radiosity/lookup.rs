@@ -53,12 +53,13 @@ pub(super) fn level_colour(level: u8) -> Rgb {
     Rgb::new(r, g, b)
 }
 
-/// The element a hit lies in and its solution (None for spheres and
-/// surfaces that are not patches).
+/// The element a hit lies in, on the triangle's front or its `back`, and
+/// its solution (None for spheres and sides that are not patches).
 pub(super) fn surface_at(
     scene: &Scene,
     state: &RadiosityState,
     hit: &SurfaceHit,
+    back: bool,
 ) -> Option<Surface> {
     let triangle = hit.primitive as usize;
     let [a, b, c] = *scene.geometry.triangles().get(triangle)?;
@@ -66,7 +67,7 @@ pub(super) fn surface_at(
     let (b1, b2) = (b1.clamp(0.0, 1.0), b2.clamp(0.0, 1.0 - b1.clamp(0.0, 1.0)));
     let (k, radiance, element, field, ambient, level) = match &state.model {
         Model::Matrix(m) => {
-            let k = m.mesh.element_at(triangle, b1, b2)?;
+            let k = m.mesh.element_at(triangle, back, b1, b2)?;
             (
                 k,
                 m.solution.radiance[k],
@@ -77,7 +78,7 @@ pub(super) fn surface_at(
             )
         }
         Model::Hierarchical(h) => {
-            let (k, radiance, element, level) = h.leaf_at(triangle, b1, b2)?;
+            let (k, radiance, element, level) = h.leaf_at(triangle, back, b1, b2)?;
             (k, radiance, *element, h.vertex_field(), Rgb::ZERO, level)
         }
     };
@@ -93,18 +94,23 @@ pub(super) fn surface_at(
 }
 
 /// The patch a ray travelling along `direction` meets at `hit`, and whether
-/// it meets its front. Of two coincident triangles facing apart
-/// ([`back_twins`]: indirect.toml's table), the ray may have met the one
-/// facing away: then it is the other's front.
+/// it meets its front. Met from behind, a triangle shows its back's patch
+/// ([`crate::radiosity::mesh::exposed_backs`]: a thin surface lit on both
+/// sides), or of two
+/// coincident triangles facing apart ([`crate::radiosity::mesh::back_twins`]: indirect.toml's
+/// table) the other's front.
 pub(super) fn facing_surface(
     scene: &Scene,
     state: &RadiosityState,
     hit: &SurfaceHit,
     direction: glam::Vec3A,
 ) -> Option<(Surface, bool)> {
-    let surface = surface_at(scene, state, hit)?;
+    let surface = surface_at(scene, state, hit, false)?;
     if surface.element.normal.dot(direction) < 0.0 {
         return Some((surface, true));
+    }
+    if let Some(back) = surface_at(scene, state, hit, true) {
+        return Some((back, true));
     }
     let twin = state.back_twins.get(hit.primitive as usize).copied();
     let across = twin.filter(|&t| t != u32::MAX).and_then(|t| {
@@ -113,7 +119,7 @@ pub(super) fn facing_surface(
             normal: -hit.normal,
             ..*hit
         };
-        surface_at(scene, state, &hit)
+        surface_at(scene, state, &hit, false)
     });
     Some(across.map_or((surface, false), |s| (s, true)))
 }

@@ -7,14 +7,27 @@ use crate::radiosity::mesh::child_at;
 use crate::radiosity::{Element, VertexField};
 
 impl Hierarchy {
-    /// The leaf of scene triangle `triangle` at its barycentrics (b1, b2):
-    /// its node, radiance, element and depth in the patch's tree.
-    pub fn leaf_at(&self, triangle: usize, b1: f32, b2: f32) -> Option<(usize, Rgb, &Element, u8)> {
-        let mut k = *self.roots.get(triangle)?;
+    /// The leaf of scene triangle `triangle`, or of its back, at the
+    /// triangle's barycentrics (b1, b2): its node, radiance, element and
+    /// depth in the patch's tree.
+    pub fn leaf_at(
+        &self,
+        triangle: usize,
+        back: bool,
+        b1: f32,
+        b2: f32,
+    ) -> Option<(usize, Rgb, &Element, u8)> {
+        let roots = if back { &self.back_roots } else { &self.roots };
+        let mut k = *roots.get(triangle)?;
         if k == NONE {
             return None;
         }
-        let mut b = [1.0 - b1 - b2, b1, b2];
+        // A back's root lists the triangle's corners 0, 2, 1.
+        let mut b = if back {
+            [1.0 - b1 - b2, b2, b1]
+        } else {
+            [1.0 - b1 - b2, b1, b2]
+        };
         while self.nodes[k as usize].children != NONE {
             let child = child_at(&mut b);
             k = self.nodes[k as usize].children + child as u32;
@@ -37,6 +50,7 @@ impl Hierarchy {
         let mut stack: Vec<(u32, f32)> = self
             .roots
             .iter()
+            .chain(&self.back_roots)
             .filter(|&&r| r != NONE)
             .map(|&r| (r, 0.0))
             .collect();
