@@ -286,6 +286,12 @@ fn radiosity_controls_drive_the_solver() {
     click(&mut harness, "Radiosity");
     click(&mut harness, "hierarchical");
     click(&mut harness, "flat");
+    // Each form-factor method starts from the count at which it is accurate.
+    let samples = |h: &Harness<'_, Window>| h.state().app.settings.a.integrator.form_factor_samples;
+    click(&mut harness, "Ray casting");
+    assert_eq!(samples(&harness), 256);
+    click(&mut harness, "Contour integral");
+    assert_eq!(samples(&harness), 16);
     let options = harness.state().app.settings.a.integrator;
     assert_eq!(options.kind, IntegratorKind::Radiosity);
     assert_eq!(
