@@ -12,18 +12,7 @@ use tracelab::radiosity::{Element, FormFactorMethod};
 fn elements(triangles: impl IntoIterator<Item = [Vec3A; 3]>) -> Vec<Element> {
     triangles
         .into_iter()
-        .map(|vertices| {
-            let [a, b, c] = vertices;
-            let n = (b - a).cross(c - a);
-            Element {
-                triangle: 0,
-                vertices,
-                normal: n.normalize(),
-                area: 0.5 * n.length(),
-                reflectance: Rgb::ZERO,
-                emission: Rgb::ZERO,
-            }
-        })
+        .map(|vertices| Element::new(0, vertices, Rgb::ZERO, Rgb::ZERO))
         .collect()
 }
 

@@ -452,47 +452,34 @@ fn sweep(
     options: IntegratorOptions,
     args: &RadiosityArgs,
 ) -> Result<()> {
-    let runs: Vec<(&str, Vec<(f32, IntegratorOptions)>)> = [
-        (
-            "epsilon",
-            args.sweep_epsilon
-                .iter()
-                .map(|&e| {
-                    let run = IntegratorOptions {
-                        radiosity_epsilon: e,
-                        ..options
-                    };
-                    (e, run)
-                })
-                .collect::<Vec<_>>(),
-        ),
-        (
-            "patch size",
-            args.sweep_patch_size
-                .iter()
-                .map(|&s| {
-                    let run = IntegratorOptions {
-                        patch_size: s,
-                        ..options
-                    };
-                    (s, run)
-                })
-                .collect(),
-        ),
-    ]
-    .into_iter()
-    .filter(|(_, runs)| !runs.is_empty())
-    .collect();
+    let sweeps = [
+        ("epsilon", &args.sweep_epsilon),
+        ("patch size", &args.sweep_patch_size),
+    ];
     let mut csv = String::from(
         "sweep,value,steps,elements,links,shadow_rays,bytes,solve_seconds,display_seconds,\
          residual,rmse,masked_rmse\n",
     );
     let mut series = Vec::new();
-    for (name, values) in runs {
+    for (name, values) in sweeps {
+        if values.is_empty() {
+            continue;
+        }
         println!("{name} sweep (converged):");
         print_header(name);
         let mut points = Vec::new();
-        for (value, run_options) in values {
+        for &value in values {
+            let run_options = if name == "epsilon" {
+                IntegratorOptions {
+                    radiosity_epsilon: value,
+                    ..options
+                }
+            } else {
+                IntegratorOptions {
+                    patch_size: value,
+                    ..options
+                }
+            };
             let rows = run(scene.clone(), reference, run_options, args, false)?;
             let Some(last) = rows.last() else { continue };
             let label = if name == "epsilon" {

@@ -373,12 +373,12 @@ impl Radiosity {
                         Rgb::ZERO
                     };
                     let ambient = e.reflectance * surface.ambient;
-                    // Patches are one-sided: the solution has nothing for a
-                    // patch's back, which a thin surface shows (the outside
-                    // of indirect.toml's lamp shade, whose inside the lamp
-                    // lights: it read 28 where path tracing finds 0.15).
-                    // There the display gathers (light sampled, one bounce
-                    // into the solution), whatever its mode.
+                    // A triangle's back without a patch of its own (nothing
+                    // lit it when the mesh was made: `exposed_backs`) has
+                    // nothing in the solution; its front's would be wrong
+                    // (indirect.toml's lamp shade read 28 outside where path
+                    // tracing finds 0.15). There the display gathers (light
+                    // sampled, one bounce into the solution), whatever its mode.
                     if !from_front && self.display != RadiosityDisplay::Gather {
                         let (mut sum, wo) = (Rgb::ZERO, -ray.direction);
                         for _ in 0..BACK_GATHERS {

@@ -123,7 +123,7 @@ fn angle_from(y: f32, x: f32) -> f32 {
 
 /// A uniform point of `element` and its rounding-error bound.
 #[inline]
-fn point_on(element: &Element, u: Vec2) -> (Vec3A, Vec3A) {
+pub(crate) fn point_on(element: &Element, u: Vec2) -> (Vec3A, Vec3A) {
     point_at(element, square_to_uniform_triangle(u))
 }
 

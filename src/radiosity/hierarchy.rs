@@ -175,21 +175,14 @@ impl Hierarchy {
                     continue;
                 }
             };
-            let n = (v[1] - v[0]).cross(v[2] - v[0]);
-            if !(n.length() > 0.0) {
+            let element = Element::new(i as u32, *v, reflectance, material.emission);
+            if !(element.area > 0.0) {
                 roots.push(NONE);
                 continue;
             }
             roots.push(nodes.len() as u32);
             nodes.push(Node {
-                element: Element {
-                    triangle: i as u32,
-                    vertices: *v,
-                    normal: n.normalize(),
-                    area: 0.5 * n.length(),
-                    reflectance,
-                    emission: material.emission,
-                },
+                element,
                 depth: 0,
                 children: NONE,
                 gathered: Rgb::ZERO,

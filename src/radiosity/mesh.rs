@@ -30,6 +30,21 @@ pub struct Element {
 }
 
 impl Element {
+    /// The element on `vertices` (of patch `triangle`), its normal along
+    /// their winding and its area from them.
+    pub fn new(triangle: u32, vertices: [Vec3A; 3], reflectance: Rgb, emission: Rgb) -> Element {
+        let [a, b, c] = vertices;
+        let n = (b - a).cross(c - a);
+        Element {
+            triangle,
+            vertices,
+            normal: n.normalize(),
+            area: 0.5 * n.length(),
+            reflectance,
+            emission,
+        }
+    }
+
     /// The point at barycentrics (b1, b2) of the element.
     #[inline]
     pub fn point(&self, b1: f32, b2: f32) -> Vec3A {
@@ -205,14 +220,13 @@ impl Mesh {
     /// Fills `cell` with `element` split `depth` more levels below `level`.
     fn grow(&mut self, cell: u32, element: Element, level: u8, depth: u8) {
         if depth == 0 {
-            let [a, b, c] = element.vertices;
-            let n = (b - a).cross(c - a);
             self.cells[cell as usize] = Cell::Leaf(self.elements.len() as u32);
-            self.elements.push(Element {
-                normal: n.normalize(),
-                area: 0.5 * n.length(),
-                ..element
-            });
+            self.elements.push(Element::new(
+                element.triangle,
+                element.vertices,
+                element.reflectance,
+                element.emission,
+            ));
             self.levels.push(level);
             return;
         }
@@ -516,7 +530,7 @@ const BACK_RAYS: u32 = 16;
 /// leave. Walls seen from outside a room see nothing; a block's faces seen
 /// from inside it see only the floor under it, which no light reaches.
 pub fn exposed_backs(scene: &Scene) -> Vec<bool> {
-    use super::form_factor::open_at;
+    use super::form_factor::{open_at, point_on};
     use crate::sampling::{Sampler, SamplerKind};
     let geometry = &scene.geometry;
     let twins = back_twins(geometry);
@@ -527,31 +541,24 @@ pub fn exposed_backs(scene: &Scene) -> Vec<bool> {
     let none = vec![false; geometry.triangles().len()];
     let exposed = |i: usize, v: &[Vec3A; 3]| -> bool {
         let material = geometry.triangle_material(i);
-        let n = (v[1] - v[0]).cross(v[2] - v[0]);
+        let front = Element::new(i as u32, *v, Rgb::ZERO, Rgb::ZERO);
         if twins[i] != u32::MAX
             || !diffuse(material)
             || scene.materials[material as usize].emission.max_element() > 0.0
-            || !(n.length() > 0.0)
+            || !(front.area > 0.0)
         {
             return false;
         }
-        let back = -n.normalize();
-        let frame = crate::math::Frame::from_normal(back);
+        let back = back_of(&front, 0);
+        let frame = crate::math::Frame::from_normal(back.normal);
         let mut sampler = Sampler::new(SamplerKind::Stratified, 0x5eed_0004, BACK_RAYS);
         (0..BACK_RAYS).any(|k| {
             sampler.start(i as u32, k);
-            let u = sampler.next_2d();
-            let (b1, b2) = if u.x + u.y > 1.0 {
-                (1.0 - u.x, 1.0 - u.y)
-            } else {
-                (u.x, u.y)
-            };
-            let x = v[0] + b1 * (v[1] - v[0]) + b2 * (v[2] - v[0]);
-            let x_error = crate::math::gamma(7) * (v[0].abs() + v[1].abs() + v[2].abs());
+            let (x, x_error) = point_on(&back, sampler.next_2d());
             let w = frame.to_world(crate::sampling::warp::square_to_cosine_hemisphere(
                 sampler.next_2d(),
             ));
-            let origin = crate::math::offset_ray_origin(x, x_error, back, w);
+            let origin = crate::math::offset_ray_origin(x, x_error, back.normal, w);
             let Some(hit) = geometry.intersect(&crate::math::Ray::new(origin, w)) else {
                 return false;
             };

@@ -148,17 +148,7 @@ mod tests {
 
     /// A unit square in the plane z = 0 split into 2 · 4^depth triangles.
     fn square(depth: u32) -> Vec<Element> {
-        let element = |vertices: [Vec3A; 3]| {
-            let n = (vertices[1] - vertices[0]).cross(vertices[2] - vertices[0]);
-            Element {
-                triangle: 0,
-                vertices,
-                normal: n.normalize(),
-                area: 0.5 * n.length(),
-                reflectance: Rgb::splat(0.5),
-                emission: Rgb::ZERO,
-            }
-        };
+        let element = |vertices: [Vec3A; 3]| Element::new(0, vertices, Rgb::splat(0.5), Rgb::ZERO);
         let mut triangles = vec![
             [Vec3A::ZERO, Vec3A::X, Vec3A::new(1.0, 1.0, 0.0)],
             [Vec3A::ZERO, Vec3A::new(1.0, 1.0, 0.0), Vec3A::Y],

@@ -145,15 +145,7 @@ mod tests {
     use crate::radiosity::mesh::children;
 
     fn element(vertices: [Vec3A; 3]) -> Element {
-        let n = (vertices[1] - vertices[0]).cross(vertices[2] - vertices[0]);
-        Element {
-            triangle: 0,
-            vertices,
-            normal: n.normalize(),
-            area: 0.5 * n.length(),
-            reflectance: Rgb::splat(0.5),
-            emission: Rgb::ZERO,
-        }
+        Element::new(0, vertices, Rgb::splat(0.5), Rgb::ZERO)
     }
 
     /// Barycentrics of `p` in the triangle `v` of the plane z = 0.
