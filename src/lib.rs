@@ -7,6 +7,7 @@
 
 pub mod accel;
 pub mod allocation;
+pub mod bsdf;
 pub mod camera;
 pub mod convergence;
 pub mod error;

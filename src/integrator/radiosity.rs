@@ -32,7 +32,6 @@ use crate::radiosity::{
 use crate::sampling::SamplerKind;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
-use crate::scene::material::Bsdf;
 use crate::shortcuts::PrimaryPixel;
 use lookup::{facing_surface, gather, level_colour, on_edge};
 
@@ -345,8 +344,8 @@ impl Radiosity {
                 counts.bounce += 1;
             }
             let material = &scene.materials[hit.material as usize];
-            match material.bsdf {
-                Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => {
+            match material.bsdf.diffuse_albedo() {
+                None => {
                     let frame = Frame::from_normal(hit.normal);
                     let wo = frame.to_local(-ray.direction);
                     let u = sampler.next_1d_for(Domain::Bsdf);

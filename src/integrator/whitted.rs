@@ -17,7 +17,7 @@ use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 use crate::scene::light::{Light, PlanarEmitter};
-use crate::scene::material::{Bsdf, fresnel_dielectric};
+use crate::scene::material::Bsdf;
 use crate::shortcuts::PrimaryPixel;
 use glam::Vec3A;
 
@@ -119,35 +119,17 @@ impl WhittedTracer {
         };
         let frame = Frame::from_normal(hit.normal);
         let wo = frame.to_local(wo_world);
-        match material.bsdf {
-            Bsdf::Diffuse { albedo } => {
-                radiance += self.direct(scene, &hit, &frame, wo, material.bsdf, counts);
-                radiance += self.ambient * albedo;
-            }
-            Bsdf::Glossy { diffuse, .. } => {
-                radiance += self.direct(scene, &hit, &frame, wo, material.bsdf, counts);
-                radiance += self.ambient * diffuse;
-            }
-            Bsdf::Mirror { reflectance } => {
-                if depth < self.max_depth {
-                    let wi = Vec3A::new(-wo.x, -wo.y, wo.z);
-                    radiance +=
-                        reflectance * self.follow(scene, &hit, frame.to_world(wi), depth, counts);
-                }
-            }
-            Bsdf::Dielectric { eta, tint } => {
-                if depth < self.max_depth {
-                    let f = fresnel_dielectric(wo.z, eta);
-                    let reflected = frame.to_world(Vec3A::new(-wo.x, -wo.y, wo.z));
-                    radiance += f.reflectance * self.follow(scene, &hit, reflected, depth, counts);
-                    if f.reflectance < 1.0 {
-                        let refracted =
-                            frame.to_world(Vec3A::new(-wo.x * f.eta_ti, -wo.y * f.eta_ti, f.cos_t));
-                        // (eta_i / eta_t)^2: radiance crossing into a denser medium.
-                        let scale = (1.0 - f.reflectance) * f.eta_ti * f.eta_ti;
-                        radiance +=
-                            tint * scale * self.follow(scene, &hit, refracted, depth, counts);
-                    }
+        // Diffuse lobes: direct light from each light as a point, plus the
+        // ambient term; ideal lobes (a rough one read as its smooth limit)
+        // recurse.
+        if let Some((diffuse, _)) = material.bsdf.diffuse_albedo() {
+            radiance += self.direct(scene, &hit, &frame, wo, material.bsdf, counts);
+            radiance += self.ambient * diffuse;
+        }
+        if depth < self.max_depth {
+            for (wi, weight) in material.bsdf.ideal_events(wo) {
+                if weight.max_element() > 0.0 {
+                    radiance += weight * self.follow(scene, &hit, frame.to_world(wi), depth, counts);
                 }
             }
         }

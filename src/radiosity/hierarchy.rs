@@ -25,7 +25,6 @@ use super::mesh::{Element, back_of, exposed_backs};
 use crate::accel::Geometry;
 use crate::math::Rgb;
 use crate::scene::Scene;
-use crate::scene::material::Bsdf;
 use rayon::prelude::*;
 
 mod queries;
@@ -166,14 +165,10 @@ impl Hierarchy {
         let mut specular = 0;
         for (i, v) in geometry.triangles().iter().enumerate() {
             let material = &scene.materials[geometry.triangle_material(i) as usize];
-            let reflectance = match material.bsdf {
-                Bsdf::Diffuse { albedo } => albedo,
-                Bsdf::Glossy { diffuse, .. } => diffuse,
-                _ => {
-                    specular += 1;
-                    roots.push(NONE);
-                    continue;
-                }
+            let Some((reflectance, _)) = material.bsdf.diffuse_albedo() else {
+                specular += 1;
+                roots.push(NONE);
+                continue;
             };
             let element = Element::new(i as u32, *v, reflectance, material.emission);
             if !(element.area > 0.0) {
@@ -246,7 +241,7 @@ impl Hierarchy {
         }
         if specular > 0 {
             h.notes.push(format!(
-                "{specular} mirror and glass triangles are not patches: they block light between \
+                "{specular} mirror, conductor and glass triangles are not patches: they block light between \
                  patches, and camera rays are traced through them (caustics are missing)"
             ));
         }

@@ -104,13 +104,12 @@ impl Mesh {
         let mut total = 0usize;
         for (i, v) in triangles.iter().enumerate() {
             let material = &scene.materials[geometry.triangle_material(i) as usize];
-            let diffuse = match material.bsdf {
-                Bsdf::Diffuse { .. } => true,
-                Bsdf::Glossy { .. } => {
-                    glossy += 1;
+            let diffuse = match material.bsdf.diffuse_albedo() {
+                Some((_, approximated)) => {
+                    glossy += usize::from(approximated);
                     true
                 }
-                Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => {
+                None => {
                     specular += 1;
                     false
                 }
@@ -163,11 +162,7 @@ impl Mesh {
                 continue;
             };
             let material = &scene.materials[geometry.triangle_material(i) as usize];
-            let reflectance = match material.bsdf {
-                Bsdf::Diffuse { albedo } => albedo,
-                Bsdf::Glossy { diffuse, .. } => diffuse,
-                _ => Rgb::ZERO,
-            };
+            let reflectance = material.bsdf.diffuse_albedo().map_or(Rgb::ZERO, |(a, _)| a);
             let root = Element {
                 triangle: i as u32,
                 vertices: *v,
@@ -198,12 +193,13 @@ impl Mesh {
         }
         if glossy > 0 {
             mesh.notes.push(format!(
-                "{glossy} glossy triangles are treated as diffuse with their diffuse reflectance"
+                "{glossy} glossy, rough diffuse or plastic triangles are treated as diffuse with \
+                 their diffuse reflectance"
             ));
         }
         if specular > 0 {
             mesh.notes.push(format!(
-                "{specular} mirror and glass triangles are not patches: they block light between \
+                "{specular} mirror, conductor and glass triangles are not patches: they block light between \
                  patches, and camera rays are traced through them (caustics are missing)"
             ));
         }

@@ -1,0 +1,211 @@
+//! Rough plastic (Mitsuba's `roughplastic`): a rough dielectric coating
+//! (microfacet reflection, sampled by visible normals) over a Lambertian
+//! base. Light enters the base in proportion to the coating's rough
+//! transmittance T(cos θ) = 1 − (the specular lobe's directional albedo),
+//! precomputed per (distribution, α, η) as Mitsuba does; the light the
+//! coating reflects back inside is summed through its internal diffuse
+//! reflectance, ρ / (1 − F_dr) or ρ / (1 − ρ F_dr) with `nonlinear`.
+
+use super::BsdfSample;
+use super::fresnel::fresnel_dielectric;
+use super::microfacet::{Distribution, Microfacet};
+use super::plastic::mean;
+use crate::math::Rgb;
+use crate::sampling::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
+use glam::{Vec2, Vec3A};
+use std::f32::consts::FRAC_1_PI;
+use std::sync::Mutex;
+
+/// Entries of the transmittance table over cos θ ∈ [0, 1] (Mitsuba's count).
+const TABLE_SIZE: usize = 64;
+
+/// What a rough coating lets through, as a function of the cosine.
+#[derive(Debug, PartialEq)]
+pub struct CoatingTables {
+    /// T(cos θ_k) at cos θ_k = k / 63.
+    pub external_transmittance: [f32; TABLE_SIZE],
+    /// Diffuse reflectance of the rough coating seen from inside.
+    pub internal_reflectance: f32,
+}
+
+/// A rough plastic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoughPlastic {
+    pub microfacet: Microfacet,
+    pub eta: f32,
+    pub diffuse: Rgb,
+    pub specular: Rgb,
+    pub nonlinear: bool,
+    pub specular_sampling_weight: f32,
+    /// Shared by every material with the same coating; computed once per
+    /// process for each (distribution, α, η) and never freed, so the BSDF
+    /// stays a small `Copy` value.
+    pub tables: &'static CoatingTables,
+}
+
+impl RoughPlastic {
+    pub fn new(
+        microfacet: Microfacet,
+        eta: f32,
+        diffuse: Rgb,
+        specular: Rgb,
+        nonlinear: bool,
+    ) -> RoughPlastic {
+        let (d, s) = (mean(diffuse), mean(specular));
+        RoughPlastic {
+            microfacet,
+            eta,
+            diffuse,
+            specular,
+            nonlinear,
+            specular_sampling_weight: if d + s > 0.0 { s / (d + s) } else { 0.5 },
+            tables: coating_tables(microfacet, eta),
+        }
+    }
+
+    /// T(cos θ), linearly interpolated in the table.
+    #[inline]
+    fn transmittance(&self, cos: f32) -> f32 {
+        let x = cos.clamp(0.0, 1.0) * (TABLE_SIZE - 1) as f32;
+        let i = (x as usize).min(TABLE_SIZE - 2);
+        let t = x - i as f32;
+        let table = &self.tables.external_transmittance;
+        table[i] * (1.0 - t) + table[i + 1] * t
+    }
+
+    #[inline]
+    fn specular_probability(&self, wo: Vec3A) -> f32 {
+        let t = self.transmittance(wo.z);
+        let ps = (1.0 - t) * self.specular_sampling_weight;
+        let pd = t * (1.0 - self.specular_sampling_weight);
+        if ps + pd > 0.0 { ps / (ps + pd) } else { 0.0 }
+    }
+
+    /// f(wo, wi): both lobes; directions on the upper side.
+    #[inline]
+    pub fn eval(&self, wo: Vec3A, wi: Vec3A) -> Rgb {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let m = (wo + wi).normalize();
+        let specular = if m.is_finite() {
+            let f = fresnel_dielectric(wo.dot(m), self.eta).reflectance;
+            let dg = self.microfacet.d(m) * self.microfacet.g(wo, wi, m);
+            self.specular * (f * dg / (4.0 * wo.z * wi.z))
+        } else {
+            Rgb::ZERO
+        };
+        let fdr = self.tables.internal_reflectance;
+        let base = if self.nonlinear {
+            self.diffuse / (Rgb::ONE - self.diffuse * fdr)
+        } else {
+            self.diffuse / (1.0 - fdr)
+        };
+        let diffuse = base
+            * (FRAC_1_PI / (self.eta * self.eta)
+                * self.transmittance(wo.z)
+                * self.transmittance(wi.z));
+        specular + diffuse
+    }
+
+    #[inline]
+    pub fn pdf(&self, wo: Vec3A, wi: Vec3A) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let ps = self.specular_probability(wo);
+        let m = (wo + wi).normalize();
+        let specular = if m.is_finite() && wo.dot(m) > 0.0 {
+            self.microfacet.pdf_visible(wo, m) / (4.0 * wo.dot(m))
+        } else {
+            0.0
+        };
+        ps * specular + (1.0 - ps) * cosine_hemisphere_pdf(wi)
+    }
+
+    #[inline]
+    pub fn sample(&self, wo: Vec3A, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = if u_lobe < self.specular_probability(wo) {
+            let m = self.microfacet.sample_visible(wo, u);
+            2.0 * wo.dot(m) * m - wo
+        } else {
+            square_to_cosine_hemisphere(u)
+        };
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.pdf(wo, wi);
+        if !(pdf > 0.0) || !pdf.is_finite() {
+            return None;
+        }
+        let weight = self.eval(wo, wi) * (wi.z / pdf);
+        weight.is_finite().then_some(BsdfSample {
+            wi,
+            weight,
+            pdf,
+            specular: false,
+        })
+    }
+
+    pub fn albedo_hint(&self) -> f32 {
+        self.diffuse.max_element().max(self.specular.max_element())
+    }
+}
+
+/// Directional albedo of the coating's specular reflection (Fresnel at
+/// relative IOR `eta`) at incident cosine `cos`: E[F(wo·m) G1(wi)] over
+/// visible normals, by a 64 × 64 midpoint rule in the sampler's unit
+/// square, where the integrand is smooth at any roughness.
+fn specular_albedo(microfacet: &Microfacet, cos: f32, eta: f32) -> f32 {
+    const N: usize = 64;
+    let cos = cos.max(1e-4);
+    let wo = Vec3A::new((1.0 - cos * cos).max(0.0).sqrt(), 0.0, cos);
+    let mut sum = 0.0f64;
+    for i in 0..N {
+        for j in 0..N {
+            let u = Vec2::new((i as f32 + 0.5) / N as f32, (j as f32 + 0.5) / N as f32);
+            let m = microfacet.sample_visible(wo, u);
+            let dot = wo.dot(m);
+            let wi = 2.0 * dot * m - wo;
+            if wi.z > 0.0 && dot > 0.0 {
+                let f = fresnel_dielectric(dot, eta).reflectance;
+                sum += (f * microfacet.g1(wi, m)) as f64;
+            }
+        }
+    }
+    (sum / (N * N) as f64) as f32
+}
+
+/// The coating tables for (distribution, α, η), computed on first use.
+fn coating_tables(microfacet: Microfacet, eta: f32) -> &'static CoatingTables {
+    type Key = (Distribution, u32, u32, u32);
+    static CACHE: Mutex<Vec<(Key, &'static CoatingTables)>> = Mutex::new(Vec::new());
+    let key = (
+        microfacet.distribution,
+        microfacet.alpha_u.to_bits(),
+        microfacet.alpha_v.to_bits(),
+        eta.to_bits(),
+    );
+    let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(&(_, tables)) = cache.iter().find(|(k, _)| *k == key) {
+        return tables;
+    }
+    let mut external_transmittance = [0.0; TABLE_SIZE];
+    let mut internal = 0.0;
+    for (k, t) in external_transmittance.iter_mut().enumerate() {
+        let cos = k as f32 / (TABLE_SIZE - 1) as f32;
+        *t = 1.0 - specular_albedo(&microfacet, cos, eta);
+        // Mitsuba's estimate of 2 ∫ R_int(μ) μ dμ: twice the mean over the
+        // same 64 points, kept for agreement with its images.
+        internal += specular_albedo(&microfacet, cos, 1.0 / eta) * cos;
+    }
+    let tables: &'static CoatingTables = Box::leak(Box::new(CoatingTables {
+        external_transmittance,
+        internal_reflectance: 2.0 * internal / TABLE_SIZE as f32,
+    }));
+    cache.push((key, tables));
+    tables
+}
