@@ -25,6 +25,8 @@ mod ambient_occlusion;
 mod strategies;
 // Bidirectional path tracing: strategy images, agreement, a wrong weight caught.
 mod bidirectional;
+// Microfacet, plastic, conductor and thin glass models in every technique.
+mod materials;
 // Same seed, same film, whatever the thread count or pass split.
 mod determinism;
 // Motion blur: a moving occluder against a case solved by hand.

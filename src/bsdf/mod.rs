@@ -203,6 +203,16 @@ impl Bsdf {
         }
     }
 
+    /// As [`Bsdf::eval_with_pdfs`] at a vertex of a light subpath, where
+    /// importance flows from `wo` (towards the light) to `wi`: the adjoint
+    /// f*(wo, wi) = f(wi, wo), which differs from f by the 1/η² of
+    /// transmission, with the same densities.
+    #[inline]
+    pub fn eval_adjoint_with_pdfs(&self, wo: Vec3A, wi: Vec3A) -> (Rgb, f32, f32) {
+        let (f, pdf, pdf_reverse) = self.eval_with_pdfs(wo, wi);
+        (f / self.refraction_scale(wo, wi), pdf, pdf_reverse)
+    }
+
     /// Density wrt. solid angle with which [`Bsdf::sample`] picks `wi`;
     /// zero for Dirac events.
     #[inline]

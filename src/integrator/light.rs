@@ -219,8 +219,5 @@ pub(super) fn sample_particle(scene: &Scene, sampler: &mut Sampler) -> Option<Em
 /// except that refraction does not scale by (eta_i / eta_t)^2.
 #[inline]
 pub(super) fn importance_weight(bsdf: Bsdf, wo: Vec3A, wi: Vec3A, radiance_weight: Rgb) -> Rgb {
-    match bsdf {
-        Bsdf::Dielectric { tint, .. } if wo.z * wi.z < 0.0 => tint,
-        _ => radiance_weight,
-    }
+    radiance_weight / bsdf.refraction_scale(wo, wi)
 }

@@ -364,7 +364,7 @@ impl PathTracer {
                 observer.bsdf_sample(&sample);
                 beta *= sample.weight;
                 specular_bounce = !DIFFUSE_ONLY && sample.specular;
-                if specular_bounce {
+                if !DIFFUSE_ONLY {
                     eta_scale /= bsdf.refraction_scale(wo, sample.wi);
                 }
                 prev_bsdf_pdf = sample.pdf;

@@ -160,6 +160,22 @@ pub enum MaterialKind {
     Glossy,
     Mirror,
     Dielectric,
+    /// Oren–Nayar (Mitsuba 0.6's `roughdiffuse`).
+    RoughDiffuse,
+    Conductor,
+    RoughConductor,
+    ThinDielectric,
+    RoughDielectric,
+    Plastic,
+    RoughPlastic,
+}
+
+/// An index of refraction: a number, or a name of Mitsuba's table ("bk7").
+#[derive(Debug, Deserialize, Clone, PartialEq)]
+#[serde(untagged)]
+pub enum IorDesc {
+    Value(f32),
+    Name(String),
 }
 
 /// `[materials.NAME]`. Which fields apply depends on `type`; the loader
@@ -181,6 +197,31 @@ pub struct MaterialDesc {
     pub ior: Option<f32>,
     /// dielectric: transmittance tint.
     pub tint: Option<[f32; 3]>,
+    /// Models added for real scenes take Mitsuba's parameter names:
+    /// roughdiffuse: RMS slope; rough*: isotropic roughness α.
+    pub alpha: Option<f32>,
+    /// roughconductor, roughdielectric: anisotropic roughness.
+    pub alpha_u: Option<f32>,
+    pub alpha_v: Option<f32>,
+    /// rough*: "beckmann" (Mitsuba's default) or "ggx".
+    pub distribution: Option<crate::bsdf::Distribution>,
+    /// Dielectrics and plastics: interior and exterior IOR.
+    pub int_ior: Option<IorDesc>,
+    pub ext_ior: Option<IorDesc>,
+    /// Conductors: a named material ("Au", "Cu", ...), or `eta` and `k`.
+    pub conductor: Option<String>,
+    pub eta: Option<[f32; 3]>,
+    pub k: Option<[f32; 3]>,
+    pub specular_reflectance: Option<[f32; 3]>,
+    pub specular_transmittance: Option<[f32; 3]>,
+    /// Plastics: the base's albedo.
+    pub diffuse_reflectance: Option<[f32; 3]>,
+    /// Plastics: internal scattering darkens and saturates the base.
+    pub nonlinear: Option<bool>,
+    /// One-sided models (everything but diffuse, glossy, mirror and the
+    /// dielectrics) give their back the front's response (Mitsuba's
+    /// `twosided`); by default they are black seen from behind.
+    pub twosided: Option<bool>,
     /// Emitted radiance (any type).
     pub emission: Option<[f32; 3]>,
     /// Emit from both sides (any type).

@@ -3,6 +3,10 @@
 
 use super::description::*;
 use super::material::{Bsdf, Material};
+use crate::bsdf::{
+    Conductor, Distribution, Microfacet, Plastic, RoughConductor, RoughDielectric, RoughDiffuse,
+    RoughPlastic, ThinDielectric, presets,
+};
 use super::obj::load_obj;
 use super::{Limits, MAX_COORDINATE, MovingInput, SceneInput, in_range};
 use crate::accel::{NO_LIGHT, Sphere, TriangleInput};
@@ -364,11 +368,54 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
             )),
         }
     };
-    let allowed: &[&str] = match d.kind {
-        MaterialKind::Diffuse => &["albedo"],
-        MaterialKind::Glossy => &["albedo", "specular", "exponent"],
-        MaterialKind::Mirror => &["reflectance"],
-        MaterialKind::Dielectric => &["ior", "tint"],
+    use MaterialKind as K;
+    const ROUGH: [&str; 4] = ["distribution", "alpha", "alpha_u", "alpha_v"];
+    let allowed: Vec<&str> = match d.kind {
+        K::Diffuse => vec!["albedo"],
+        K::Glossy => vec!["albedo", "specular", "exponent"],
+        K::Mirror => vec!["reflectance"],
+        K::Dielectric => vec!["ior", "tint"],
+        K::RoughDiffuse => vec!["albedo", "alpha", "twosided"],
+        K::Conductor => vec!["conductor", "eta", "k", "specular_reflectance", "twosided"],
+        K::RoughConductor => [
+            &["conductor", "eta", "k", "specular_reflectance", "twosided"][..],
+            &ROUGH,
+        ]
+        .concat(),
+        K::ThinDielectric => vec![
+            "int_ior",
+            "ext_ior",
+            "specular_reflectance",
+            "specular_transmittance",
+        ],
+        K::RoughDielectric => [
+            &[
+                "int_ior",
+                "ext_ior",
+                "specular_reflectance",
+                "specular_transmittance",
+            ][..],
+            &ROUGH,
+        ]
+        .concat(),
+        K::Plastic => vec![
+            "int_ior",
+            "ext_ior",
+            "diffuse_reflectance",
+            "specular_reflectance",
+            "nonlinear",
+            "twosided",
+        ],
+        K::RoughPlastic => vec![
+            "int_ior",
+            "ext_ior",
+            "diffuse_reflectance",
+            "specular_reflectance",
+            "nonlinear",
+            "twosided",
+            "distribution",
+            "alpha",
+        ],
     };
     let present = [
         ("albedo", d.albedo.is_some()),
@@ -377,6 +424,20 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
         ("reflectance", d.reflectance.is_some()),
         ("ior", d.ior.is_some()),
         ("tint", d.tint.is_some()),
+        ("alpha", d.alpha.is_some()),
+        ("alpha_u", d.alpha_u.is_some()),
+        ("alpha_v", d.alpha_v.is_some()),
+        ("distribution", d.distribution.is_some()),
+        ("int_ior", d.int_ior.is_some()),
+        ("ext_ior", d.ext_ior.is_some()),
+        ("conductor", d.conductor.is_some()),
+        ("eta", d.eta.is_some()),
+        ("k", d.k.is_some()),
+        ("specular_reflectance", d.specular_reflectance.is_some()),
+        ("specular_transmittance", d.specular_transmittance.is_some()),
+        ("diffuse_reflectance", d.diffuse_reflectance.is_some()),
+        ("nonlinear", d.nonlinear.is_some()),
+        ("twosided", d.twosided.is_some()),
     ];
     for (field, is_present) in present {
         if is_present && !allowed.contains(&field) {
@@ -386,11 +447,74 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
             ));
         }
     }
+    let ior = |field: &str, v: &Option<IorDesc>, default: f32| -> std::result::Result<f32, String> {
+        let value = match v {
+            None => default,
+            Some(IorDesc::Value(x)) => *x,
+            Some(IorDesc::Name(n)) => presets::ior(n).ok_or_else(|| {
+                let names: Vec<&str> = presets::IORS.iter().map(|(n, _)| *n).collect();
+                format!("material `{name}`: `{field}` \"{n}\" is not a known IOR (known: {})", names.join(", "))
+            })?,
+        };
+        if value.is_finite() && value > 0.0 {
+            Ok(value)
+        } else {
+            Err(format!("material `{name}`: `{field}` must be > 0, got {value}"))
+        }
+    };
+    // Interior over exterior; Mitsuba's defaults (BK7 glass, polypropylene
+    // plastic, in air).
+    let relative_ior = |default_int: f32| -> std::result::Result<f32, String> {
+        Ok(ior("int_ior", &d.int_ior, default_int)? / ior("ext_ior", &d.ext_ior, 1.000277)?)
+    };
+    let roughness = |field: &str, v: Option<f32>, default: f32| -> std::result::Result<f32, String> {
+        let a = v.unwrap_or(default);
+        if a.is_finite() && a >= 0.0 {
+            Ok(a)
+        } else {
+            Err(format!("material `{name}`: `{field}` must be >= 0, got {a}"))
+        }
+    };
+    let microfacet = || -> std::result::Result<Microfacet, String> {
+        let alpha = roughness("alpha", d.alpha, 0.1)?;
+        if d.alpha.is_some() && (d.alpha_u.is_some() || d.alpha_v.is_some()) {
+            return Err(format!(
+                "material `{name}`: give either `alpha` or `alpha_u` and `alpha_v`, not both"
+            ));
+        }
+        Ok(Microfacet::new(
+            d.distribution.unwrap_or(Distribution::Beckmann),
+            roughness("alpha_u", d.alpha_u, alpha)?,
+            roughness("alpha_v", d.alpha_v, alpha)?,
+        ))
+    };
+    let conductor = || -> std::result::Result<(Rgb, Rgb, Rgb), String> {
+        let tint = colour("specular_reflectance", d.specular_reflectance, Rgb::ONE, 1.0)?;
+        match (&d.conductor, d.eta, d.k) {
+            (Some(_), Some(_), _) | (Some(_), _, Some(_)) => Err(format!(
+                "material `{name}`: give either `conductor` or `eta` and `k`, not both"
+            )),
+            (Some(n), None, None) => {
+                let (eta, k) = presets::conductor(n).ok_or_else(|| {
+                    let names: Vec<&str> = presets::CONDUCTORS.iter().map(|(n, _, _)| *n).collect();
+                    format!("material `{name}`: conductor \"{n}\" is unknown (known: {})", names.join(", "))
+                })?;
+                Ok((Rgb::from(eta), Rgb::from(k), tint))
+            }
+            // Mitsuba's default is "none", a perfect mirror (η 0, k 1).
+            (None, eta, k) => Ok((
+                colour("eta", eta, Rgb::ZERO, f32::MAX)?,
+                colour("k", k, Rgb::ONE, f32::MAX)?,
+                tint,
+            )),
+        }
+    };
+    let two_sided = d.twosided.unwrap_or(false);
     let bsdf = match d.kind {
-        MaterialKind::Diffuse => Bsdf::Diffuse {
+        K::Diffuse => Bsdf::Diffuse {
             albedo: colour("albedo", d.albedo, Rgb::splat(0.8), 1.0)?,
         },
-        MaterialKind::Glossy => {
+        K::Glossy => {
             let exponent = d.exponent.unwrap_or(50.0);
             if !(exponent.is_finite() && exponent >= 0.0) {
                 return Err(format!(
@@ -403,10 +527,10 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
                 exponent,
             )
         }
-        MaterialKind::Mirror => Bsdf::Mirror {
+        K::Mirror => Bsdf::Mirror {
             reflectance: colour("reflectance", d.reflectance, Rgb::ONE, 1.0)?,
         },
-        MaterialKind::Dielectric => {
+        K::Dielectric => {
             let eta = d.ior.unwrap_or(1.5);
             if !(eta.is_finite() && eta > 0.0) {
                 return Err(format!("material `{name}`: `ior` must be > 0, got {eta}"));
@@ -414,6 +538,71 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
             Bsdf::Dielectric {
                 eta,
                 tint: colour("tint", d.tint, Rgb::ONE, 1.0)?,
+            }
+        }
+        K::RoughDiffuse => Bsdf::RoughDiffuse {
+            lobe: RoughDiffuse {
+                albedo: colour("albedo", d.albedo, Rgb::splat(0.5), 1.0)?,
+                alpha: roughness("alpha", d.alpha, 0.2)?,
+            },
+            two_sided,
+        },
+        K::Conductor => {
+            let (eta, k, tint) = conductor()?;
+            Bsdf::Conductor {
+                lobe: Conductor { eta, k, tint },
+                two_sided,
+            }
+        }
+        K::RoughConductor => {
+            let (eta, k, tint) = conductor()?;
+            Bsdf::RoughConductor {
+                lobe: RoughConductor {
+                    microfacet: microfacet()?,
+                    eta,
+                    k,
+                    tint,
+                },
+                two_sided,
+            }
+        }
+        K::ThinDielectric => Bsdf::ThinDielectric(ThinDielectric {
+            eta: relative_ior(1.5046)?,
+            reflectance: colour("specular_reflectance", d.specular_reflectance, Rgb::ONE, 1.0)?,
+            transmittance: colour(
+                "specular_transmittance",
+                d.specular_transmittance,
+                Rgb::ONE,
+                1.0,
+            )?,
+        }),
+        K::RoughDielectric => Bsdf::RoughDielectric(RoughDielectric {
+            microfacet: microfacet()?,
+            eta: relative_ior(1.5046)?,
+            reflectance: colour("specular_reflectance", d.specular_reflectance, Rgb::ONE, 1.0)?,
+            transmittance: colour(
+                "specular_transmittance",
+                d.specular_transmittance,
+                Rgb::ONE,
+                1.0,
+            )?,
+        }),
+        K::Plastic | K::RoughPlastic => {
+            let eta = relative_ior(1.49)?;
+            let diffuse = colour("diffuse_reflectance", d.diffuse_reflectance, Rgb::splat(0.5), 1.0)?;
+            let specular = colour("specular_reflectance", d.specular_reflectance, Rgb::ONE, 1.0)?;
+            let nonlinear = d.nonlinear.unwrap_or(false);
+            if d.kind == K::Plastic {
+                Bsdf::Plastic {
+                    lobe: Plastic::new(eta, diffuse, specular, nonlinear),
+                    two_sided,
+                }
+            } else {
+                let microfacet = microfacet()?;
+                Bsdf::RoughPlastic {
+                    lobe: RoughPlastic::new(microfacet, eta, diffuse, specular, nonlinear),
+                    two_sided,
+                }
             }
         }
     };

@@ -89,6 +89,9 @@ pub struct Features {
     pub mirror: bool,
     pub dielectric: bool,
     pub glossy: bool,
+    /// Some surface uses a model added for real scenes (microfacet,
+    /// plastic, conductor, thin glass, Oren–Nayar).
+    pub rich_materials: bool,
     pub point_lights: bool,
     pub spheres: bool,
     pub area_lights: usize,
@@ -108,6 +111,15 @@ impl Features {
             mirror: used(&|b| matches!(b, Bsdf::Mirror { .. })),
             dielectric: used(&|b| matches!(b, Bsdf::Dielectric { .. })),
             glossy: used(&|b| matches!(b, Bsdf::Glossy { .. })),
+            rich_materials: used(&|b| {
+                !matches!(
+                    b,
+                    Bsdf::Diffuse { .. }
+                        | Bsdf::Glossy { .. }
+                        | Bsdf::Mirror { .. }
+                        | Bsdf::Dielectric { .. }
+                )
+            }),
             point_lights: lights
                 .as_slice()
                 .iter()
@@ -129,7 +141,7 @@ impl Features {
 
     /// True when every material is Lambertian.
     pub fn diffuse_only(&self) -> bool {
-        !self.specular() && !self.glossy
+        !self.specular() && !self.glossy && !self.rich_materials
     }
 
     /// What the specialised code paths leave out, for render summaries.

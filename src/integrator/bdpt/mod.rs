@@ -178,14 +178,16 @@ impl Vertex {
         u_connect: Vec2::ZERO,
     };
 
-    /// f(wo -> w) at a surface, or the emitted radiance towards `w` at a
-    /// light vertex (whose beta is 1 / p_position); `w` is a unit vector.
+    /// At a light subpath's surface vertex, the adjoint BSDF from wo (the
+    /// light's side) to w; at a light vertex (whose beta is 1 /
+    /// p_position), the emitted radiance towards `w`; `w` is a unit vector.
     #[inline]
     fn scatter(&self, w: Vec3A) -> Rgb {
         match self.kind {
             Kind::Surface => {
                 let frame = Frame::from_normal(self.normal);
-                self.bsdf.eval(frame.to_local(self.wo), frame.to_local(w))
+                let (wo, w) = (frame.to_local(self.wo), frame.to_local(w));
+                self.bsdf.eval(w, wo)
             }
             Kind::Light => {
                 if self.normal == Vec3A::ZERO || self.two_sided || self.normal.dot(w) > 0.0 {
@@ -523,7 +525,9 @@ impl Bdpt {
         if t == 1 {
             // The light vertex seen by the camera: a splat where it lands.
             let qs = &light[s - 1];
-            if qs.delta {
+            // A vertex connects if any of its lobes is not a delta, however
+            // its own path went on (pbrt-v4's IsConnectible).
+            if qs.kind == Kind::Surface && qs.bsdf.is_specular() {
                 return None;
             }
             let c = scene.camera.connect(qs.point, qs.u_connect)?;
@@ -551,7 +555,7 @@ impl Bdpt {
             });
         }
         let pt = &cam[t - 1];
-        if pt.delta || pt.kind != Kind::Surface {
+        if pt.kind != Kind::Surface || pt.bsdf.is_specular() {
             return None;
         }
         let pm = &cam[t - 2];
@@ -599,7 +603,7 @@ impl Bdpt {
         // Both subpaths end on surfaces: a shadow ray joins them. One
         // evaluation at each end gives f and the densities both ways.
         let qs = &light[s - 1];
-        if qs.delta {
+        if qs.bsdf.is_specular() {
             return None;
         }
         let d = pt.point - qs.point;
@@ -612,7 +616,7 @@ impl Bdpt {
         let qs_frame = Frame::from_normal(qs.normal);
         let (f_qs, pdf_qs, pdf_qs_reverse) = qs
             .bsdf
-            .eval_with_pdfs(qs_frame.to_local(qs.wo), qs_frame.to_local(w));
+            .eval_adjoint_with_pdfs(qs_frame.to_local(qs.wo), qs_frame.to_local(w));
         let g = qs.cos(w) * pt.cos(w) / dist2;
         let value = qs.beta * f_qs * f_pt * pt.beta * g;
         if !(value.max_element() > 0.0) {

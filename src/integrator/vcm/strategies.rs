@@ -65,7 +65,7 @@ impl Vcm {
             let bsdf = scene.materials[v.material as usize].bsdf;
             let frame = Frame::from_normal(v.normal);
             let (f, _, pdf_reverse) =
-                bsdf.eval_with_pdfs(frame.to_local(v.wo), frame.to_local(c.wi));
+                bsdf.eval_adjoint_with_pdfs(frame.to_local(v.wo), frame.to_local(c.wi));
             let cos = v.normal.dot(c.wi).abs();
             let value = v.beta * f * (cos * c.weight);
             let camera = self.camera_density(scene, iteration, c, v.point, cos);
@@ -183,7 +183,7 @@ impl Vcm {
         let light_bsdf = scene.materials[light.material as usize].bsdf;
         let light_frame = Frame::from_normal(light.normal);
         let (f_light, pdf_light, pdf_light_reverse) =
-            light_bsdf.eval_with_pdfs(light_frame.to_local(light.wo), light_frame.to_local(-w));
+            light_bsdf.eval_adjoint_with_pdfs(light_frame.to_local(light.wo), light_frame.to_local(-w));
         let (cos_camera, cos_light) = (at.normal.dot(w).abs(), light.normal.dot(w).abs());
         let value = f_camera * f_light * light.beta * (cos_camera * cos_light / dist2);
         if !(value.max_element() > 0.0) {
