@@ -1,5 +1,6 @@
 //! Perspective camera: pinhole, or thin lens with an aperture and focus distance.
 
+use crate::filter::PixelFilter;
 use crate::math::Ray;
 use crate::sampling::warp::square_to_concentric_disk;
 use glam::{Vec2, Vec3A};
@@ -24,6 +25,8 @@ pub struct Camera {
     /// Equal ends give an instantaneous exposure (no motion blur).
     pub shutter_open: f32,
     pub shutter_close: f32,
+    /// How samples are spread over pixels (Mitsuba's `rfilter`).
+    pub filter: PixelFilter,
 }
 
 impl Camera {
@@ -54,7 +57,14 @@ impl Camera {
             focus_distance,
             shutter_open: 0.0,
             shutter_close: 0.0,
+            filter: PixelFilter::Box,
         }
+    }
+
+    /// The same camera with pixel filter `filter`.
+    pub fn with_filter(mut self, filter: PixelFilter) -> Self {
+        self.filter = filter;
+        self
     }
 
     /// The same camera with the shutter open over [open, close).

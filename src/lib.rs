@@ -12,6 +12,7 @@ pub mod camera;
 pub mod convergence;
 pub mod error;
 pub mod film;
+pub mod filter;
 pub mod image;
 pub mod integrator;
 pub mod lab;

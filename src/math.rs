@@ -267,6 +267,45 @@ pub fn reflect(w: Vec3A, n: Vec3A) -> Vec3A {
     2.0 * w.dot(n) * n - w
 }
 
+/// The error function (Abramowitz and Stegun 7.1.26, |error| < 1.5e-7).
+pub fn erf(x: f32) -> f32 {
+    let t = 1.0 / (1.0 + 0.327_591_1 * x.abs());
+    let poly = t
+        * (0.254_829_6
+            + t * (-0.284_496_74 + t * (1.421_413_8 + t * (-1.453_152_1 + t * 1.061_405_4))));
+    let y = 1.0 - poly * (-x * x).exp();
+    y.copysign(x)
+}
+
+/// The inverse error function (Giles 2010, single precision).
+pub fn erfinv(x: f32) -> f32 {
+    let mut w = -((1.0 - x) * (1.0 + x)).max(1e-30).ln();
+    let p = if w < 5.0 {
+        w -= 2.5;
+        let mut p = 2.810_226_4e-8;
+        p = 3.432_739_4e-7 + p * w;
+        p = -3.523_387_7e-6 + p * w;
+        p = -4.391_506_5e-6 + p * w;
+        p = 2.185_808_7e-4 + p * w;
+        p = -1.253_725e-3 + p * w;
+        p = -4.177_681_6e-3 + p * w;
+        p = 2.466_407_3e-1 + p * w;
+        1.501_409_4 + p * w
+    } else {
+        w = w.sqrt() - 3.0;
+        let mut p = -2.002_142_6e-4;
+        p = 1.009_505_6e-4 + p * w;
+        p = 1.349_343_2e-3 + p * w;
+        p = -3.673_428_4e-3 + p * w;
+        p = 5.739_507_7e-3 + p * w;
+        p = -7.622_461_3e-3 + p * w;
+        p = 9.438_870_5e-3 + p * w;
+        p = 1.001_674_1 + p * w;
+        2.832_976_8 + p * w
+    };
+    p * x
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,13 +7,13 @@
 //! Reciprocity: f(wo, wi) = f(wi, wo) for every pair, to float precision.
 
 use glam::{Vec2, Vec3A};
-use tracelab::math::Rgb;
-use tracelab::sampling::hash::{hash_combine, to_unit_float};
-use tracelab::sampling::warp::square_to_uniform_sphere;
 use tracelab::bsdf::{
     Conductor, Distribution, Microfacet, Plastic, RoughConductor, RoughDielectric, RoughDiffuse,
     RoughPlastic, ThinDielectric,
 };
+use tracelab::math::Rgb;
+use tracelab::sampling::hash::{hash_combine, to_unit_float};
+use tracelab::sampling::warp::square_to_uniform_sphere;
 use tracelab::scene::material::Bsdf;
 
 fn uniform(seed: u64, i: u64, dim: u64) -> f32 {
@@ -74,10 +74,22 @@ fn rough_bsdfs() -> Vec<(&'static str, Bsdf)> {
     let ggx = |a| Microfacet::isotropic(Distribution::Ggx, a);
     let beckmann = |a| Microfacet::isotropic(Distribution::Beckmann, a);
     vec![
-        ("white GGX conductor 0.1", white_conductor(Distribution::Ggx, 0.1, 0.1)),
-        ("white GGX conductor 0.5", white_conductor(Distribution::Ggx, 0.5, 0.5)),
-        ("white Beckmann conductor 0.3", white_conductor(Distribution::Beckmann, 0.3, 0.3)),
-        ("white anisotropic GGX 0.05/0.6", white_conductor(Distribution::Ggx, 0.05, 0.6)),
+        (
+            "white GGX conductor 0.1",
+            white_conductor(Distribution::Ggx, 0.1, 0.1),
+        ),
+        (
+            "white GGX conductor 0.5",
+            white_conductor(Distribution::Ggx, 0.5, 0.5),
+        ),
+        (
+            "white Beckmann conductor 0.3",
+            white_conductor(Distribution::Beckmann, 0.3, 0.3),
+        ),
+        (
+            "white anisotropic GGX 0.05/0.6",
+            white_conductor(Distribution::Ggx, 0.05, 0.6),
+        ),
         (
             "rough glass GGX 0.2",
             Bsdf::RoughDielectric(RoughDielectric {
@@ -280,7 +292,10 @@ fn rough_dielectric_transmission_obeys_the_ior_relation() {
             );
             transmitted += u32::from(a.z * b.z < 0.0 && left.max_element() > 0.0);
         }
-        assert!(transmitted > 500, "{name}: {transmitted} transmitting pairs");
+        assert!(
+            transmitted > 500,
+            "{name}: {transmitted} transmitting pairs"
+        );
     }
 }
 
@@ -308,7 +323,10 @@ fn albedo_by_quadrature(bsdf: &Bsdf, wo: Vec3A, n: usize) -> f64 {
 fn mean_sample_weight_equals_the_integral_of_f_cos() {
     let n = 100_000u64;
     for (k, (name, bsdf)) in rough_bsdfs().into_iter().enumerate() {
-        if matches!(name, "white GGX conductor 0.1" | "white anisotropic GGX 0.05/0.6") {
+        if matches!(
+            name,
+            "white GGX conductor 0.1" | "white anisotropic GGX 0.05/0.6"
+        ) {
             continue; // Too narrow for the grid; the furnace test covers them.
         }
         for theta in [20.0f32, 70.0] {
@@ -379,7 +397,8 @@ fn white_furnace_of_rough_conductors_matches_the_microfacet_albedo() {
                 let u = (i as f64 + 0.5) / nu as f64;
                 let s = (std::f64::consts::FRAC_PI_2 * u).tan();
                 let theta_m = (a * s).atan();
-                let dtheta = a * std::f64::consts::FRAC_PI_2 * (1.0 + s * s) / (1.0 + a * a * s * s)
+                let dtheta = a * std::f64::consts::FRAC_PI_2 * (1.0 + s * s)
+                    / (1.0 + a * a * s * s)
                     / nu as f64;
                 for j in 0..nphi {
                     let phi = (j as f64 + 0.5) / nphi as f64 * std::f64::consts::TAU;

@@ -12,16 +12,16 @@
 use glam::{Vec2, Vec3A};
 use std::f64::consts::PI;
 use tracelab::accel::{Geometry, NO_LIGHT, TriangleInput};
+use tracelab::bsdf::{
+    Distribution, Microfacet, Plastic, RoughConductor, RoughDielectric, RoughDiffuse, RoughPlastic,
+    ThinDielectric,
+};
 use tracelab::lab::stats::{ChiSquare, gamma_q, sidak};
 use tracelab::lab::warps::{Domain, Histogram};
 use tracelab::math::{Frame, Rgb};
 use tracelab::sampling::hash::{hash_combine, to_unit_float};
 use tracelab::sampling::warp::*;
 use tracelab::scene::light::{Light, LightSampling, Lights, PlanarEmitter};
-use tracelab::bsdf::{
-    Distribution, Microfacet, Plastic, RoughConductor, RoughDielectric, RoughDiffuse,
-    RoughPlastic, ThinDielectric,
-};
 use tracelab::scene::material::{Bsdf, fresnel_dielectric};
 
 /// Number of `assert_fits` calls below (the significance is split over them).

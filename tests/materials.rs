@@ -157,10 +157,20 @@ fn render(scene: Scene, integrator: Integrator, spp: u32, seed: u64) -> FilmSnap
 fn every_technique_agrees_on_rough_materials() {
     let scene = load_scene_text("rough-room", ROUGH_ROOM);
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
-    let path = render(scene.clone(), Integrator::from(PathTracer::default()), 512, 1);
+    let path = render(
+        scene.clone(),
+        Integrator::from(PathTracer::default()),
+        512,
+        1,
+    );
     let bdpt = render(scene.clone(), Integrator::from(Bdpt::default()), 256, 2);
     assert_agree("rough room, bdpt / path", &bdpt, &path);
-    let light = render(scene.clone(), Integrator::from(LightTracer::default()), 512, 3);
+    let light = render(
+        scene.clone(),
+        Integrator::from(LightTracer::default()),
+        512,
+        3,
+    );
     assert_agree("rough room, light / path", &light, &path);
     // Merges blur over their radius, which on these small spheres is a
     // visible bias at 1% of the diagonal (z 7.6 against BDPT) but not at
@@ -176,7 +186,12 @@ fn every_technique_agrees_on_rough_materials() {
 fn bidirectional_techniques_agree_with_path_tracing_on_every_material() {
     let mut scene = Scene::load(&repo_path("scenes/material_preview.toml")).unwrap();
     scene.set_resolution(SIZE, SIZE);
-    let path = render(scene.clone(), Integrator::from(PathTracer::default()), 512, 5);
+    let path = render(
+        scene.clone(),
+        Integrator::from(PathTracer::default()),
+        512,
+        5,
+    );
     let bdpt = render(scene.clone(), Integrator::from(Bdpt::default()), 256, 6);
     assert_agree("material preview, bdpt / path", &bdpt, &path);
     // The preview's diagonal is twice the room's: 0.2% of it is the same
@@ -185,6 +200,9 @@ fn bidirectional_techniques_agree_with_path_tracing_on_every_material() {
         radius: 0.002,
         ..Vcm::default()
     }));
-    assert_agree("material preview, vcm / path", &render(scene, vcm, 256, 7), &path);
+    assert_agree(
+        "material preview, vcm / path",
+        &render(scene, vcm, 256, 7),
+        &path,
+    );
 }
-

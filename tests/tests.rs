@@ -5,6 +5,8 @@ mod common;
 
 // Agreement with the Mitsuba 3 reference renders in tests/data.
 mod reference;
+// Each material model against Mitsuba 3 renders of the same scene.
+mod material_references;
 // White furnace: closed sphere with known radiance Le / (1 - albedo).
 mod furnace;
 // Chi-square goodness of fit of every sampling routine against its pdf.

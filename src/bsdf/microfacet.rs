@@ -4,6 +4,7 @@
 //! inversion (2014). Directions are in the local frame (normal = +z) and on
 //! its upper side; callers flip them there first.
 
+use crate::math::{erf, erfinv};
 use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
 
@@ -32,7 +33,13 @@ impl Microfacet {
     /// A distribution, α clamped to [1e-4, ∞) (NaN read as the minimum):
     /// at smaller α, D overflows f32 at the peak.
     pub fn new(distribution: Distribution, alpha_u: f32, alpha_v: f32) -> Microfacet {
-        let clamp = |a: f32| if a.is_finite() { a.max(MIN_ALPHA) } else { MIN_ALPHA };
+        let clamp = |a: f32| {
+            if a.is_finite() {
+                a.max(MIN_ALPHA)
+            } else {
+                MIN_ALPHA
+            }
+        };
         Microfacet {
             distribution,
             alpha_u: clamp(alpha_u),
@@ -53,7 +60,8 @@ impl Microfacet {
         }
         let cos2 = m.z * m.z;
         // tan² θ (cos² φ / α_u² + sin² φ / α_v²), from the slopes.
-        let e = (m.x * m.x / (self.alpha_u * self.alpha_u) + m.y * m.y / (self.alpha_v * self.alpha_v))
+        let e = (m.x * m.x / (self.alpha_u * self.alpha_u)
+            + m.y * m.y / (self.alpha_v * self.alpha_v))
             / cos2;
         let value = match self.distribution {
             Distribution::Beckmann => (-e).exp() / (PI * self.alpha_u * self.alpha_v * cos2 * cos2),
@@ -189,46 +197,10 @@ fn beckmann_visible_slope(cos_theta: f32, u: Vec2) -> Vec2 {
         b -= value / derivative;
     }
     let uy = u.y.clamp(1e-6, 1.0 - 1e-6);
-    Vec2::new(erfinv(b.clamp(-1.0 + 1e-7, 1.0 - 1e-7)), erfinv(2.0 * uy - 1.0))
-}
-
-/// The error function (Abramowitz and Stegun 7.1.26, |error| < 1.5e-7).
-pub fn erf(x: f32) -> f32 {
-    let t = 1.0 / (1.0 + 0.327_591_1 * x.abs());
-    let poly = t
-        * (0.254_829_6
-            + t * (-0.284_496_74 + t * (1.421_413_8 + t * (-1.453_152_1 + t * 1.061_405_4))));
-    let y = 1.0 - poly * (-x * x).exp();
-    y.copysign(x)
-}
-
-/// The inverse error function (Giles 2010, single precision).
-pub fn erfinv(x: f32) -> f32 {
-    let mut w = -((1.0 - x) * (1.0 + x)).max(1e-30).ln();
-    let p = if w < 5.0 {
-        w -= 2.5;
-        let mut p = 2.810_226_4e-8;
-        p = 3.432_739_4e-7 + p * w;
-        p = -3.523_387_7e-6 + p * w;
-        p = -4.391_506_5e-6 + p * w;
-        p = 2.185_808_7e-4 + p * w;
-        p = -1.253_725e-3 + p * w;
-        p = -4.177_681_6e-3 + p * w;
-        p = 2.466_407_3e-1 + p * w;
-        1.501_409_4 + p * w
-    } else {
-        w = w.sqrt() - 3.0;
-        let mut p = -2.002_142_6e-4;
-        p = 1.009_505_6e-4 + p * w;
-        p = 1.349_343_2e-3 + p * w;
-        p = -3.673_428_4e-3 + p * w;
-        p = 5.739_507_7e-3 + p * w;
-        p = -7.622_461_3e-3 + p * w;
-        p = 9.438_870_5e-3 + p * w;
-        p = 1.001_674_1 + p * w;
-        2.832_976_8 + p * w
-    };
-    p * x
+    Vec2::new(
+        erfinv(b.clamp(-1.0 + 1e-7, 1.0 - 1e-7)),
+        erfinv(2.0 * uy - 1.0),
+    )
 }
 
 #[cfg(test)]
@@ -243,7 +215,11 @@ mod tests {
             let r = (1.0 - z * z).sqrt();
             for j in 0..2 * n {
                 let phi = (j as f64 + 0.5) / (2 * n) as f64 * 2.0 * std::f64::consts::PI;
-                sum += f(Vec3A::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32));
+                sum += f(Vec3A::new(
+                    (r * phi.cos()) as f32,
+                    (r * phi.sin()) as f32,
+                    z as f32,
+                ));
             }
         }
         sum * 2.0 * std::f64::consts::PI / (2 * n * n) as f64
@@ -255,10 +231,16 @@ mod tests {
             for (au, av) in [(0.3, 0.3), (0.6, 0.2), (1.0, 1.0)] {
                 let mf = Microfacet::new(distribution, au, av);
                 let projected = hemisphere_integral(|m| (mf.d(m) * m.z) as f64, 600);
-                assert!((projected - 1.0).abs() < 2e-3, "{distribution:?} {au} {av}: {projected}");
+                assert!(
+                    (projected - 1.0).abs() < 2e-3,
+                    "{distribution:?} {au} {av}: {projected}"
+                );
                 let w = Vec3A::new(0.6, 0.3, 0.5).normalize();
                 let visible = hemisphere_integral(|m| mf.pdf_visible(w, m) as f64, 600);
-                assert!((visible - 1.0).abs() < 3e-3, "{distribution:?} {au} {av}: {visible}");
+                assert!(
+                    (visible - 1.0).abs() < 3e-3,
+                    "{distribution:?} {au} {av}: {visible}"
+                );
             }
         }
     }

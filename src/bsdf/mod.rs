@@ -65,7 +65,10 @@ pub enum Bsdf {
     /// Smooth conductor: a Fresnel-weighted mirror.
     Conductor { lobe: Conductor, two_sided: bool },
     /// Microfacet conductor.
-    RoughConductor { lobe: RoughConductor, two_sided: bool },
+    RoughConductor {
+        lobe: RoughConductor,
+        two_sided: bool,
+    },
     /// Smooth plastic: a dielectric coating over a diffuse base.
     Plastic { lobe: Plastic, two_sided: bool },
     /// Rough plastic: a microfacet coating over a diffuse base.
@@ -258,7 +261,9 @@ impl Bsdf {
             Bsdf::RoughDiffuse { lobe, two_sided } => {
                 sample_oriented(two_sided, wo, |wo| lobe.sample(wo, u))
             }
-            Bsdf::Conductor { lobe, two_sided } => sample_oriented(two_sided, wo, |wo| lobe.sample(wo)),
+            Bsdf::Conductor { lobe, two_sided } => {
+                sample_oriented(two_sided, wo, |wo| lobe.sample(wo))
+            }
             Bsdf::RoughConductor { lobe, two_sided } => {
                 sample_oriented(two_sided, wo, |wo| lobe.sample(wo, u))
             }
@@ -360,9 +365,14 @@ impl Bsdf {
             }
             Bsdf::ThinDielectric(lobe) => {
                 let r = lobe.slab_reflectance(wo.z);
-                [(mirror, lobe.reflectance * r), (-wo, lobe.transmittance * (1.0 - r))]
+                [
+                    (mirror, lobe.reflectance * r),
+                    (-wo, lobe.transmittance * (1.0 - r)),
+                ]
             }
-            Bsdf::Conductor { lobe, two_sided } => conductor(lobe.eta, lobe.k, lobe.tint, two_sided),
+            Bsdf::Conductor { lobe, two_sided } => {
+                conductor(lobe.eta, lobe.k, lobe.tint, two_sided)
+            }
             Bsdf::RoughConductor { lobe, two_sided } => {
                 conductor(lobe.eta, lobe.k, lobe.tint, two_sided)
             }

@@ -51,8 +51,8 @@ impl Phong {
         } else {
             0.0
         };
-        let f = self.diffuse * FRAC_1_PI
-            + self.specular * ((self.exponent + 2.0) / (2.0 * PI) * lobe);
+        let f =
+            self.diffuse * FRAC_1_PI + self.specular * ((self.exponent + 2.0) / (2.0 * PI) * lobe);
         let phong = (1.0 - self.diffuse_probability) * (self.exponent + 1.0) / (2.0 * PI) * lobe;
         let pdf = |w: Vec3A| self.diffuse_probability * cosine_hemisphere_pdf(w) + phong;
         (f, pdf(wi), pdf(wo))
@@ -86,7 +86,8 @@ impl Phong {
         let wi = if u_lobe < self.diffuse_probability {
             square_to_cosine_hemisphere(u)
         } else {
-            Frame::from_normal(reflect(wo, Vec3A::Z)).to_world(square_to_phong_lobe(u, self.exponent))
+            Frame::from_normal(reflect(wo, Vec3A::Z))
+                .to_world(square_to_phong_lobe(u, self.exponent))
         };
         if wi.z <= 0.0 {
             return None;

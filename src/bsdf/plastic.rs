@@ -9,7 +9,7 @@
 //! the specular sampling weight.
 
 use super::BsdfSample;
-use super::fresnel::{fresnel_diffuse_reflectance, fresnel_dielectric};
+use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance};
 use crate::math::Rgb;
 use crate::sampling::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use glam::{Vec2, Vec3A};

@@ -61,7 +61,8 @@ impl RoughDielectric {
             self.reflectance * (f * d * g / (4.0 * (wo.z * wi.z).abs()))
         } else {
             let denom = wi.dot(m) + wo.dot(m) / etap;
-            let t = (1.0 - f) * d * g * (wi.dot(m) * wo.dot(m) / (denom * denom * wi.z * wo.z)).abs();
+            let t =
+                (1.0 - f) * d * g * (wi.dot(m) * wo.dot(m) / (denom * denom * wi.z * wo.z)).abs();
             // Radiance is compressed by 1/η'² on entering the denser side.
             self.transmittance * (t / (etap * etap))
         }
@@ -144,6 +145,8 @@ impl RoughDielectric {
     }
 
     pub fn albedo_hint(&self) -> f32 {
-        self.reflectance.max_element().max(self.transmittance.max_element())
+        self.reflectance
+            .max_element()
+            .max(self.transmittance.max_element())
     }
 }

@@ -63,7 +63,11 @@ impl RoughDiffuse {
             * self.albedo
             * (0.17 * sigma2 / (sigma2 + 0.13) * (1.0 - cos_phi_diff * tmp3 * tmp3));
         let f = (l1 + l2) * FRAC_1_PI;
-        if f.is_finite() { f.max(Rgb::ZERO) } else { Rgb::ZERO }
+        if f.is_finite() {
+            f.max(Rgb::ZERO)
+        } else {
+            Rgb::ZERO
+        }
     }
 
     #[inline]

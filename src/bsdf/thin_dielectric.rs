@@ -51,6 +51,8 @@ impl ThinDielectric {
     }
 
     pub fn albedo_hint(&self) -> f32 {
-        self.reflectance.max_element().max(self.transmittance.max_element())
+        self.reflectance
+            .max_element()
+            .max(self.transmittance.max_element())
     }
 }

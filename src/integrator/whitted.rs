@@ -129,7 +129,8 @@ impl WhittedTracer {
         if depth < self.max_depth {
             for (wi, weight) in material.bsdf.ideal_events(wo) {
                 if weight.max_element() > 0.0 {
-                    radiance += weight * self.follow(scene, &hit, frame.to_world(wi), depth, counts);
+                    radiance +=
+                        weight * self.follow(scene, &hit, frame.to_world(wi), depth, counts);
                 }
             }
         }

@@ -14,6 +14,7 @@
 
 use crate::error::{Error, Result};
 use crate::film::{Film, FilmSnapshot, Tile, classify, non_finite_of, note_flagged};
+use crate::filter::PixelFilter;
 use crate::integrator::{
     ErrorEstimate, Integrator, RayCounts, SolverProgress, SplattingIntegrator, sample_time,
 };
@@ -463,7 +464,7 @@ impl Session {
         let scene = &*self.scene;
         let settings = &self.settings;
         let (width, height) = (self.film.width(), self.film.height());
-        let splats = SplatBuffer::new(width, height);
+        let splats = SplatBuffer::with_filter(width, height, scene.camera.filter);
         self.pool.install(|| {
             self.film
                 .tiles()
@@ -607,7 +608,12 @@ pub fn camera_ray(
     deterministic: bool,
     general: bool,
 ) -> Ray {
-    let mut film_point = Vec2::new(x as f32, y as f32) + sampler.next_2d_for(Domain::Pixel);
+    let u_pixel = sampler.next_2d_for(Domain::Pixel);
+    // Filter importance sampling; the box keeps its exact arithmetic.
+    let mut film_point = match scene.camera.filter {
+        PixelFilter::Box => Vec2::new(x as f32, y as f32) + u_pixel,
+        filter => Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + filter.sample(u_pixel),
+    };
     let lens_dim = sampler.skip();
     let mut lens = if scene.camera.aperture_radius > 0.0 {
         sampler.get_2d_for(lens_dim, Domain::Lens)

@@ -1,6 +1,7 @@
 //! The splat buffer of splatting estimators: per-pixel sums whose value does
 //! not depend on the order in which threads add to them.
 
+use crate::filter::PixelFilter;
 use crate::math::Rgb;
 use glam::Vec2;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -10,6 +11,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 pub(crate) struct SplatBuffer {
     width: u32,
     height: u32,
+    filter: PixelFilter,
     sums: Vec<[AtomicU64; 3]>,
 }
 
@@ -17,13 +19,20 @@ pub(crate) struct SplatBuffer {
 const SPLAT_SCALE: f64 = 4294967296.0;
 
 impl SplatBuffer {
+    #[cfg(test)]
     pub(crate) fn new(width: u32, height: u32) -> Self {
+        Self::with_filter(width, height, PixelFilter::Box)
+    }
+
+    /// A buffer whose splats spread over the pixels `filter` covers.
+    pub(crate) fn with_filter(width: u32, height: u32, filter: PixelFilter) -> Self {
         let sums = (0..width as usize * height as usize)
             .map(|_| [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)])
             .collect();
         SplatBuffer {
             width,
             height,
+            filter,
             sums,
         }
     }
@@ -52,6 +61,31 @@ impl SplatBuffer {
     /// Adds `value` to the pixel containing `film`; false (and nothing added)
     /// when the value is not finite, negative or too large to represent.
     pub(crate) fn add(&self, film: Vec2, value: Rgb) -> bool {
+        if self.filter == PixelFilter::Box {
+            return self.add_to_pixel(film, value);
+        }
+        // Every pixel whose filter reaches `film`, weighted by it.
+        let r = self.filter.radius();
+        let (x0, x1) = ((film.x - r - 0.5).ceil(), (film.x + r - 0.5).floor());
+        let (y0, y1) = ((film.y - r - 0.5).ceil(), (film.y + r - 0.5).floor());
+        let mut ok = true;
+        let mut y = y0.max(0.0);
+        while y <= y1.min(self.height as f32 - 1.0) {
+            let mut x = x0.max(0.0);
+            while x <= x1.min(self.width as f32 - 1.0) {
+                let weight = self.filter.eval(film - Vec2::new(x + 0.5, y + 0.5));
+                if weight > 0.0 {
+                    ok &= self.add_to_pixel(Vec2::new(x + 0.5, y + 0.5), value * weight);
+                }
+                x += 1.0;
+            }
+            y += 1.0;
+        }
+        ok
+    }
+
+    /// Adds `value` to the pixel containing `film`.
+    fn add_to_pixel(&self, film: Vec2, value: Rgb) -> bool {
         let (x, y) = (film.x as u32, film.y as u32);
         if x >= self.width || y >= self.height {
             return true;

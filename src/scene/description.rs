@@ -85,6 +85,12 @@ pub struct CameraDesc {
     pub focus_distance: Option<f32>,
     #[serde(default)]
     pub shutter: [f32; 2],
+    /// Pixel filter: "box" (default), "tent" or "gaussian" (Mitsuba's).
+    pub filter: Option<String>,
+    /// Tent and Gaussian: radius in pixels (Mitsuba: 1 and 4 stddev).
+    pub filter_radius: Option<f32>,
+    /// Gaussian: standard deviation in pixels (Mitsuba: 0.5).
+    pub filter_stddev: Option<f32>,
 }
 
 fn default_up() -> [f32; 3] {

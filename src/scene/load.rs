@@ -3,15 +3,16 @@
 
 use super::description::*;
 use super::material::{Bsdf, Material};
+use super::obj::load_obj;
+use super::{Limits, MAX_COORDINATE, MovingInput, SceneInput, in_range};
+use crate::accel::{NO_LIGHT, Sphere, TriangleInput};
 use crate::bsdf::{
     Conductor, Distribution, Microfacet, Plastic, RoughConductor, RoughDielectric, RoughDiffuse,
     RoughPlastic, ThinDielectric, presets,
 };
-use super::obj::load_obj;
-use super::{Limits, MAX_COORDINATE, MovingInput, SceneInput, in_range};
-use crate::accel::{NO_LIGHT, Sphere, TriangleInput};
 use crate::camera::Camera;
 use crate::error::{Error, Result, line_of};
+use crate::filter::PixelFilter;
 use crate::math::Rgb;
 use crate::scene::light::Light;
 use glam::{EulerRot, Mat4, Quat, Vec3, Vec3A};
@@ -297,6 +298,38 @@ fn build_camera(
             c.shutter
         ));
     }
+    let positive = |name: &str, v: Option<f32>, default: f32| match v.unwrap_or(default) {
+        x if x.is_finite() && x > 0.0 => Ok(x),
+        x => Err(format!("`camera.{name}` must be > 0, got {x}")),
+    };
+    let filter = match c.filter.as_deref() {
+        None | Some("box") => {
+            if c.filter_radius.is_some() || c.filter_stddev.is_some() {
+                return Err("the box filter takes no `filter_radius` or `filter_stddev`".into());
+            }
+            PixelFilter::Box
+        }
+        Some("tent") => {
+            if c.filter_stddev.is_some() {
+                return Err("the tent filter takes no `filter_stddev`".into());
+            }
+            PixelFilter::Tent {
+                radius: positive("filter_radius", c.filter_radius, 1.0)?,
+            }
+        }
+        Some("gaussian") => {
+            let stddev = positive("filter_stddev", c.filter_stddev, 0.5)?;
+            PixelFilter::Gaussian {
+                stddev,
+                radius: positive("filter_radius", c.filter_radius, 4.0 * stddev)?,
+            }
+        }
+        Some(other) => {
+            return Err(format!(
+                "`camera.filter` must be \"box\", \"tent\" or \"gaussian\", got \"{other}\""
+            ));
+        }
+    };
     Ok(Camera::look_at(
         eye,
         look_at,
@@ -307,7 +340,8 @@ fn build_camera(
         c.aperture_radius,
         focus,
     )
-    .with_shutter(open, close))
+    .with_shutter(open, close)
+    .with_filter(filter))
 }
 
 fn mesh_transform(m: &MeshDesc) -> std::result::Result<Mat4, String> {
@@ -447,34 +481,43 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
             ));
         }
     }
-    let ior = |field: &str, v: &Option<IorDesc>, default: f32| -> std::result::Result<f32, String> {
-        let value = match v {
-            None => default,
-            Some(IorDesc::Value(x)) => *x,
-            Some(IorDesc::Name(n)) => presets::ior(n).ok_or_else(|| {
-                let names: Vec<&str> = presets::IORS.iter().map(|(n, _)| *n).collect();
-                format!("material `{name}`: `{field}` \"{n}\" is not a known IOR (known: {})", names.join(", "))
-            })?,
+    let ior =
+        |field: &str, v: &Option<IorDesc>, default: f32| -> std::result::Result<f32, String> {
+            let value = match v {
+                None => default,
+                Some(IorDesc::Value(x)) => *x,
+                Some(IorDesc::Name(n)) => presets::ior(n).ok_or_else(|| {
+                    let names: Vec<&str> = presets::IORS.iter().map(|(n, _)| *n).collect();
+                    format!(
+                        "material `{name}`: `{field}` \"{n}\" is not a known IOR (known: {})",
+                        names.join(", ")
+                    )
+                })?,
+            };
+            if value.is_finite() && value > 0.0 {
+                Ok(value)
+            } else {
+                Err(format!(
+                    "material `{name}`: `{field}` must be > 0, got {value}"
+                ))
+            }
         };
-        if value.is_finite() && value > 0.0 {
-            Ok(value)
-        } else {
-            Err(format!("material `{name}`: `{field}` must be > 0, got {value}"))
-        }
-    };
     // Interior over exterior; Mitsuba's defaults (BK7 glass, polypropylene
     // plastic, in air).
     let relative_ior = |default_int: f32| -> std::result::Result<f32, String> {
         Ok(ior("int_ior", &d.int_ior, default_int)? / ior("ext_ior", &d.ext_ior, 1.000277)?)
     };
-    let roughness = |field: &str, v: Option<f32>, default: f32| -> std::result::Result<f32, String> {
-        let a = v.unwrap_or(default);
-        if a.is_finite() && a >= 0.0 {
-            Ok(a)
-        } else {
-            Err(format!("material `{name}`: `{field}` must be >= 0, got {a}"))
-        }
-    };
+    let roughness =
+        |field: &str, v: Option<f32>, default: f32| -> std::result::Result<f32, String> {
+            let a = v.unwrap_or(default);
+            if a.is_finite() && a >= 0.0 {
+                Ok(a)
+            } else {
+                Err(format!(
+                    "material `{name}`: `{field}` must be >= 0, got {a}"
+                ))
+            }
+        };
     let microfacet = || -> std::result::Result<Microfacet, String> {
         let alpha = roughness("alpha", d.alpha, 0.1)?;
         if d.alpha.is_some() && (d.alpha_u.is_some() || d.alpha_v.is_some()) {
@@ -489,7 +532,12 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
         ))
     };
     let conductor = || -> std::result::Result<(Rgb, Rgb, Rgb), String> {
-        let tint = colour("specular_reflectance", d.specular_reflectance, Rgb::ONE, 1.0)?;
+        let tint = colour(
+            "specular_reflectance",
+            d.specular_reflectance,
+            Rgb::ONE,
+            1.0,
+        )?;
         match (&d.conductor, d.eta, d.k) {
             (Some(_), Some(_), _) | (Some(_), _, Some(_)) => Err(format!(
                 "material `{name}`: give either `conductor` or `eta` and `k`, not both"
@@ -497,7 +545,10 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
             (Some(n), None, None) => {
                 let (eta, k) = presets::conductor(n).ok_or_else(|| {
                     let names: Vec<&str> = presets::CONDUCTORS.iter().map(|(n, _, _)| *n).collect();
-                    format!("material `{name}`: conductor \"{n}\" is unknown (known: {})", names.join(", "))
+                    format!(
+                        "material `{name}`: conductor \"{n}\" is unknown (known: {})",
+                        names.join(", ")
+                    )
                 })?;
                 Ok((Rgb::from(eta), Rgb::from(k), tint))
             }
@@ -568,7 +619,12 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
         }
         K::ThinDielectric => Bsdf::ThinDielectric(ThinDielectric {
             eta: relative_ior(1.5046)?,
-            reflectance: colour("specular_reflectance", d.specular_reflectance, Rgb::ONE, 1.0)?,
+            reflectance: colour(
+                "specular_reflectance",
+                d.specular_reflectance,
+                Rgb::ONE,
+                1.0,
+            )?,
             transmittance: colour(
                 "specular_transmittance",
                 d.specular_transmittance,
@@ -579,7 +635,12 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
         K::RoughDielectric => Bsdf::RoughDielectric(RoughDielectric {
             microfacet: microfacet()?,
             eta: relative_ior(1.5046)?,
-            reflectance: colour("specular_reflectance", d.specular_reflectance, Rgb::ONE, 1.0)?,
+            reflectance: colour(
+                "specular_reflectance",
+                d.specular_reflectance,
+                Rgb::ONE,
+                1.0,
+            )?,
             transmittance: colour(
                 "specular_transmittance",
                 d.specular_transmittance,
@@ -589,8 +650,18 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
         }),
         K::Plastic | K::RoughPlastic => {
             let eta = relative_ior(1.49)?;
-            let diffuse = colour("diffuse_reflectance", d.diffuse_reflectance, Rgb::splat(0.5), 1.0)?;
-            let specular = colour("specular_reflectance", d.specular_reflectance, Rgb::ONE, 1.0)?;
+            let diffuse = colour(
+                "diffuse_reflectance",
+                d.diffuse_reflectance,
+                Rgb::splat(0.5),
+                1.0,
+            )?;
+            let specular = colour(
+                "specular_reflectance",
+                d.specular_reflectance,
+                Rgb::ONE,
+                1.0,
+            )?;
             let nonlinear = d.nonlinear.unwrap_or(false);
             if d.kind == K::Plastic {
                 Bsdf::Plastic {

@@ -58,6 +58,8 @@ pub enum NotApplied {
     ManyTriangles(usize),
     /// A thin lens: camera rays leave from anywhere on the lens.
     ThinLens,
+    /// A pixel filter wider than the pixel: camera rays leave its square.
+    WideFilter,
     /// A triangle reaches behind the eye's image plane (unbounded projection).
     BehindEye,
     /// The build would take this many overlap tests per pixel, or most
@@ -83,6 +85,7 @@ impl fmt::Display for NotApplied {
                 "{n} triangles, more than {SOUP_MAX_TRIANGLES}: the BVH decides"
             ),
             NotApplied::ThinLens => write!(f, "thin lens"),
+            NotApplied::WideFilter => write!(f, "the pixel filter is wider than a pixel"),
             NotApplied::BehindEye => write!(f, "a triangle reaches behind the eye"),
             NotApplied::Crowded { tests_per_pixel } => write!(
                 f,

@@ -115,6 +115,9 @@ impl PrimaryCandidates {
         if camera.aperture_radius > 0.0 {
             return Err(NotApplied::ThinLens);
         }
+        if camera.filter != crate::filter::PixelFilter::Box {
+            return Err(NotApplied::WideFilter);
+        }
         let (width, height) = (camera.width as usize, camera.height as usize);
         let pixels = width * height;
         let mut footprints: Vec<Option<Footprint>> = Vec::with_capacity(triangles.len());

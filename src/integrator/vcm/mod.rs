@@ -393,7 +393,11 @@ impl MultiPassEstimator for Vcm {
         let mut iteration = Iteration {
             starts: Vec::new(),
             map: PhotonMap::build(Vec::new(), radius),
-            light_image: SplatBuffer::new(scene.camera.width, scene.camera.height),
+            light_image: SplatBuffer::with_filter(
+                scene.camera.width,
+                scene.camera.height,
+                scene.camera.filter,
+            ),
             paths,
             radius,
             vm_factor: self.mis(eta),

@@ -182,8 +182,8 @@ impl Vcm {
             at.bsdf.eval_with_pdfs(at.wo, at.frame.to_local(w));
         let light_bsdf = scene.materials[light.material as usize].bsdf;
         let light_frame = Frame::from_normal(light.normal);
-        let (f_light, pdf_light, pdf_light_reverse) =
-            light_bsdf.eval_adjoint_with_pdfs(light_frame.to_local(light.wo), light_frame.to_local(-w));
+        let (f_light, pdf_light, pdf_light_reverse) = light_bsdf
+            .eval_adjoint_with_pdfs(light_frame.to_local(light.wo), light_frame.to_local(-w));
         let (cos_camera, cos_light) = (at.normal.dot(w).abs(), light.normal.dot(w).abs());
         let value = f_camera * f_light * light.beta * (cos_camera * cos_light / dist2);
         if !(value.max_element() > 0.0) {

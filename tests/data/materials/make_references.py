@@ -1,0 +1,118 @@
+"""Mitsuba 3 references for tests/material_references.rs: one object per
+material model on a grey floor under a square area light, 64 x 64.
+
+Each reference is the mean of PASSES independent renders (seeds differ) of
+SPP samples per pixel; `<name>_var.exr` holds the per-pixel variance of that
+mean (the passes' sample variance / PASSES), which the test's tolerance uses.
+
+The scene is the one `material_scene` in tests/material_references.rs writes
+as TOML; keep the two in step. z is up.
+
+Run: pip install mitsuba; python3 tests/data/materials/make_references.py
+(Mitsuba 3.9.1, llvm_ad_rgb; needs libllvm19.)
+"""
+import sys
+import numpy as np
+import mitsuba as mi
+
+mi.set_variant("llvm_ad_rgb")
+
+SPP = 2048
+PASSES = 16
+MAX_DEPTH = 9  # segments; tracelab's max_depth 8 (bounces)
+
+
+def sphere(bsdf):
+    return {"type": "sphere", "center": [0, 0, 0.6], "radius": 0.6, "bsdf": bsdf}
+
+
+def panel(bsdf):
+    # A 1.6 m square lying on the floor, normal +z, its tangent +x (the
+    # frame tracelab builds for a +z normal), for anisotropic lobes.
+    return {
+        "type": "rectangle",
+        "to_world": mi.ScalarTransform4f().translate([0, 0, 0.01]).scale(0.8),
+        "bsdf": bsdf,
+    }
+
+
+def behind(bsdf):
+    # The same square turned to face away from the camera (normal +y): its
+    # back is what the camera sees.
+    return {
+        "type": "rectangle",
+        "to_world": mi.ScalarTransform4f().translate([0, 0, 0.8]).rotate([1, 0, 0], -90).scale(0.8),
+        "bsdf": bsdf,
+    }
+
+
+MATERIALS = {
+    "roughconductor_ggx": sphere({"type": "roughconductor", "material": "Cu", "distribution": "ggx", "alpha": 0.2}),
+    "roughconductor_beckmann": sphere({"type": "roughconductor", "material": "Cr", "distribution": "beckmann", "alpha": 0.3}),
+    "roughconductor_anisotropic": panel({"type": "roughconductor", "material": "Al", "distribution": "ggx", "alpha_u": 0.05, "alpha_v": 0.4}),
+    "conductor_gold": sphere({"type": "conductor", "material": "Au"}),
+    "roughdielectric": sphere({"type": "roughdielectric", "int_ior": "bk7", "distribution": "ggx", "alpha": 0.15}),
+    "thindielectric": sphere({"type": "thindielectric", "int_ior": "bk7"}),
+    "plastic": sphere({"type": "plastic", "diffuse_reflectance": {"type": "rgb", "value": [0.7, 0.1, 0.05]}}),
+    "roughplastic": sphere({"type": "roughplastic", "distribution": "ggx", "alpha": 0.2,
+                            "diffuse_reflectance": {"type": "rgb", "value": [0.1, 0.3, 0.7]}}),
+    "roughplastic_nonlinear": sphere({"type": "roughplastic", "distribution": "beckmann", "alpha": 0.3, "nonlinear": True,
+                                      "diffuse_reflectance": {"type": "rgb", "value": [0.1, 0.3, 0.7]}}),
+    "onesided_back": behind({"type": "roughconductor", "material": "Au", "distribution": "ggx", "alpha": 0.3}),
+    "twosided_back": behind({"type": "twosided", "bsdf": {"type": "roughconductor", "material": "Au", "distribution": "ggx", "alpha": 0.3}}),
+}
+
+
+PLASTIC = sphere({"type": "plastic", "diffuse_reflectance": {"type": "rgb", "value": [0.7, 0.1, 0.05]}})
+# The plastic sphere again through Mitsuba's tent and Gaussian filters.
+FILTERS = {
+    "filter_tent": (PLASTIC, {"type": "tent"}),
+    "filter_gaussian": (PLASTIC, {"type": "gaussian"}),
+}
+
+
+def scene(obj, rfilter=None):
+    return {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": MAX_DEPTH, "rr_depth": 5},
+        "sensor": {
+            "type": "perspective",
+            "fov_axis": "y",
+            "fov": 35,
+            "to_world": mi.ScalarTransform4f().look_at(origin=[0, -4, 2.5], target=[0, 0, 0.5], up=[0, 0, 1]),
+            "film": {"type": "hdrfilm", "width": 64, "height": 64, "rfilter": rfilter or {"type": "box"}, "pixel_format": "rgb"},
+            "sampler": {"type": "independent", "sample_count": SPP},
+        },
+        "floor": {
+            "type": "rectangle",
+            "to_world": mi.ScalarTransform4f().scale(20),
+            "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.4, 0.4, 0.4]}},
+        },
+        # 2 m square at (1.2, -1.2, 3), facing down: large, so that the
+        # caustics of Dirac spheres (found by BSDF sampling from the floor)
+        # are not rare events that a 256-spp standard error misses.
+        "light": {
+            "type": "rectangle",
+            "to_world": mi.ScalarTransform4f().translate([1.2, -1.2, 3]).rotate([1, 0, 0], 180),
+            "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [3, 3, 3]}},
+        },
+        "object": obj,
+    }
+
+
+def main(names):
+    jobs = {name: (obj, None) for name, obj in MATERIALS.items()} | FILTERS
+    for name, (obj, rfilter) in jobs.items():
+        if names and name not in names:
+            continue
+        s = mi.load_dict(scene(obj, rfilter))
+        passes = np.stack([np.array(mi.render(s, seed=1000 * k + 7)) for k in range(PASSES)])
+        mean = passes.mean(axis=0)
+        var = passes.var(axis=0, ddof=1) / PASSES
+        mi.Bitmap(mean.astype(np.float32)).write(f"{name}.exr")
+        mi.Bitmap(var.astype(np.float32)).write(f"{name}_var.exr")
+        print(f"{name}: mean {mean.reshape(-1, 3).mean(axis=0)}, rms se {np.sqrt(var.mean()):.5f}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
