@@ -26,6 +26,7 @@ pub mod sampling;
 pub mod scene;
 pub mod shortcuts;
 pub mod stress;
+pub mod texture;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 

@@ -156,10 +156,12 @@ fn cuboid(min: Vec3A, max: Vec3A, material: u32) -> Vec<TriangleInput> {
                 TriangleInput {
                     vertices: [a, b, c],
                     material,
+                    uvs: None,
                 },
                 TriangleInput {
                     vertices: [a, c, d],
                     material,
+                    uvs: None,
                 },
             ]
         })
@@ -269,6 +271,7 @@ impl StressSuite {
                 Vec3A::new(0.0, 1e7, 570.0),
             ],
             material: white,
+            uvs: None,
         });
         for i in 0..64 {
             let p = Vec3A::new(
@@ -279,6 +282,7 @@ impl StressSuite {
             mixed.triangles.push(TriangleInput {
                 vertices: [p, p + Vec3A::X * 1e-3, p + Vec3A::Z * 1e-3],
                 material: white,
+                uvs: None,
             });
         }
         add("tiny and huge triangles".into(), mixed, 0)?;

@@ -227,6 +227,7 @@ fn emitter_above(
         .map(|&vertices| TriangleInput {
             vertices,
             material: 0,
+            uvs: None,
         })
         .collect();
     (emitter, Geometry::build(&inputs, vec![]))

@@ -115,6 +115,7 @@ fn set_to_set(a: &[Element], b: &[Element], method: FormFactorMethod, n: u32, ru
         .map(|e| TriangleInput {
             vertices: e.vertices,
             material: 0,
+            uvs: None,
         })
         .collect();
     let geometry = Geometry::build(&inputs, vec![]);
@@ -305,6 +306,7 @@ fn a_probed_exchange_resumes_to_the_full_one() {
         .map(|e| TriangleInput {
             vertices: e.vertices,
             material: 0,
+            uvs: None,
         })
         .collect();
     let geometry = Geometry::build(&inputs, vec![]);

@@ -27,6 +27,7 @@ fn furnace_material() -> Material {
         bsdf: Bsdf::Diffuse { albedo: ALBEDO },
         emission: EMISSION,
         two_sided_emission: true,
+        textures: Default::default(),
     }
 }
 
@@ -45,6 +46,7 @@ fn camera() -> Camera {
 
 fn sphere_furnace() -> Scene {
     Scene::build(SceneInput {
+        textures: Vec::new(),
         camera: camera(),
         materials: vec![furnace_material()],
         triangles: vec![],
@@ -85,13 +87,16 @@ fn cube_furnace() -> Scene {
         triangles.push(TriangleInput {
             vertices: [a, b, c],
             material: 0,
+            uvs: None,
         });
         triangles.push(TriangleInput {
             vertices: [a, c, d],
             material: 0,
+            uvs: None,
         });
     }
     Scene::build(SceneInput {
+        textures: Vec::new(),
         camera: camera(),
         materials: vec![furnace_material()],
         triangles,

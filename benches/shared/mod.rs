@@ -31,10 +31,12 @@ pub fn uv_sphere(n: usize) -> Vec<TriangleInput> {
             triangles.push(TriangleInput {
                 vertices: [a, b, c],
                 material: 0,
+                uvs: None,
             });
             triangles.push(TriangleInput {
                 vertices: [a, c, d],
                 material: 0,
+                uvs: None,
             });
         }
     }

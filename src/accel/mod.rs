@@ -15,7 +15,7 @@ pub(crate) mod triangle;
 mod wide_bvh;
 
 use crate::math::{OffsetMode, Ray, gamma};
-use glam::Vec3A;
+use glam::{Vec2, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
@@ -44,6 +44,9 @@ pub struct Sphere {
 pub struct TriangleInput {
     pub vertices: [Vec3A; 3],
     pub material: u32,
+    /// Texture coordinates at the vertices; None gives (0, 0), (1, 0),
+    /// (1, 1)'s barycentric default (b1, b2).
+    pub uvs: Option<[Vec2; 3]>,
 }
 
 impl TriangleInput {
@@ -51,13 +54,16 @@ impl TriangleInput {
     /// triangles wound like (u, v): the quads of scene files and test scenes.
     pub fn quad(corner: Vec3A, u: Vec3A, v: Vec3A, material: u32) -> [TriangleInput; 2] {
         [
+            // (a, b) as texture coordinates, as Mitsuba's rectangle.
             TriangleInput {
                 vertices: [corner, corner + u, corner + u + v],
                 material,
+                uvs: Some([Vec2::ZERO, Vec2::X, Vec2::ONE]),
             },
             TriangleInput {
                 vertices: [corner, corner + u + v, corner + v],
                 material,
+                uvs: Some([Vec2::ZERO, Vec2::ONE, Vec2::Y]),
             },
         ]
     }
@@ -81,6 +87,10 @@ pub struct SurfaceHit {
     pub light: u32,
     /// Time of the ray that found the hit, inherited by rays spawned here.
     pub time: f32,
+    /// Texture coordinates: interpolated from the triangle's (barycentrics
+    /// where the geometry keeps none), or (φ / 2π, θ / π) on a sphere as
+    /// Mitsuba's.
+    pub uv: Vec2,
     /// Which primitive: a triangle's index, or the triangle count plus a
     /// sphere's index (within one object, for diagnostics such as counting
     /// self-intersections).
@@ -163,6 +173,9 @@ pub struct Geometry {
     tri_vertices: Vec<[Vec3A; 3]>,
     /// What a hit needs besides the position, one cache line per triangle.
     tri_shading: Vec<TriangleShading>,
+    /// Texture coordinates per triangle in BVH order; empty when no
+    /// material reads textures (hits then carry barycentrics).
+    tri_uvs: Vec<[Vec2; 3]>,
     sphere_bvh: Option<CwBvh>,
     spheres: Vec<Sphere>,
     /// Objects in linear motion, each tested by moving the ray instead.
@@ -172,6 +185,8 @@ pub struct Geometry {
     /// A BVH came out deeper than its traversal stack and its primitives
     /// are tested one by one instead.
     bvh_too_deep: bool,
+    /// Whether hits interpolate the triangles' texture coordinates.
+    keep_uvs: bool,
 }
 
 /// Geometry translated by `velocity * time`: at time t it is hit where the
@@ -257,7 +272,21 @@ impl Geometry {
         spheres: Vec<Sphere>,
         choice: AccelChoice,
     ) -> Self {
-        let mut geometry = Geometry::default();
+        Self::build_full(triangles, spheres, choice, false)
+    }
+
+    /// Builds, keeping texture coordinates for hits when `keep_uvs` (a
+    /// material reads a texture): only then do they cost memory and time.
+    pub fn build_full(
+        triangles: &[TriangleInput],
+        spheres: Vec<Sphere>,
+        choice: AccelChoice,
+        keep_uvs: bool,
+    ) -> Self {
+        let mut geometry = Geometry {
+            keep_uvs,
+            ..Geometry::default()
+        };
         let use_soup = match choice {
             AccelChoice::Auto => triangles.len() <= SOUP_MAX_TRIANGLES,
             AccelChoice::Bvh => false,
@@ -318,6 +347,10 @@ impl Geometry {
         for i in order {
             self.tri_vertices.push(triangles[i].vertices);
             self.tri_shading.push(TriangleShading::new(&triangles[i]));
+            if self.keep_uvs {
+                let barycentric = [Vec2::ZERO, Vec2::X, Vec2::Y];
+                self.tri_uvs.push(triangles[i].uvs.unwrap_or(barycentric));
+            }
         }
     }
 
@@ -544,9 +577,19 @@ impl Geometry {
             let normal = (ray.at(best_t) - s.center).normalize();
             let local = s.radius * normal;
             let point = s.center + local;
+            let phi = normal.y.atan2(normal.x);
+            let phi = if phi < 0.0 {
+                phi + std::f32::consts::TAU
+            } else {
+                phi
+            };
             return Some(SurfaceHit {
                 t: best_t,
                 point,
+                uv: Vec2::new(
+                    phi * (0.5 * std::f32::consts::FRAC_1_PI),
+                    normal.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
+                ),
                 // Re-projection onto the sphere (gamma(5), pbrt-v4 6.8.5) plus
                 // the translation by the centre.
                 error: gamma(5) * local.abs() + gamma(1) * point.abs(),
@@ -579,9 +622,14 @@ impl Geometry {
         let shading = self.tri_shading[index as usize];
         let b0 = 1.0 - best_b1 - best_b2;
         let point = b0 * p0 + best_b1 * p1 + best_b2 * p2;
+        let uv = match self.tri_uvs.get(index as usize) {
+            Some([t0, t1, t2]) => b0 * *t0 + best_b1 * *t1 + best_b2 * *t2,
+            None => Vec2::new(best_b1, best_b2),
+        };
         SurfaceHit {
             t: best_t,
             point,
+            uv,
             // Barycentric interpolation (pbrt-v4 6.8.4).
             error: gamma(7) * ((b0 * p0).abs() + (best_b1 * p1).abs() + (best_b2 * p2).abs()),
             normal: shading.normal,

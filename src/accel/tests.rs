@@ -14,10 +14,12 @@ fn quad_mesh() -> Vec<TriangleInput> {
         TriangleInput {
             vertices: [p[0], p[1], p[2]],
             material: 0,
+            uvs: None,
         },
         TriangleInput {
             vertices: [p[0], p[2], p[3]],
             material: 1,
+            uvs: None,
         },
     ]
 }

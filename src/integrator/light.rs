@@ -128,7 +128,7 @@ impl SplattingEstimator for LightTracer {
             let Some(hit) = scene.geometry.intersect(&ray) else {
                 break;
             };
-            let bsdf = scene.materials[hit.material as usize].bsdf;
+            let bsdf = scene.bsdf_at(&hit);
             if bsdf.is_black() {
                 break;
             }

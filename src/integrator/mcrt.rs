@@ -151,7 +151,7 @@ impl McRayTracer {
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
-        let bsdf = scene.materials[hit.material as usize].bsdf;
+        let bsdf = scene.bsdf_at(&hit);
         if level >= self.max_depth || bsdf.is_black() {
             return Rgb::ZERO;
         }

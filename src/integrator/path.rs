@@ -308,11 +308,11 @@ impl PathTracer {
                     observer.emission(emitted, weight, beta * emitted * weight);
                 }
             }
-            if bounces >= self.max_depth || material.bsdf.is_black() {
+            let bsdf = scene.bsdf_at(&hit);
+            if bounces >= self.max_depth || bsdf.is_black() {
                 break;
             }
 
-            let bsdf = material.bsdf;
             let frame = Frame::from_normal(hit.normal);
             let wo = frame.to_local(wo_world);
             // The lobe and roulette numbers are computed only when used.

@@ -162,7 +162,7 @@ impl PhotonMap2Pass {
         let mut beta = Rgb::ONE;
         for _ in 0..self.max_depth {
             let hit = scene.geometry.intersect(&ray)?;
-            let bsdf = scene.materials[hit.material as usize].bsdf;
+            let bsdf = scene.bsdf_at(&hit);
             if bsdf.is_black() {
                 return None;
             }
@@ -244,7 +244,7 @@ impl MultiPassEstimator for PhotonMap2Pass {
             let gather = x.hit.spawn_ray(x.frame.to_world(sample.wi));
             if let Some((y, arrived, chain)) = self.through_specular(scene, gather, sampler, counts)
             {
-                let bsdf_y = scene.materials[y.material as usize].bsdf;
+                let bsdf_y = scene.bsdf_at(&y);
                 let frame_y = Frame::from_normal(y.normal);
                 let wo_y = frame_y.to_local(-arrived);
                 let facing_y = if wo_y.z > 0.0 { y.normal } else { -y.normal };

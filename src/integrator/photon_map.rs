@@ -322,7 +322,7 @@ fn trace_photon(
         let Some(hit) = scene.geometry.intersect(&ray) else {
             break;
         };
-        let bsdf = scene.materials[hit.material as usize].bsdf;
+        let bsdf = scene.bsdf_at(&hit);
         if bsdf.is_black() {
             break;
         }
@@ -402,7 +402,7 @@ pub fn camera_to_diffuse(
         if hit.light != NO_LIGHT {
             emitted += beta * material.emitted(hit.normal, wo_world);
         }
-        let bsdf = material.bsdf;
+        let bsdf = scene.bsdf_at(&hit);
         if bsdf.is_black() {
             break;
         }

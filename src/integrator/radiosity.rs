@@ -344,12 +344,13 @@ impl Radiosity {
                 counts.bounce += 1;
             }
             let material = &scene.materials[hit.material as usize];
-            match material.bsdf.diffuse_albedo() {
+            let bsdf = scene.bsdf_at(&hit);
+            match bsdf.diffuse_albedo() {
                 None => {
                     let frame = Frame::from_normal(hit.normal);
                     let wo = frame.to_local(-ray.direction);
                     let u = sampler.next_1d_for(Domain::Bsdf);
-                    let Some(s) = material.bsdf.sample(wo, u, glam::Vec2::ZERO) else {
+                    let Some(s) = bsdf.sample(wo, u, glam::Vec2::ZERO) else {
                         return Rgb::ZERO;
                     };
                     weight *= s.weight;

@@ -122,12 +122,13 @@ impl WhittedTracer {
         // Diffuse lobes: direct light from each light as a point, plus the
         // ambient term; ideal lobes (a rough one read as its smooth limit)
         // recurse.
-        if let Some((diffuse, _)) = material.bsdf.diffuse_albedo() {
-            radiance += self.direct(scene, &hit, &frame, wo, material.bsdf, counts);
+        let bsdf = scene.bsdf_at(&hit);
+        if let Some((diffuse, _)) = bsdf.diffuse_albedo() {
+            radiance += self.direct(scene, &hit, &frame, wo, bsdf, counts);
             radiance += self.ambient * diffuse;
         }
         if depth < self.max_depth {
-            for (wi, weight) in material.bsdf.ideal_events(wo) {
+            for (wi, weight) in bsdf.ideal_events(wo) {
                 if weight.max_element() > 0.0 {
                     radiance +=
                         weight * self.follow(scene, &hit, frame.to_world(wi), depth, counts);

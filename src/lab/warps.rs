@@ -394,6 +394,7 @@ impl Fixtures {
                 &[TriangleInput {
                     vertices: triangle,
                     material: 0,
+                    uvs: None,
                 }],
                 vec![],
             ),

@@ -165,7 +165,7 @@ impl Hierarchy {
         let mut specular = 0;
         for (i, v) in geometry.triangles().iter().enumerate() {
             let material = &scene.materials[geometry.triangle_material(i) as usize];
-            let Some((reflectance, _)) = material.bsdf.diffuse_albedo() else {
+            let Some((reflectance, _)) = scene.diffuse_albedo(geometry.triangle_material(i)) else {
                 specular += 1;
                 roots.push(NONE);
                 continue;

@@ -103,8 +103,7 @@ impl Mesh {
         let (mut glossy, mut specular) = (0usize, 0usize);
         let mut total = 0usize;
         for (i, v) in triangles.iter().enumerate() {
-            let material = &scene.materials[geometry.triangle_material(i) as usize];
-            let diffuse = match material.bsdf.diffuse_albedo() {
+            let diffuse = match scene.diffuse_albedo(geometry.triangle_material(i)) {
                 Some((_, approximated)) => {
                     glossy += usize::from(approximated);
                     true
@@ -162,7 +161,9 @@ impl Mesh {
                 continue;
             };
             let material = &scene.materials[geometry.triangle_material(i) as usize];
-            let reflectance = material.bsdf.diffuse_albedo().map_or(Rgb::ZERO, |(a, _)| a);
+            let reflectance = scene
+                .diffuse_albedo(geometry.triangle_material(i))
+                .map_or(Rgb::ZERO, |(a, _)| a);
             let root = Element {
                 triangle: i as u32,
                 vertices: *v,
@@ -193,7 +194,7 @@ impl Mesh {
         }
         if glossy > 0 {
             mesh.notes.push(format!(
-                "{glossy} glossy, rough diffuse or plastic triangles are treated as diffuse with \
+                "{glossy} glossy, rough diffuse, plastic or textured triangles are treated as diffuse with \
                  their diffuse reflectance"
             ));
         }

@@ -66,7 +66,39 @@ pub struct SceneFile {
     #[serde(default)]
     pub materials: BTreeMap<String, Spanned<MaterialDesc>>,
     #[serde(default)]
+    pub textures: BTreeMap<String, Spanned<TextureDesc>>,
+    #[serde(default)]
     pub lights: LightOptions,
+}
+
+/// `[textures.NAME]`: Mitsuba's `bitmap` and `checkerboard`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureDesc {
+    #[serde(rename = "type")]
+    pub kind: TextureKind,
+    /// bitmap: an image file (PNG, JPEG, TGA, EXR, HDR), relative to the scene.
+    pub file: Option<String>,
+    /// bitmap: read 8-bit values as data, without sRGB decoding.
+    pub raw: Option<bool>,
+    /// bitmap: "repeat" (default), "mirror" or "clamp".
+    pub wrap: Option<String>,
+    /// bitmap: "bilinear" (default) or "nearest".
+    pub filter: Option<String>,
+    /// checkerboard: the two colours (Mitsuba: 0.4 and 0.2).
+    pub color0: Option<[f32; 3]>,
+    pub color1: Option<[f32; 3]>,
+    /// uv · uv_scale + uv_offset (Mitsuba's `to_uv`).
+    pub uv_scale: Option<[f32; 2]>,
+    pub uv_offset: Option<[f32; 2]>,
+}
+
+/// Kinds of texture.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum TextureKind {
+    Bitmap,
+    Checkerboard,
 }
 
 /// `[camera]`.
@@ -228,6 +260,12 @@ pub struct MaterialDesc {
     /// dielectrics) give their back the front's response (Mitsuba's
     /// `twosided`); by default they are black seen from behind.
     pub twosided: Option<bool>,
+    /// Textures (names in `[textures]`) for the diffuse colour (`albedo`
+    /// or `diffuse_reflectance`), the specular tint and the roughness.
+    pub albedo_texture: Option<String>,
+    pub diffuse_reflectance_texture: Option<String>,
+    pub specular_reflectance_texture: Option<String>,
+    pub alpha_texture: Option<String>,
     /// Emitted radiance (any type).
     pub emission: Option<[f32; 3]>,
     /// Emit from both sides (any type).

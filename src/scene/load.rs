@@ -2,7 +2,7 @@
 //! scene file and the line of the entry at fault (or the OBJ/MTL file and line).
 
 use super::description::*;
-use super::material::{Bsdf, Material};
+use super::material::{Bsdf, Material, MaterialTextures};
 use super::obj::load_obj;
 use super::{Limits, MAX_COORDINATE, MovingInput, SceneInput, in_range};
 use crate::accel::{NO_LIGHT, Sphere, TriangleInput};
@@ -15,7 +15,8 @@ use crate::error::{Error, Result, line_of};
 use crate::filter::PixelFilter;
 use crate::math::Rgb;
 use crate::scene::light::Light;
-use glam::{EulerRot, Mat4, Quat, Vec3, Vec3A};
+use crate::texture::{Bitmap, Filter as TextureFilter, Texture, UvTransform, Wrap};
+use glam::{EulerRot, Mat4, Quat, Vec2, Vec3, Vec3A};
 use std::collections::HashMap;
 use std::path::Path;
 use toml::Spanned;
@@ -42,10 +43,19 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
 
     // Materials named in the scene file come first; MTL materials of the
     // same name are replaced by them.
+    let mut textures = Vec::new();
+    let mut texture_ids: HashMap<String, u32> = HashMap::new();
+    for (name, desc) in &file.textures {
+        let t = build_texture(name, desc.get_ref(), &dir).map_err(|m| at(desc.span(), m))?;
+        texture_ids.insert(name.clone(), textures.len() as u32);
+        textures.push(t);
+    }
     let mut materials: Vec<Material> = Vec::new();
     let mut by_name: HashMap<String, u32> = HashMap::new();
     for (name, desc) in &file.materials {
-        let m = build_material(name, desc.get_ref()).map_err(|m| at(desc.span(), m))?;
+        let mut m = build_material(name, desc.get_ref()).map_err(|m| at(desc.span(), m))?;
+        m.textures = material_textures(name, desc.get_ref(), &texture_ids)
+            .map_err(|m| at(desc.span(), m))?;
         by_name.insert(name.clone(), materials.len() as u32);
         materials.push(m);
     }
@@ -125,7 +135,11 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
                 }),
             };
             let vertices = vertices.map(|v| transform.transform_point3a(v));
-            mesh_triangles.push(TriangleInput { vertices, material });
+            mesh_triangles.push(TriangleInput {
+                vertices,
+                material,
+                uvs: None,
+            });
             if triangles.len() + mesh_triangles.len() > limits.max_triangles {
                 return Err(at(
                     mesh.span(),
@@ -233,6 +247,7 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
     }
 
     Ok(SceneInput {
+        textures,
         camera,
         materials,
         triangles,
@@ -383,7 +398,146 @@ fn default_material() -> Material {
         },
         emission: Rgb::ZERO,
         two_sided_emission: false,
+        textures: Default::default(),
     }
+}
+
+fn build_texture(name: &str, d: &TextureDesc, dir: &Path) -> std::result::Result<Texture, String> {
+    let pair = |field: &str, v: Option<[f32; 2]>, default: Vec2| match v {
+        None => Ok(default),
+        Some(p) if p.iter().all(|x| x.is_finite()) => Ok(Vec2::from(p)),
+        Some(p) => Err(format!(
+            "texture `{name}`: `{field}` must be finite, got {p:?}"
+        )),
+    };
+    let to_uv = UvTransform {
+        scale: pair("uv_scale", d.uv_scale, Vec2::ONE)?,
+        offset: pair("uv_offset", d.uv_offset, Vec2::ZERO)?,
+    };
+    let colour = |field: &str, v: Option<[f32; 3]>, default: f32| match v {
+        None => Ok(Rgb::splat(default)),
+        Some(c) if c.iter().all(|x| x.is_finite() && *x >= 0.0) => Ok(Rgb::from(c)),
+        Some(c) => Err(format!(
+            "texture `{name}`: `{field}` must be finite and >= 0, got {c:?}"
+        )),
+    };
+    let only = |allowed: &[&str]| -> std::result::Result<(), String> {
+        let present = [
+            ("file", d.file.is_some()),
+            ("raw", d.raw.is_some()),
+            ("wrap", d.wrap.is_some()),
+            ("filter", d.filter.is_some()),
+            ("color0", d.color0.is_some()),
+            ("color1", d.color1.is_some()),
+        ];
+        match present.iter().find(|(f, p)| *p && !allowed.contains(f)) {
+            Some((f, _)) => Err(format!(
+                "texture `{name}`: field `{f}` does not apply to type {:?}",
+                d.kind
+            )),
+            None => Ok(()),
+        }
+    };
+    match d.kind {
+        TextureKind::Checkerboard => {
+            only(&["color0", "color1"])?;
+            Ok(Texture::Checkerboard {
+                color0: colour("color0", d.color0, 0.4)?,
+                color1: colour("color1", d.color1, 0.2)?,
+                to_uv,
+            })
+        }
+        TextureKind::Bitmap => {
+            only(&["file", "raw", "wrap", "filter"])?;
+            let file = d
+                .file
+                .as_ref()
+                .ok_or_else(|| format!("texture `{name}`: a bitmap needs `file`"))?;
+            let wrap = match d.wrap.as_deref() {
+                None | Some("repeat") => Wrap::Repeat,
+                Some("mirror") => Wrap::Mirror,
+                Some("clamp") => Wrap::Clamp,
+                Some(w) => {
+                    return Err(format!(
+                        "texture `{name}`: `wrap` must be repeat, mirror or clamp, got \"{w}\""
+                    ));
+                }
+            };
+            let filter = match d.filter.as_deref() {
+                None | Some("bilinear") => TextureFilter::Bilinear,
+                Some("nearest") => TextureFilter::Nearest,
+                Some(f) => {
+                    return Err(format!(
+                        "texture `{name}`: `filter` must be bilinear or nearest, got \"{f}\""
+                    ));
+                }
+            };
+            let image = Bitmap::read(&dir.join(file), d.raw.unwrap_or(false))
+                .map_err(|e| format!("texture `{name}`: {e}"))?;
+            Ok(Texture::Bitmap {
+                image: std::sync::Arc::new(image),
+                wrap,
+                filter,
+                to_uv,
+            })
+        }
+    }
+}
+
+/// The texture slots of material `name`, each checked against its model.
+fn material_textures(
+    name: &str,
+    d: &MaterialDesc,
+    ids: &HashMap<String, u32>,
+) -> std::result::Result<MaterialTextures, String> {
+    use MaterialKind as K;
+    let id = |field: &str,
+              v: &Option<String>,
+              applies: bool|
+     -> std::result::Result<Option<u32>, String> {
+        let Some(t) = v else { return Ok(None) };
+        if !applies {
+            return Err(format!(
+                "material `{name}`: `{field}` does not apply to type {:?}",
+                d.kind
+            ));
+        }
+        ids.get(t).copied().map(Some).ok_or_else(|| {
+            let mut known: Vec<&String> = ids.keys().collect();
+            known.sort();
+            format!("material `{name}`: unknown texture `{t}` (defined: {known:?})")
+        })
+    };
+    let plastic = matches!(d.kind, K::Plastic | K::RoughPlastic);
+    let albedo = id(
+        "albedo_texture",
+        &d.albedo_texture,
+        matches!(d.kind, K::Diffuse | K::RoughDiffuse),
+    )?;
+    let diffuse = id(
+        "diffuse_reflectance_texture",
+        &d.diffuse_reflectance_texture,
+        plastic,
+    )?;
+    let specular = id(
+        "specular_reflectance_texture",
+        &d.specular_reflectance_texture,
+        plastic
+            || matches!(
+                d.kind,
+                K::Conductor | K::RoughConductor | K::ThinDielectric | K::RoughDielectric
+            ),
+    )?;
+    let alpha = id(
+        "alpha_texture",
+        &d.alpha_texture,
+        matches!(d.kind, K::RoughConductor | K::RoughDielectric),
+    )?;
+    Ok(MaterialTextures {
+        diffuse: albedo.or(diffuse),
+        specular,
+        alpha,
+    })
 }
 
 fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material, String> {
@@ -682,5 +836,6 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
         bsdf,
         emission: colour("emission", d.emission, Rgb::ZERO, f32::MAX)?,
         two_sided_emission: d.two_sided.unwrap_or(false),
+        textures: Default::default(),
     })
 }

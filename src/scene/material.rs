@@ -1,8 +1,10 @@
 //! Materials: a BSDF (see [`crate::bsdf`]) plus optional emission.
 
+use crate::bsdf::Microfacet;
 pub use crate::bsdf::{Bsdf, BsdfSample, Fresnel, fresnel_dielectric};
 use crate::math::Rgb;
-use glam::Vec3A;
+use crate::texture::Texture;
+use glam::{Vec2, Vec3A};
 
 /// A material: how a surface scatters and what it emits.
 #[derive(Clone, Debug, PartialEq)]
@@ -13,9 +15,73 @@ pub struct Material {
     pub emission: Rgb,
     /// Emit on both sides; by default only along the geometric normal.
     pub two_sided_emission: bool,
+    /// Parameters read from textures at each hit.
+    pub textures: MaterialTextures,
+}
+
+/// Which of a material's parameters come from textures (indices into
+/// [`crate::scene::Scene::textures`]), Mitsuba's names.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MaterialTextures {
+    /// `reflectance` / `diffuse_reflectance`: the diffuse colour.
+    pub diffuse: Option<u32>,
+    /// `specular_reflectance`: conductors' and coatings' tint.
+    pub specular: Option<u32>,
+    /// `alpha`: a rough conductor's or dielectric's roughness (its first channel).
+    pub alpha: Option<u32>,
+}
+
+impl MaterialTextures {
+    /// True when no parameter is textured.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.diffuse.is_none() && self.specular.is_none() && self.alpha.is_none()
+    }
 }
 
 impl Material {
+    /// The BSDF at a hit with texture coordinates `uv`: the textured
+    /// parameters read from `textures`, the rest as stored.
+    #[inline]
+    pub fn bsdf_at(&self, textures: &[Texture], uv: Vec2) -> Bsdf {
+        let t = self.textures;
+        if t.is_empty() {
+            return self.bsdf;
+        }
+        let read = |slot: Option<u32>| slot.map(|i| textures[i as usize].eval(uv));
+        let (diffuse, specular) = (read(t.diffuse), read(t.specular));
+        let alpha = read(t.alpha).map(|a| a.x);
+        let mut bsdf = self.bsdf;
+        match &mut bsdf {
+            Bsdf::Diffuse { albedo } => *albedo = diffuse.unwrap_or(*albedo),
+            Bsdf::RoughDiffuse { lobe, .. } => lobe.albedo = diffuse.unwrap_or(lobe.albedo),
+            Bsdf::Plastic { lobe, .. } => {
+                lobe.diffuse = diffuse.unwrap_or(lobe.diffuse);
+                lobe.specular = specular.unwrap_or(lobe.specular);
+            }
+            Bsdf::RoughPlastic { lobe, .. } => {
+                lobe.diffuse = diffuse.unwrap_or(lobe.diffuse);
+                lobe.specular = specular.unwrap_or(lobe.specular);
+            }
+            Bsdf::Conductor { lobe, .. } => lobe.tint = specular.unwrap_or(lobe.tint),
+            Bsdf::RoughConductor { lobe, .. } => {
+                lobe.tint = specular.unwrap_or(lobe.tint);
+                if let Some(a) = alpha {
+                    lobe.microfacet = Microfacet::new(lobe.microfacet.distribution, a, a);
+                }
+            }
+            Bsdf::RoughDielectric(lobe) => {
+                lobe.reflectance = specular.unwrap_or(lobe.reflectance);
+                if let Some(a) = alpha {
+                    lobe.microfacet = Microfacet::new(lobe.microfacet.distribution, a, a);
+                }
+            }
+            Bsdf::ThinDielectric(lobe) => lobe.reflectance = specular.unwrap_or(lobe.reflectance),
+            Bsdf::Glossy { .. } | Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => {}
+        }
+        bsdf
+    }
+
     /// True when the surface is a light source.
     pub fn is_emissive(&self) -> bool {
         self.emission.max_element() > 0.0

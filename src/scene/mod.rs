@@ -8,11 +8,12 @@ pub mod load;
 pub mod material;
 pub mod obj;
 
-use crate::accel::{Geometry, NO_LIGHT, Sphere, TriangleInput};
+use crate::accel::{AccelChoice, Geometry, NO_LIGHT, Sphere, SurfaceHit, TriangleInput};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::math::OffsetMode;
 use crate::shortcuts::{NotApplied, PrimaryCandidates, Shortcuts, ShortcutsUsed};
+use crate::texture::Texture;
 use emitters::EmitterShape;
 use glam::Vec3A;
 use light::{Light, LightSampling, Lights, PlanarEmitter};
@@ -64,6 +65,8 @@ impl Limits {
 pub struct SceneInput {
     pub camera: Camera,
     pub materials: Vec<Material>,
+    /// Textures the materials read (see [`material::MaterialTextures`]).
+    pub textures: Vec<Texture>,
     pub triangles: Vec<TriangleInput>,
     pub spheres: Vec<Sphere>,
     pub point_lights: Vec<Light>,
@@ -208,6 +211,8 @@ pub struct Scene {
     /// Shared, so that a scene with another camera costs no copy of the BVH.
     pub geometry: Arc<Geometry>,
     pub materials: Vec<Material>,
+    /// Textures, each once, shared by the materials that read them.
+    pub textures: Vec<Texture>,
     pub lights: Lights,
     pub features: Features,
     /// Things the user should know that did not stop loading (dropped triangles, ...).
@@ -297,7 +302,10 @@ impl Scene {
             )));
         }
 
-        let mut geometry = Geometry::build(&triangles, spheres);
+        // Texture coordinates cost memory and a lookup per hit: kept only
+        // when some material reads a texture.
+        let textured = input.materials.iter().any(|m| !m.textures.is_empty());
+        let mut geometry = Geometry::build_full(&triangles, spheres, AccelChoice::Auto, textured);
         for (triangles, spheres, velocity) in moving {
             if !(triangles.is_empty() && spheres.is_empty()) {
                 geometry.add_moving(Geometry::build(&triangles, spheres), velocity);
@@ -377,10 +385,29 @@ impl Scene {
             features,
             geometry: Arc::new(geometry),
             materials: input.materials,
+            textures: input.textures,
             lights,
             warnings,
             shortcuts,
         })
+    }
+
+    /// What radiosity makes of material `m` (see
+    /// [`crate::bsdf::Bsdf::diffuse_albedo`]); a textured diffuse colour
+    /// is read as the texture's mean, which counts as dropping detail.
+    pub fn diffuse_albedo(&self, m: u32) -> Option<(crate::math::Rgb, bool)> {
+        let material = &self.materials[m as usize];
+        let (albedo, approximated) = material.bsdf.diffuse_albedo()?;
+        match material.textures.diffuse {
+            Some(t) => Some((self.textures[t as usize].mean(), true)),
+            None => Some((albedo, approximated)),
+        }
+    }
+
+    /// The BSDF at `hit`, its textures read.
+    #[inline]
+    pub fn bsdf_at(&self, hit: &SurfaceHit) -> crate::bsdf::Bsdf {
+        self.materials[hit.material as usize].bsdf_at(&self.textures, hit.uv)
     }
 
     /// Samples every area light by `mode` (the CLI's `--light-sampling`).

@@ -297,6 +297,7 @@ fn convert_material(mtl_path: &Path, m: &tobj::Material) -> Result<Material> {
         bsdf,
         emission,
         two_sided_emission: false,
+        textures: Default::default(),
     })
 }
 

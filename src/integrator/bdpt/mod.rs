@@ -435,7 +435,8 @@ impl Bdpt {
             let wo_world = -ray.direction;
             let index = path.len();
             let previous = path[index - 1];
-            let mut vertex = surface_vertex(&hit, material.bsdf, wo_world, beta);
+            let bsdf = scene.bsdf_at(&hit);
+            let mut vertex = surface_vertex(&hit, bsdf, wo_world, beta);
             if hit.light != NO_LIGHT {
                 vertex.light = hit.light;
                 vertex.emitted = material.emitted(hit.normal, wo_world);
@@ -444,13 +445,12 @@ impl Bdpt {
             vertex.u_connect = u_connect;
             vertex.pdf_fwd = previous.area_density_at(pdf_direction, &vertex);
             path.push(vertex);
-            if path.len() >= max_vertices || material.bsdf.is_black() {
+            if path.len() >= max_vertices || bsdf.is_black() {
                 break;
             }
 
             let frame = Frame::from_normal(hit.normal);
             let wo = frame.to_local(wo_world);
-            let bsdf = material.bsdf;
             let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
                 break;
             };

@@ -129,6 +129,8 @@ pub struct LightVertex {
     /// The subpath's weight up to here (flux of one of N subpaths).
     beta: Rgb,
     material: u32,
+    /// Texture coordinates, to read the material's textures.
+    uv: glam::Vec2,
     /// Segments from the light to here.
     segments: u32,
     /// Georgiev et al.'s recursive MIS quantities at this vertex.
@@ -341,8 +343,7 @@ impl Vcm {
                 break;
             };
             let wo_world = -ray.direction;
-            let material = &scene.materials[hit.material as usize];
-            let bsdf = material.bsdf;
+            let bsdf = scene.bsdf_at(&hit);
             if bsdf.is_black() {
                 break;
             }
@@ -354,6 +355,7 @@ impl Vcm {
                     wo: wo_world,
                     beta: walk.beta,
                     material: hit.material,
+                    uv: hit.uv,
                     segments,
                     d_vcm: walk.d_vcm,
                     d_vc: walk.d_vc,
@@ -497,7 +499,7 @@ impl MultiPassEstimator for Vcm {
                     radiance += walk.beta * emitted * weight;
                 }
             }
-            let bsdf = material.bsdf;
+            let bsdf = scene.bsdf_at(&hit);
             if bsdf.is_black() || segments > self.max_depth {
                 break;
             }

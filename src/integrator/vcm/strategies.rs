@@ -62,7 +62,7 @@ impl Vcm {
     ) {
         let at = (v.point, v.error, v.normal);
         self.splat_through_lens(scene, iteration, at, sampler, counts, splats, |c| {
-            let bsdf = scene.materials[v.material as usize].bsdf;
+            let bsdf = scene.materials[v.material as usize].bsdf_at(&scene.textures, v.uv);
             let frame = Frame::from_normal(v.normal);
             let (f, _, pdf_reverse) =
                 bsdf.eval_adjoint_with_pdfs(frame.to_local(v.wo), frame.to_local(c.wi));
@@ -180,7 +180,8 @@ impl Vcm {
         let w = d / dist2.sqrt();
         let (f_camera, pdf_camera, pdf_camera_reverse) =
             at.bsdf.eval_with_pdfs(at.wo, at.frame.to_local(w));
-        let light_bsdf = scene.materials[light.material as usize].bsdf;
+        let light_bsdf =
+            scene.materials[light.material as usize].bsdf_at(&scene.textures, light.uv);
         let light_frame = Frame::from_normal(light.normal);
         let (f_light, pdf_light, pdf_light_reverse) = light_bsdf
             .eval_adjoint_with_pdfs(light_frame.to_local(light.wo), light_frame.to_local(-w));

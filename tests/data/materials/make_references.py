@@ -71,7 +71,22 @@ FILTERS = {
 }
 
 
-def scene(obj, rfilter=None):
+def checks(scale, c0, c1):
+    return {"type": "checkerboard", "to_uv": mi.ScalarTransform3f().scale([scale, scale]),
+            "color0": {"type": "rgb", "value": c0}, "color1": {"type": "rgb", "value": c1}}
+
+
+# Textures: a checkerboard floor (checks of 2 m) under a diffuse sphere with
+# a checkerboard of 8 x 8 checks in its (phi / 2 pi, theta / pi) coordinates.
+TEXTURED = {
+    "textured_diffuse": (
+        sphere({"type": "diffuse", "reflectance": checks(8, [0.7, 0.6, 0.1], [0.1, 0.2, 0.6])}),
+        {"type": "diffuse", "reflectance": checks(20, [0.6, 0.6, 0.6], [0.1, 0.1, 0.1])},
+    ),
+}
+
+
+def scene(obj, rfilter=None, floor_bsdf=None):
     return {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": MAX_DEPTH, "rr_depth": 5},
@@ -86,7 +101,7 @@ def scene(obj, rfilter=None):
         "floor": {
             "type": "rectangle",
             "to_world": mi.ScalarTransform4f().scale(20),
-            "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.4, 0.4, 0.4]}},
+            "bsdf": floor_bsdf or {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.4, 0.4, 0.4]}},
         },
         # 2 m square at (1.2, -1.2, 3), facing down: large, so that the
         # caustics of Dirac spheres (found by BSDF sampling from the floor)
@@ -101,11 +116,13 @@ def scene(obj, rfilter=None):
 
 
 def main(names):
-    jobs = {name: (obj, None) for name, obj in MATERIALS.items()} | FILTERS
-    for name, (obj, rfilter) in jobs.items():
+    jobs = {name: (obj, None, None) for name, obj in MATERIALS.items()}
+    jobs |= {name: (obj, rfilter, None) for name, (obj, rfilter) in FILTERS.items()}
+    jobs |= {name: (obj, None, floor) for name, (obj, floor) in TEXTURED.items()}
+    for name, (obj, rfilter, floor) in jobs.items():
         if names and name not in names:
             continue
-        s = mi.load_dict(scene(obj, rfilter))
+        s = mi.load_dict(scene(obj, rfilter, floor))
         passes = np.stack([np.array(mi.render(s, seed=1000 * k + 7)) for k in range(PASSES)])
         mean = passes.mean(axis=0)
         var = passes.var(axis=0, ddof=1) / PASSES

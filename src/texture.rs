@@ -1,0 +1,266 @@
+//! Textures (Mitsuba's `bitmap` and `checkerboard`): evaluated at a hit's
+//! texture coordinates into the parameter of a material. A scene holds
+//! each texture once; materials refer to it by index, so textures are
+//! shared and a bitmap is decoded once.
+
+use crate::math::Rgb;
+use glam::Vec2;
+use std::path::Path;
+use std::sync::Arc;
+
+/// How coordinates outside [0, 1) map into a bitmap (Mitsuba's `wrap_mode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wrap {
+    Repeat,
+    Mirror,
+    Clamp,
+}
+
+/// How a bitmap is read between texel centres (Mitsuba's `filter_type`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Filter {
+    Nearest,
+    Bilinear,
+}
+
+/// Linear RGB texels, row 0 at the top of the image file: v = 0 reads the
+/// top row, as Mitsuba's bitmap (OBJ files' v, which counts from the
+/// bottom, is flipped at load, as Mitsuba does).
+#[derive(Debug)]
+pub struct Bitmap {
+    pub width: usize,
+    pub height: usize,
+    pub texels: Vec<Rgb>,
+}
+
+/// The affine map from a surface's texture coordinates to the texture's:
+/// uv · scale + offset (Mitsuba's `to_uv` with a scale and a translation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform {
+    pub scale: Vec2,
+    pub offset: Vec2,
+}
+
+impl Default for UvTransform {
+    fn default() -> Self {
+        UvTransform {
+            scale: Vec2::ONE,
+            offset: Vec2::ZERO,
+        }
+    }
+}
+
+/// A texture.
+#[derive(Clone, Debug)]
+pub enum Texture {
+    Bitmap {
+        image: Arc<Bitmap>,
+        wrap: Wrap,
+        filter: Filter,
+        to_uv: UvTransform,
+    },
+    /// color0 where the fractional parts of u and v are on the same side
+    /// of 1/2, else color1 (Mitsuba's checkerboard).
+    Checkerboard {
+        color0: Rgb,
+        color1: Rgb,
+        to_uv: UvTransform,
+    },
+}
+
+impl Texture {
+    /// The texture's value at surface coordinates `uv`.
+    #[inline]
+    pub fn eval(&self, uv: Vec2) -> Rgb {
+        match self {
+            Texture::Bitmap {
+                image,
+                wrap,
+                filter,
+                to_uv,
+            } => image.lookup(uv * to_uv.scale + to_uv.offset, *wrap, *filter),
+            Texture::Checkerboard {
+                color0,
+                color1,
+                to_uv,
+            } => {
+                let uv = uv * to_uv.scale + to_uv.offset;
+                let fu = uv.x - uv.x.floor() > 0.5;
+                let fv = uv.y - uv.y.floor() > 0.5;
+                if fu == fv { *color0 } else { *color1 }
+            }
+        }
+    }
+
+    /// The mean over the texture (for lobe choices that want one value).
+    pub fn mean(&self) -> Rgb {
+        match self {
+            Texture::Bitmap { image, .. } => {
+                image.texels.iter().copied().sum::<Rgb>() / image.texels.len().max(1) as f32
+            }
+            Texture::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
+        }
+    }
+}
+
+impl Bitmap {
+    /// Reads an image (PNG, JPEG, TGA, EXR, HDR, by extension). 8- and
+    /// 16-bit colour is sRGB-decoded unless `raw` (data such as roughness);
+    /// float images (EXR, HDR) are linear. Non-finite texels become 0.
+    pub fn read(path: &Path, raw: bool) -> Result<Bitmap, String> {
+        let image = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let float = matches!(
+            image.color(),
+            image::ColorType::Rgb32F | image::ColorType::Rgba32F
+        );
+        let rgb = image.to_rgb32f();
+        let (width, height) = (rgb.width() as usize, rgb.height() as usize);
+        if width == 0 || height == 0 {
+            return Err(format!("{}: the image is empty", path.display()));
+        }
+        let decode = |c: f32| {
+            let c = if c.is_finite() { c.max(0.0) } else { 0.0 };
+            if float || raw { c } else { srgb_to_linear(c) }
+        };
+        let texels = rgb
+            .pixels()
+            .map(|p| Rgb::new(decode(p[0]), decode(p[1]), decode(p[2])))
+            .collect();
+        Ok(Bitmap {
+            width,
+            height,
+            texels,
+        })
+    }
+
+    #[inline]
+    fn texel(&self, x: i64, y: i64, wrap: Wrap) -> Rgb {
+        let map = |i: i64, n: usize| -> usize {
+            let n = n as i64;
+            let i = match wrap {
+                Wrap::Repeat => i.rem_euclid(n),
+                Wrap::Clamp => i.clamp(0, n - 1),
+                Wrap::Mirror => {
+                    let m = i.rem_euclid(2 * n);
+                    if m < n { m } else { 2 * n - 1 - m }
+                }
+            };
+            i as usize
+        };
+        self.texels[map(y, self.height) * self.width + map(x, self.width)]
+    }
+
+    /// The bitmap at texture coordinates `uv` (texel centres at
+    /// ((i + 1/2) / width, (j + 1/2) / height)).
+    #[inline]
+    pub fn lookup(&self, uv: Vec2, wrap: Wrap, filter: Filter) -> Rgb {
+        if !uv.is_finite() {
+            return Rgb::ZERO;
+        }
+        let x = uv.x * self.width as f32 - 0.5;
+        let y = uv.y * self.height as f32 - 0.5;
+        match filter {
+            Filter::Nearest => self.texel((x + 0.5).floor() as i64, (y + 0.5).floor() as i64, wrap),
+            Filter::Bilinear => {
+                let (x0, y0) = (x.floor(), y.floor());
+                let (fx, fy) = (x - x0, y - y0);
+                let (x0, y0) = (x0 as i64, y0 as i64);
+                let top = self.texel(x0, y0, wrap) * (1.0 - fx) + self.texel(x0 + 1, y0, wrap) * fx;
+                let bottom = self.texel(x0, y0 + 1, wrap) * (1.0 - fx)
+                    + self.texel(x0 + 1, y0 + 1, wrap) * fx;
+                top * (1.0 - fy) + bottom * fy
+            }
+        }
+    }
+}
+
+/// The sRGB transfer function's inverse (IEC 61966-2-1).
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two_by_two() -> Bitmap {
+        Bitmap {
+            width: 2,
+            height: 2,
+            texels: vec![
+                Rgb::splat(0.0),
+                Rgb::splat(1.0),
+                Rgb::splat(2.0),
+                Rgb::splat(3.0),
+            ],
+        }
+    }
+
+    #[test]
+    fn bitmap_lookup_filters_and_wraps() {
+        let b = two_by_two();
+        // Texel centres read exactly; the middle is the mean of four.
+        assert_eq!(
+            b.lookup(Vec2::new(0.25, 0.25), Wrap::Repeat, Filter::Bilinear)
+                .x,
+            0.0
+        );
+        assert_eq!(
+            b.lookup(Vec2::new(0.75, 0.75), Wrap::Repeat, Filter::Bilinear)
+                .x,
+            3.0
+        );
+        assert_eq!(
+            b.lookup(Vec2::new(0.5, 0.5), Wrap::Repeat, Filter::Bilinear)
+                .x,
+            1.5
+        );
+        // Row 0 is the top: v = 0.25 reads texels 0 and 1.
+        assert_eq!(
+            b.lookup(Vec2::new(0.75, 0.25), Wrap::Repeat, Filter::Nearest)
+                .x,
+            1.0
+        );
+        // Repeat, clamp and mirror one texel beyond the right edge.
+        let beyond = Vec2::new(1.25, 0.25);
+        assert_eq!(b.lookup(beyond, Wrap::Repeat, Filter::Nearest).x, 0.0);
+        assert_eq!(b.lookup(beyond, Wrap::Clamp, Filter::Nearest).x, 1.0);
+        assert_eq!(b.lookup(beyond, Wrap::Mirror, Filter::Nearest).x, 1.0);
+        assert_eq!(
+            b.lookup(Vec2::new(1.75, 0.25), Wrap::Mirror, Filter::Nearest)
+                .x,
+            0.0
+        );
+        assert_eq!(
+            b.lookup(Vec2::NAN, Wrap::Repeat, Filter::Bilinear),
+            Rgb::ZERO
+        );
+    }
+
+    #[test]
+    fn checkerboard_alternates_as_mitsubas() {
+        let t = Texture::Checkerboard {
+            color0: Rgb::ONE,
+            color1: Rgb::ZERO,
+            to_uv: UvTransform {
+                scale: Vec2::splat(2.0),
+                offset: Vec2::ZERO,
+            },
+        };
+        assert_eq!(t.eval(Vec2::new(0.1, 0.1)), Rgb::ONE);
+        assert_eq!(t.eval(Vec2::new(0.3, 0.1)), Rgb::ZERO);
+        assert_eq!(t.eval(Vec2::new(0.3, 0.3)), Rgb::ONE);
+        assert_eq!(t.mean(), Rgb::splat(0.5));
+    }
+
+    #[test]
+    fn srgb_decoding_matches_the_standard() {
+        assert_eq!(srgb_to_linear(0.0), 0.0);
+        assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-6);
+        assert!((srgb_to_linear(0.5) - 0.214_041).abs() < 1e-5);
+    }
+}
