@@ -108,6 +108,10 @@ impl Bitmap {
     /// 16-bit colour is sRGB-decoded unless `raw` (data such as roughness);
     /// float images (EXR, HDR) are linear. Non-finite texels become 0.
     pub fn read(path: &Path, raw: bool) -> Result<Bitmap, String> {
+        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("pfm")) {
+            let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            return read_pfm(&bytes).map_err(|e| format!("{}: {e}", path.display()));
+        }
         let image = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let float = matches!(
             image.color(),
@@ -172,6 +176,63 @@ impl Bitmap {
             }
         }
     }
+}
+
+/// A Portable Float Map (`PF` colour or `Pf` grey; rows stored bottom to
+/// top; a negative scale means little-endian). Linear.
+pub fn read_pfm(bytes: &[u8]) -> Result<Bitmap, String> {
+    // The header: three whitespace-separated tokens after the magic.
+    let mut tokens = Vec::new();
+    let mut at = 0;
+    while tokens.len() < 4 {
+        while at < bytes.len() && bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        let start = at;
+        while at < bytes.len() && !bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        if start == at {
+            return Err("truncated PFM header".into());
+        }
+        tokens.push(String::from_utf8_lossy(&bytes[start..at]).into_owned());
+    }
+    at += 1; // The single whitespace byte before the data.
+    let channels = match tokens[0].as_str() {
+        "PF" => 3,
+        "Pf" => 1,
+        m => return Err(format!("not a PFM file (magic {m:?})")),
+    };
+    let parse = |t: &str| t.parse::<usize>().map_err(|_| format!("bad PFM size {t:?}"));
+    let (width, height) = (parse(&tokens[1])?, parse(&tokens[2])?);
+    let scale: f32 = tokens[3].parse().map_err(|_| format!("bad PFM scale {:?}", tokens[3]))?;
+    let count = width
+        .checked_mul(height)
+        .and_then(|n| n.checked_mul(channels))
+        .filter(|&n| n > 0 && n <= 1 << 28)
+        .ok_or_else(|| format!("PFM size {width}x{height} is empty or too large"))?;
+    let data = bytes.get(at..at + 4 * count).ok_or("truncated PFM data")?;
+    let value = |i: usize| {
+        let b = [data[4 * i], data[4 * i + 1], data[4 * i + 2], data[4 * i + 3]];
+        let v = if scale < 0.0 { f32::from_le_bytes(b) } else { f32::from_be_bytes(b) };
+        if v.is_finite() { v.max(0.0) } else { 0.0 }
+    };
+    let mut texels = vec![Rgb::ZERO; width * height];
+    for y in 0..height {
+        for x in 0..width {
+            let i = ((height - 1 - y) * width + x) * channels;
+            texels[y * width + x] = if channels == 3 {
+                Rgb::new(value(i), value(i + 1), value(i + 2))
+            } else {
+                Rgb::splat(value(i))
+            };
+        }
+    }
+    Ok(Bitmap {
+        width,
+        height,
+        texels,
+    })
 }
 
 /// The sRGB transfer function's inverse (IEC 61966-2-1).
@@ -255,6 +316,19 @@ mod tests {
         assert_eq!(t.eval(Vec2::new(0.3, 0.1)), Rgb::ZERO);
         assert_eq!(t.eval(Vec2::new(0.3, 0.3)), Rgb::ONE);
         assert_eq!(t.mean(), Rgb::splat(0.5));
+    }
+
+    #[test]
+    fn pfm_reads_bottom_up_little_endian() {
+        let mut bytes = b"PF\n2 1\n-1.0\n".to_vec();
+        for v in [1.0f32, 2.0, 3.0, 4.0, 5.0, 6.0] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        let b = read_pfm(&bytes).unwrap();
+        assert_eq!((b.width, b.height), (2, 1));
+        assert_eq!(b.texels[1], Rgb::new(4.0, 5.0, 6.0));
+        assert!(read_pfm(b"PF\n2 1\n-1.0\n").is_err());
+        assert!(read_pfm(b"P6\n2 1\n255\n").is_err());
     }
 
     #[test]

@@ -46,6 +46,7 @@ fn camera() -> Camera {
 
 fn sphere_furnace() -> Scene {
     Scene::build(SceneInput {
+        environment: None,
         textures: Vec::new(),
         camera: camera(),
         materials: vec![furnace_material()],
@@ -96,6 +97,7 @@ fn cube_furnace() -> Scene {
         });
     }
     Scene::build(SceneInput {
+        environment: None,
         textures: Vec::new(),
         camera: camera(),
         materials: vec![furnace_material()],

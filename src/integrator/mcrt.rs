@@ -119,7 +119,8 @@ impl CameraEstimator for McRayTracer {
     ) -> Rgb {
         let seen_emission = pixel.seen_emission.filter(|_| self.exact_seen_emitters);
         let Some(hit) = scene.geometry.intersect(&ray) else {
-            return seen_emission.unwrap_or(Rgb::ZERO);
+            let background = scene.lights.environment().map_or(Rgb::ZERO, |e| e.le(ray.direction));
+            return seen_emission.unwrap_or(background);
         };
         let material = &scene.materials[hit.material as usize];
         let emitted = match seen_emission {
@@ -202,6 +203,17 @@ impl McRayTracer {
             let ray = hit.spawn_ray(wi_world);
             counts.bounce += 1;
             let Some(next) = scene.geometry.intersect(&ray) else {
+                if let Some(env) = scene.lights.environment() {
+                    let weight = if sample.specular || n_light == 0 {
+                        1.0
+                    } else if self.mis == MisHeuristic::None {
+                        0.0
+                    } else {
+                        let light_pdf = scene.lights.environment_pdf(wi_world);
+                        multi_sample_weight(self.mis, n_bsdf, sample.pdf, n_light, light_pdf)
+                    };
+                    radiance += sample.weight / n_bsdf as f32 * env.le(wi_world) * weight;
+                }
                 continue;
             };
             let beta = sample.weight / n_bsdf as f32;

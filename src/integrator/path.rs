@@ -284,6 +284,18 @@ impl PathTracer {
                 .intersect_maybe_among(&ray, candidates.take());
             let Some(hit) = hit else {
                 observer.escaped();
+                // Light from infinity, weighed against its light samples.
+                if let Some(env) = scene.lights.environment() {
+                    let weight = if specular_bounce || !self.nee {
+                        1.0
+                    } else if self.mis == MisHeuristic::None {
+                        0.0
+                    } else {
+                        let light_pdf = scene.lights.environment_pdf(ray.direction);
+                        self.mis.weight(prev_bsdf_pdf, light_pdf)
+                    };
+                    radiance += beta * env.le(ray.direction) * weight;
+                }
                 break;
             };
             observer.vertex(bounces, &hit, beta);

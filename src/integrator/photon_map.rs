@@ -395,6 +395,11 @@ pub fn camera_to_diffuse(
     let mut emitted = Rgb::ZERO;
     for _ in 0..=max_depth {
         let Some(hit) = scene.geometry.intersect(&ray) else {
+            // Seen directly or through Dirac surfaces only: no photon
+            // stands for it.
+            if let Some(env) = scene.lights.environment() {
+                emitted += beta * env.le(ray.direction);
+            }
             break;
         };
         let material = &scene.materials[hit.material as usize];

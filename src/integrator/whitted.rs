@@ -108,7 +108,9 @@ impl CameraEstimator for WhittedTracer {
 impl WhittedTracer {
     fn trace(&self, scene: &Scene, ray: Ray, depth: u32, counts: &mut RayCounts) -> Rgb {
         let Some(hit) = scene.geometry.intersect(&ray) else {
-            return Rgb::ZERO;
+            // The environment as a background; it lights nothing (no point
+            // stands for it).
+            return scene.lights.environment().map_or(Rgb::ZERO, |e| e.le(ray.direction));
         };
         let wo_world = -ray.direction;
         let material = &scene.materials[hit.material as usize];

@@ -134,6 +134,18 @@ impl Session {
     /// Refuses, before allocating, a render whose film would not fit in
     /// the memory available ([`Session::memory_estimate`]).
     pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Result<Session> {
+        if scene.lights.environment().is_some()
+            && matches!(
+                settings.integrator.kind(),
+                IntegratorKind::Bdpt | IntegratorKind::Vcm
+            )
+        {
+            return Err(Error::new(format!(
+                "{} does not handle environment light yet (its MIS needs densities for light \
+                 from infinity): use path, light, mcrt or photon mapping",
+                settings.integrator.name()
+            )));
+        }
         let needed = Session::memory_estimate(&scene, &settings);
         if let Some(available) = available_memory()
             && needed > available

@@ -5,6 +5,7 @@
 
 pub mod alias;
 pub mod hash;
+pub mod piecewise;
 pub mod sampler;
 pub mod spherical_triangle;
 pub mod warp;

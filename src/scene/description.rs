@@ -67,6 +67,7 @@ pub struct SceneFile {
     pub materials: BTreeMap<String, Spanned<MaterialDesc>>,
     #[serde(default)]
     pub textures: BTreeMap<String, Spanned<TextureDesc>>,
+    pub environment: Option<Spanned<EnvironmentDesc>>,
     #[serde(default)]
     pub lights: LightOptions,
 }
@@ -91,6 +92,23 @@ pub struct TextureDesc {
     /// uv · uv_scale + uv_offset (Mitsuba's `to_uv`).
     pub uv_scale: Option<[f32; 2]>,
     pub uv_offset: Option<[f32; 2]>,
+}
+
+/// `[environment]`: light from infinity (Mitsuba's `constant` and `envmap`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDesc {
+    /// "constant" or "envmap".
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// constant: the radiance from every direction (Mitsuba: 1).
+    pub radiance: Option<[f32; 3]>,
+    /// envmap: a lat-long image (EXR, HDR, PFM or any bitmap), relative to the scene.
+    pub file: Option<String>,
+    /// envmap: a factor on the map (Mitsuba's `scale`).
+    pub scale: Option<f32>,
+    /// envmap: rotation to world, degrees about x, y, z (applied z, y, x).
+    pub rotate: Option<[f32; 3]>,
 }
 
 /// Kinds of texture.

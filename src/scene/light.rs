@@ -6,6 +6,8 @@
 //! solid angle they subtend. All densities are returned wrt. solid angle at
 //! the shading point, so the integrators can combine them with BSDF densities.
 
+use super::environment::Environment;
+use std::sync::Arc;
 use crate::math::{Frame, OffsetMode, Rgb, gamma, luminance};
 use crate::sampling::warp::{
     cosine_hemisphere_pdf, square_to_cosine_hemisphere, square_to_uniform_cone,
@@ -564,6 +566,8 @@ impl Light {
 #[derive(Clone, Debug, Default)]
 pub struct Lights {
     lights: Vec<Light>,
+    /// Light from infinitely far away; its light id is `lights.len()`.
+    environment: Option<Arc<Environment>>,
     selection: Option<AliasTable>,
     /// How shadow rays stop short of sampled light points.
     offset: OffsetMode,
@@ -572,12 +576,43 @@ pub struct Lights {
 impl Lights {
     /// Builds the selection table. Lights of zero power can never be chosen.
     pub fn new(lights: Vec<Light>) -> Self {
-        let powers: Vec<f32> = lights.iter().map(Light::power).collect();
+        Self::with_environment(lights, None)
+    }
+
+    /// Lights and an environment, chosen in proportion to their power.
+    pub fn with_environment(lights: Vec<Light>, environment: Option<Environment>) -> Self {
+        let mut powers: Vec<f32> = lights.iter().map(Light::power).collect();
+        if let Some(env) = &environment {
+            powers.push(env.power());
+        }
         let selection = AliasTable::new(&powers);
         Lights {
             lights,
+            environment: environment.map(Arc::new),
             selection,
             offset: OffsetMode::Robust,
+        }
+    }
+
+    /// The environment, if the scene has one.
+    #[inline]
+    pub fn environment(&self) -> Option<&Environment> {
+        self.environment.as_deref()
+    }
+
+    /// The light id of the environment.
+    #[inline]
+    pub fn environment_id(&self) -> u32 {
+        self.lights.len() as u32
+    }
+
+    /// Density (solid angle, including selection) with which
+    /// [`Lights::sample`] picks direction `d` on the environment.
+    #[inline]
+    pub fn environment_pdf(&self, d: Vec3A) -> f32 {
+        match (&self.environment, &self.selection) {
+            (Some(env), Some(table)) => table.pmf(self.lights.len()) * env.pdf(d),
+            _ => 0.0,
         }
     }
 
@@ -593,6 +628,7 @@ impl Lights {
         }
         Lights {
             lights,
+            environment: self.environment.clone(),
             selection: self.selection.clone(),
             offset: self.offset,
         }
@@ -616,7 +652,7 @@ impl Lights {
     /// True when sampling chooses between lights: with one light the
     /// choice's random number is not read, so callers may skip drawing it.
     pub fn has_choice(&self) -> bool {
-        self.lights.len() > 1
+        self.lights.len() + usize::from(self.environment.is_some()) > 1
     }
 
     /// Chooses a light with `u_select` and a point on it with `u`, for next-event
@@ -630,7 +666,10 @@ impl Lights {
         } else {
             (0, table.pmf(0))
         };
-        let mut s = self.lights[index].sample(reference, u)?;
+        let mut s = match self.lights.get(index) {
+            Some(light) => light.sample(reference, u)?,
+            None => self.environment.as_ref()?.sample_from(reference, u)?,
+        };
         s.pdf *= pmf;
         s.light = index as u32;
         s.error = self.offset.spawn_error(s.error, s.normal);
@@ -647,7 +686,10 @@ impl Lights {
     ) -> Option<EmissionSample> {
         let table = self.selection.as_ref()?;
         let (index, pmf) = table.sample(u_select);
-        let mut s = self.lights[index].sample_emission(u_position, u_direction)?;
+        let mut s = match self.lights.get(index) {
+            Some(light) => light.sample_emission(u_position, u_direction)?,
+            None => self.environment.as_ref()?.emission(u_position, u_direction)?,
+        };
         s.throughput /= pmf;
         s.error = self.offset.spawn_error(s.error, s.normal);
         s.pdf_position *= pmf;
@@ -660,6 +702,9 @@ impl Lights {
     /// `reference`. Used for the MIS weight of BSDF-sampled hits on lights.
     #[inline]
     pub fn pdf(&self, light: u32, reference: Vec3A, point: Vec3A, normal: Vec3A) -> f32 {
+        if light as usize >= self.lights.len() {
+            return self.environment_pdf((point - reference).normalize());
+        }
         match &self.selection {
             Some(table) => {
                 table.pmf(light as usize)
@@ -679,7 +724,17 @@ impl Lights {
             return (0.0, 0.0);
         };
         let pmf = table.pmf(light as usize);
-        let (area, two_sided) = match self.lights[light as usize] {
+        let Some(&emitter) = self.lights.get(light as usize) else {
+            // The environment: a point on its disc, a direction by its map.
+            return match &self.environment {
+                Some(env) => (
+                    pmf / (std::f32::consts::PI * env.radius * env.radius),
+                    env.pdf(-w),
+                ),
+                None => (0.0, 0.0),
+            };
+        };
+        let (area, two_sided) = match emitter {
             Light::Triangle(p) | Light::Parallelogram(p) => (p.area, p.two_sided),
             Light::Sphere {
                 radius, two_sided, ..
@@ -695,5 +750,46 @@ impl Lights {
             cos.max(0.0) * std::f32::consts::FRAC_1_PI
         };
         (pmf / area, pdf_direction)
+    }
+}
+
+impl Environment {
+    /// A light sample towards the environment from `reference`: a point
+    /// beyond the scene's bounding sphere in the sampled direction.
+    #[inline]
+    fn sample_from(&self, reference: Vec3A, u: Vec2) -> Option<LightSample> {
+        let (wi, radiance, pdf) = self.sample(u)?;
+        let distance = 2.0 * self.radius + (reference - self.center).length();
+        Some(LightSample {
+            point: reference + wi * distance,
+            error: Vec3A::ZERO,
+            normal: Vec3A::ZERO,
+            wi,
+            distance,
+            radiance,
+            pdf,
+            delta: false,
+            light: 0,
+        })
+    }
+
+    /// A particle from the environment (see [`Environment::sample_particle`]).
+    #[inline]
+    fn emission(&self, u_position: Vec2, u_direction: Vec2) -> Option<EmissionSample> {
+        let (point, direction, le, pdf_position, pdf_direction) =
+            self.sample_particle(u_position, u_direction)?;
+        Some(EmissionSample {
+            point,
+            error: Vec3A::ZERO,
+            normal: direction,
+            direction,
+            throughput: le / (pdf_position * pdf_direction),
+            // The disc is not a surface the camera could see.
+            emitted: Rgb::ZERO,
+            two_sided: false,
+            pdf_position,
+            pdf_direction,
+            light: 0,
+        })
     }
 }

@@ -15,6 +15,7 @@ use crate::error::{Error, Result, line_of};
 use crate::filter::PixelFilter;
 use crate::math::Rgb;
 use crate::scene::light::Light;
+use super::environment::{Environment, Radiance as EnvRadiance};
 use crate::texture::{Bitmap, Filter as TextureFilter, Texture, UvTransform, Wrap};
 use glam::{EulerRot, Mat4, Quat, Vec2, Vec3, Vec3A};
 use std::collections::HashMap;
@@ -246,7 +247,12 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         });
     }
 
+    let environment = match &file.environment {
+        None => None,
+        Some(e) => Some(build_environment(e.get_ref(), &dir).map_err(|m| at(e.span(), m))?),
+    };
     Ok(SceneInput {
+        environment,
         textures,
         camera,
         materials,
@@ -399,6 +405,46 @@ fn default_material() -> Material {
         emission: Rgb::ZERO,
         two_sided_emission: false,
         textures: Default::default(),
+    }
+}
+
+fn build_environment(d: &EnvironmentDesc, dir: &Path) -> std::result::Result<Environment, String> {
+    let scale = d.scale.unwrap_or(1.0);
+    if !(scale.is_finite() && scale >= 0.0) {
+        return Err(format!("environment: `scale` must be finite and >= 0, got {scale}"));
+    }
+    let rotate = d.rotate.unwrap_or([0.0; 3]);
+    if !rotate.iter().all(|x| x.is_finite()) {
+        return Err(format!("environment: `rotate` must be finite, got {rotate:?}"));
+    }
+    let to_world = glam::Mat3A::from_euler(
+        EulerRot::ZYX,
+        rotate[2].to_radians(),
+        rotate[1].to_radians(),
+        rotate[0].to_radians(),
+    );
+    match d.kind.as_str() {
+        "constant" => {
+            if d.file.is_some() || d.rotate.is_some() {
+                return Err("environment: a constant takes `radiance` and `scale` only".into());
+            }
+            let radiance = d.radiance.unwrap_or([1.0; 3]);
+            if !radiance.iter().all(|x| x.is_finite() && *x >= 0.0) {
+                return Err(format!("environment: `radiance` must be finite and >= 0, got {radiance:?}"));
+            }
+            Ok(Environment::new(EnvRadiance::Constant(Rgb::from(radiance)), scale, to_world))
+        }
+        "envmap" => {
+            if d.radiance.is_some() {
+                return Err("environment: an envmap takes `file`, `scale` and `rotate`".into());
+            }
+            let file = d.file.as_ref().ok_or("environment: an envmap needs `file`")?;
+            let map = Bitmap::read(&dir.join(file), false).map_err(|e| format!("environment: {e}"))?;
+            Ok(Environment::new(EnvRadiance::Map(std::sync::Arc::new(map)), scale, to_world))
+        }
+        other => Err(format!(
+            "environment: `type` must be \"constant\" or \"envmap\", got \"{other}\""
+        )),
     }
 }
 

@@ -3,6 +3,7 @@
 
 pub mod description;
 pub mod emitters;
+pub mod environment;
 pub mod light;
 pub mod load;
 pub mod material;
@@ -67,6 +68,8 @@ pub struct SceneInput {
     pub materials: Vec<Material>,
     /// Textures the materials read (see [`material::MaterialTextures`]).
     pub textures: Vec<Texture>,
+    /// Light from infinity, placed around the scene when it is built.
+    pub environment: Option<environment::Environment>,
     pub triangles: Vec<TriangleInput>,
     pub spheres: Vec<Sphere>,
     pub point_lights: Vec<Light>,
@@ -374,7 +377,18 @@ impl Scene {
             }
         }
         lights.extend(input.point_lights);
-        let lights = Lights::new(lights);
+        let environment = input.environment.map(|mut env| {
+            let b = geometry.bounds();
+            let (min, max) = (Vec3A::from(b.min), Vec3A::from(b.max));
+            let radius = if (max - min).is_finite() && max.cmpge(min).all() {
+                0.5 * (max - min).length()
+            } else {
+                1.0
+            };
+            env.bound(0.5 * (min + max), radius);
+            env
+        });
+        let lights = Lights::with_environment(lights, environment);
         if lights.is_empty() {
             warnings.push("the scene has no light source: the image will be black".into());
         }

@@ -1,0 +1,132 @@
+//! Piecewise-constant densities on [0, 1) and [0, 1)², sampled by
+//! inverting their CDFs (pbrt's Distribution1D / 2D): the environment
+//! map's importance sampling.
+
+use glam::Vec2;
+
+/// A density proportional to `func` over n equal cells of [0, 1).
+#[derive(Clone, Debug)]
+pub struct Piecewise1D {
+    func: Vec<f32>,
+    /// cdf[i] = ∫_0^{i/n} f / ∫_0^1 f; n + 1 entries.
+    cdf: Vec<f32>,
+    /// ∫_0^1 func.
+    pub integral: f32,
+}
+
+impl Piecewise1D {
+    /// The density of `func` (non-negative; all zero gives the uniform one).
+    pub fn new(func: &[f32]) -> Piecewise1D {
+        let n = func.len().max(1);
+        let mut cdf = vec![0.0f64; n + 1];
+        for i in 0..n {
+            cdf[i + 1] = cdf[i] + func.get(i).copied().unwrap_or(0.0).max(0.0) as f64 / n as f64;
+        }
+        let integral = cdf[n];
+        let cdf: Vec<f32> = if integral > 0.0 {
+            cdf.iter().map(|c| (c / integral) as f32).collect()
+        } else {
+            (0..=n).map(|i| i as f32 / n as f32).collect()
+        };
+        let func = if integral > 0.0 {
+            func.iter().map(|f| f.max(0.0)).collect()
+        } else {
+            vec![1.0; n]
+        };
+        Piecewise1D {
+            func,
+            cdf,
+            integral: if integral > 0.0 { integral as f32 } else { 1.0 },
+        }
+    }
+
+    /// Cells.
+    pub fn len(&self) -> usize {
+        self.func.len()
+    }
+
+    /// True for no cells (never: `new` makes at least one).
+    pub fn is_empty(&self) -> bool {
+        self.func.is_empty()
+    }
+
+    /// A point x with its density and cell.
+    #[inline]
+    pub fn sample(&self, u: f32) -> (f32, f32, usize) {
+        // The last cell whose cdf start is <= u.
+        let i = self.cdf.partition_point(|&c| c <= u).clamp(1, self.func.len()) - 1;
+        let width = self.cdf[i + 1] - self.cdf[i];
+        let t = if width > 0.0 { ((u - self.cdf[i]) / width).clamp(0.0, 1.0) } else { 0.5 };
+        let n = self.func.len() as f32;
+        let x = ((i as f32 + t) / n).min(1.0 - f32::EPSILON);
+        (x, self.func[i] / self.integral, i)
+    }
+
+    /// The density at x.
+    #[inline]
+    pub fn pdf(&self, x: f32) -> f32 {
+        let i = ((x * self.func.len() as f32) as usize).min(self.func.len() - 1);
+        self.func[i] / self.integral
+    }
+}
+
+/// A density over [0, 1)² proportional to `func` on a `width` × `height`
+/// grid (rows top to bottom): a marginal over rows, a conditional per row.
+#[derive(Clone, Debug)]
+pub struct Piecewise2D {
+    rows: Vec<Piecewise1D>,
+    marginal: Piecewise1D,
+}
+
+impl Piecewise2D {
+    pub fn new(func: &[f32], width: usize, height: usize) -> Piecewise2D {
+        let rows: Vec<Piecewise1D> = (0..height)
+            .map(|y| Piecewise1D::new(&func[y * width..(y + 1) * width]))
+            .collect();
+        let marginal = Piecewise1D::new(&rows.iter().map(|r| r.integral).collect::<Vec<_>>());
+        Piecewise2D { rows, marginal }
+    }
+
+    /// A point (x, y) and its density.
+    #[inline]
+    pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
+        let (y, pdf_y, row) = self.marginal.sample(u.y);
+        let (x, pdf_x, _) = self.rows[row].sample(u.x);
+        (Vec2::new(x, y), pdf_x * pdf_y)
+    }
+
+    /// The density at `p`.
+    #[inline]
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        let row = ((p.y * self.rows.len() as f32) as usize).min(self.rows.len() - 1);
+        self.marginal.pdf(p.y) * self.rows[row].pdf(p.x)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_follow_the_density() {
+        let d = Piecewise1D::new(&[1.0, 0.0, 3.0, 4.0]);
+        assert_eq!(d.pdf(0.3), 0.0);
+        assert!((d.pdf(0.9) - 4.0 / 2.0).abs() < 1e-6);
+        let (x, pdf, i) = d.sample(0.4);
+        assert_eq!(i, 2);
+        assert!((x - (0.5 + 0.25 * (0.4 - 0.125) / 0.375)).abs() < 1e-5);
+        assert!((pdf - 1.5).abs() < 1e-6);
+        // A 2D density integrates to one over its cells.
+        let f = [1.0, 2.0, 0.0, 5.0, 1.0, 1.0];
+        let d2 = Piecewise2D::new(&f, 3, 2);
+        let mut total = 0.0;
+        for y in 0..2 {
+            for x in 0..3 {
+                total += d2.pdf(Vec2::new((x as f32 + 0.5) / 3.0, (y as f32 + 0.5) / 2.0)) / 6.0;
+            }
+        }
+        assert!((total - 1.0).abs() < 1e-5);
+        let (p, pdf) = d2.sample(Vec2::new(0.3, 0.7));
+        assert!((pdf - d2.pdf(p)).abs() < 1e-5);
+    }
+}

@@ -1,0 +1,191 @@
+//! Light from infinitely far away: a constant environment or a lat-long
+//! environment map (Mitsuba's `constant` and `envmap`), with a to-world
+//! rotation and a scale. Maps are importance-sampled by a piecewise-
+//! constant density of luminance × sin θ over their texels (each texel's
+//! weight the largest of its 3 × 3 neighbourhood, so that no direction the
+//! bilinear lookup lights has density zero); the density in solid angle is
+//! p(u, v) / (2π² sin θ). Light paths start on a disc of the scene's
+//! bounding radius facing the sampled direction.
+
+use crate::math::{Frame, Rgb, luminance};
+use crate::sampling::piecewise::Piecewise2D;
+use crate::sampling::warp::{square_to_concentric_disk, square_to_uniform_sphere};
+use crate::texture::{Bitmap, Filter, Wrap};
+use glam::{Mat3A, Vec2, Vec3A};
+use std::f32::consts::PI;
+use std::sync::Arc;
+
+/// What the environment shows.
+#[derive(Clone, Debug)]
+pub enum Radiance {
+    Constant(Rgb),
+    /// Lat-long: u = φ / 2π with φ measured from −z towards +x, v = θ / π
+    /// from +y (Mitsuba's envmap convention), row 0 at the top.
+    Map(Arc<Bitmap>),
+}
+
+/// An environment light.
+#[derive(Clone, Debug)]
+pub struct Environment {
+    pub radiance: Radiance,
+    pub scale: f32,
+    to_world: Mat3A,
+    to_local: Mat3A,
+    distribution: Option<Piecewise2D>,
+    /// The scene's bounding sphere (set by [`Environment::bound`]).
+    pub center: Vec3A,
+    pub radius: f32,
+}
+
+impl Environment {
+    /// An environment of `radiance` × `scale`, rotated by `to_world`.
+    pub fn new(radiance: Radiance, scale: f32, to_world: Mat3A) -> Environment {
+        let distribution = match &radiance {
+            Radiance::Constant(_) => None,
+            Radiance::Map(map) => {
+                let (w, h) = (map.width, map.height);
+                let mut weights = vec![0.0f32; w * h];
+                for y in 0..h {
+                    let sin_theta = ((y as f32 + 0.5) / h as f32 * PI).sin();
+                    for x in 0..w {
+                        let mut m = 0.0f32;
+                        for dy in -1i64..=1 {
+                            let yy = (y as i64 + dy).clamp(0, h as i64 - 1) as usize;
+                            for dx in -1i64..=1 {
+                                let xx = (x as i64 + dx).rem_euclid(w as i64) as usize;
+                                m = m.max(luminance(map.texels[yy * w + xx]));
+                            }
+                        }
+                        weights[y * w + x] = m * sin_theta;
+                    }
+                }
+                Some(Piecewise2D::new(&weights, w, h))
+            }
+        };
+        Environment {
+            radiance,
+            scale,
+            to_world,
+            to_local: to_world.transpose(),
+            distribution,
+            center: Vec3A::ZERO,
+            radius: 1.0,
+        }
+    }
+
+    /// Places the environment around a scene bounded by the given sphere.
+    pub fn bound(&mut self, center: Vec3A, radius: f32) {
+        self.center = center;
+        self.radius = radius.max(1e-3);
+    }
+
+    /// Radiance arriving from direction `d` (unit, pointing away from the scene).
+    #[inline]
+    pub fn le(&self, d: Vec3A) -> Rgb {
+        match &self.radiance {
+            Radiance::Constant(c) => *c * self.scale,
+            Radiance::Map(map) => {
+                let uv = direction_to_uv(self.to_local * d);
+                map.lookup(uv, Wrap::Repeat, Filter::Bilinear) * self.scale
+            }
+        }
+    }
+
+    /// A direction with its radiance and density in solid angle.
+    #[inline]
+    pub fn sample(&self, u: Vec2) -> Option<(Vec3A, Rgb, f32)> {
+        let Some(distribution) = &self.distribution else {
+            let d = square_to_uniform_sphere(u);
+            return Some((d, self.le(d), 1.0 / (4.0 * PI)));
+        };
+        let (uv, pdf_uv) = distribution.sample(u);
+        let local = uv_to_direction(uv);
+        let sin_theta = (uv.y * PI).sin();
+        if pdf_uv <= 0.0 || sin_theta <= 0.0 {
+            return None;
+        }
+        let d = (self.to_world * local).normalize();
+        Some((d, self.le(d), pdf_uv / (2.0 * PI * PI * sin_theta)))
+    }
+
+    /// Density of [`Environment::sample`] at direction `d`.
+    #[inline]
+    pub fn pdf(&self, d: Vec3A) -> f32 {
+        let Some(distribution) = &self.distribution else {
+            return 1.0 / (4.0 * PI);
+        };
+        let uv = direction_to_uv(self.to_local * d);
+        let sin_theta = (uv.y * PI).sin();
+        if sin_theta <= 0.0 {
+            return 0.0;
+        }
+        distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)
+    }
+
+    /// Power, for choosing between lights: π R² ∫ luminance(L) dω.
+    pub fn power(&self) -> f32 {
+        let mean = match &self.radiance {
+            Radiance::Constant(c) => luminance(*c) * 4.0 * PI,
+            Radiance::Map(map) => {
+                // ∫ L dω over the texels' solid angles.
+                let (w, h) = (map.width, map.height);
+                let mut sum = 0.0f64;
+                for y in 0..h {
+                    let sin_theta = ((y as f32 + 0.5) / h as f32 * PI).sin() as f64;
+                    for x in 0..w {
+                        sum += luminance(map.texels[y * w + x]) as f64 * sin_theta;
+                    }
+                }
+                (sum * 2.0 * PI as f64 * PI as f64 / (w * h) as f64) as f32
+            }
+        };
+        mean * self.scale * PI * self.radius * self.radius
+    }
+
+    /// A particle entering the scene: a direction `d` towards the
+    /// environment and a point on the disc of the bounding radius facing
+    /// it, outside the bounding sphere. Returns (point, travel direction,
+    /// radiance, density of the point on the disc, density of d).
+    #[inline]
+    pub fn sample_particle(&self, u_position: Vec2, u_direction: Vec2) -> Option<(Vec3A, Vec3A, Rgb, f32, f32)> {
+        let (d, le, pdf_direction) = self.sample(u_direction)?;
+        let disk = square_to_concentric_disk(u_position) * self.radius;
+        let frame = Frame::from_normal(d);
+        let point = self.center + self.radius * d + frame.s * disk.x + frame.t * disk.y;
+        let pdf_position = 1.0 / (PI * self.radius * self.radius);
+        Some((point, -d, le, pdf_position, pdf_direction))
+    }
+}
+
+/// Mitsuba's lat-long coordinates of a local direction.
+#[inline]
+pub fn direction_to_uv(v: Vec3A) -> Vec2 {
+    let u = v.x.atan2(-v.z) * (0.5 / PI);
+    let u = u - u.floor();
+    let theta = v.y.clamp(-1.0, 1.0).acos();
+    Vec2::new(u, theta / PI)
+}
+
+/// The local direction of lat-long coordinates.
+#[inline]
+pub fn uv_to_direction(uv: Vec2) -> Vec3A {
+    let (sin_theta, cos_theta) = (uv.y * PI).sin_cos();
+    let (sin_phi, cos_phi) = (uv.x * 2.0 * PI).sin_cos();
+    Vec3A::new(sin_theta * sin_phi, cos_theta, -sin_theta * cos_phi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lat_long_coordinates_round_trip() {
+        for uv in [Vec2::new(0.1, 0.3), Vec2::new(0.7, 0.9), Vec2::new(0.5, 0.5)] {
+            let back = direction_to_uv(uv_to_direction(uv));
+            assert!((back - uv).abs().max_element() < 1e-5, "{uv} -> {back}");
+        }
+        // Mitsuba: up is +y, u = 0 looks along -z.
+        assert!((uv_to_direction(Vec2::new(0.0, 0.5)) - Vec3A::NEG_Z).length() < 1e-6);
+        assert!((uv_to_direction(Vec2::new(0.25, 0.5)) - Vec3A::X).length() < 1e-6);
+    }
+}
