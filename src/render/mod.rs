@@ -137,7 +137,7 @@ impl Session {
         if scene.lights.environment().is_some()
             && matches!(
                 settings.integrator.kind(),
-                IntegratorKind::Bdpt | IntegratorKind::Vcm
+                crate::integrator::IntegratorKind::Bdpt | crate::integrator::IntegratorKind::Vcm
             )
         {
             return Err(Error::new(format!(
