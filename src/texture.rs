@@ -108,7 +108,10 @@ impl Bitmap {
     /// 16-bit colour is sRGB-decoded unless `raw` (data such as roughness);
     /// float images (EXR, HDR) are linear. Non-finite texels become 0.
     pub fn read(path: &Path, raw: bool) -> Result<Bitmap, String> {
-        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("pfm")) {
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("pfm"))
+        {
             let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
             return read_pfm(&bytes).map_err(|e| format!("{}: {e}", path.display()));
         }
@@ -203,9 +206,14 @@ pub fn read_pfm(bytes: &[u8]) -> Result<Bitmap, String> {
         "Pf" => 1,
         m => return Err(format!("not a PFM file (magic {m:?})")),
     };
-    let parse = |t: &str| t.parse::<usize>().map_err(|_| format!("bad PFM size {t:?}"));
+    let parse = |t: &str| {
+        t.parse::<usize>()
+            .map_err(|_| format!("bad PFM size {t:?}"))
+    };
     let (width, height) = (parse(&tokens[1])?, parse(&tokens[2])?);
-    let scale: f32 = tokens[3].parse().map_err(|_| format!("bad PFM scale {:?}", tokens[3]))?;
+    let scale: f32 = tokens[3]
+        .parse()
+        .map_err(|_| format!("bad PFM scale {:?}", tokens[3]))?;
     let count = width
         .checked_mul(height)
         .and_then(|n| n.checked_mul(channels))
@@ -213,8 +221,17 @@ pub fn read_pfm(bytes: &[u8]) -> Result<Bitmap, String> {
         .ok_or_else(|| format!("PFM size {width}x{height} is empty or too large"))?;
     let data = bytes.get(at..at + 4 * count).ok_or("truncated PFM data")?;
     let value = |i: usize| {
-        let b = [data[4 * i], data[4 * i + 1], data[4 * i + 2], data[4 * i + 3]];
-        let v = if scale < 0.0 { f32::from_le_bytes(b) } else { f32::from_be_bytes(b) };
+        let b = [
+            data[4 * i],
+            data[4 * i + 1],
+            data[4 * i + 2],
+            data[4 * i + 3],
+        ];
+        let v = if scale < 0.0 {
+            f32::from_le_bytes(b)
+        } else {
+            f32::from_be_bytes(b)
+        };
         if v.is_finite() { v.max(0.0) } else { 0.0 }
     };
     let mut texels = vec![Rgb::ZERO; width * height];

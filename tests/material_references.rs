@@ -268,3 +268,25 @@ fn textures_match_mitsuba() {
         "textured_diffuse: RMSE {ratio:.3} times its expected value"
     );
 }
+
+/// A constant environment and an environment map (tests/data/materials/
+/// sky.exr, with a small sun) beside the area light, as Mitsuba's
+/// `constant` and `envmap`: the map's orientation, its texel placement and
+/// its importance sampling combined with BSDF sampling by MIS.
+#[test]
+fn environments_match_mitsuba() {
+    let constant = material_scene("type = \"diffuse\"\nalbedo = [0.6, 0.6, 0.6]", SPHERE)
+        + "\n[environment]\ntype = \"constant\"\nradiance = [0.3, 0.35, 0.4]\n";
+    let ratio = check_scene("environment_constant", &constant);
+    assert!(ratio <= 1.10, "environment_constant: RMSE ratio {ratio:.3}");
+    let sky = crate::common::repo_path("tests/data/materials/sky.exr");
+    let map = material_scene(
+        "type = \"roughconductor\"\nconductor = \"Cu\"\ndistribution = \"ggx\"\nalpha = 0.2",
+        SPHERE,
+    ) + &format!(
+        "\n[environment]\ntype = \"envmap\"\nfile = {:?}\nscale = 0.5\n",
+        sky.display().to_string()
+    );
+    let ratio = check_scene("environment_map", &map);
+    assert!(ratio <= 1.10, "environment_map: RMSE ratio {ratio:.3}");
+}

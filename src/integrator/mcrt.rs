@@ -119,7 +119,10 @@ impl CameraEstimator for McRayTracer {
     ) -> Rgb {
         let seen_emission = pixel.seen_emission.filter(|_| self.exact_seen_emitters);
         let Some(hit) = scene.geometry.intersect(&ray) else {
-            let background = scene.lights.environment().map_or(Rgb::ZERO, |e| e.le(ray.direction));
+            let background = scene
+                .lights
+                .environment()
+                .map_or(Rgb::ZERO, |e| e.le(ray.direction));
             return seen_emission.unwrap_or(background);
         };
         let material = &scene.materials[hit.material as usize];

@@ -110,7 +110,10 @@ impl WhittedTracer {
         let Some(hit) = scene.geometry.intersect(&ray) else {
             // The environment as a background; it lights nothing (no point
             // stands for it).
-            return scene.lights.environment().map_or(Rgb::ZERO, |e| e.le(ray.direction));
+            return scene
+                .lights
+                .environment()
+                .map_or(Rgb::ZERO, |e| e.le(ray.direction));
         };
         let wo_world = -ray.direction;
         let material = &scene.materials[hit.material as usize];

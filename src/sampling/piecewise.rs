@@ -54,9 +54,17 @@ impl Piecewise1D {
     #[inline]
     pub fn sample(&self, u: f32) -> (f32, f32, usize) {
         // The last cell whose cdf start is <= u.
-        let i = self.cdf.partition_point(|&c| c <= u).clamp(1, self.func.len()) - 1;
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .clamp(1, self.func.len())
+            - 1;
         let width = self.cdf[i + 1] - self.cdf[i];
-        let t = if width > 0.0 { ((u - self.cdf[i]) / width).clamp(0.0, 1.0) } else { 0.5 };
+        let t = if width > 0.0 {
+            ((u - self.cdf[i]) / width).clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
         let n = self.func.len() as f32;
         let x = ((i as f32 + t) / n).min(1.0 - f32::EPSILON);
         (x, self.func[i] / self.integral, i)

@@ -7,7 +7,6 @@
 //! the shading point, so the integrators can combine them with BSDF densities.
 
 use super::environment::Environment;
-use std::sync::Arc;
 use crate::math::{Frame, OffsetMode, Rgb, gamma, luminance};
 use crate::sampling::warp::{
     cosine_hemisphere_pdf, square_to_cosine_hemisphere, square_to_uniform_cone,
@@ -16,6 +15,7 @@ use crate::sampling::warp::{
 use crate::sampling::{AliasTable, spherical_triangle};
 use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 /// How points on area lights are chosen for next-event estimation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
@@ -688,7 +688,10 @@ impl Lights {
         let (index, pmf) = table.sample(u_select);
         let mut s = match self.lights.get(index) {
             Some(light) => light.sample_emission(u_position, u_direction)?,
-            None => self.environment.as_ref()?.emission(u_position, u_direction)?,
+            None => self
+                .environment
+                .as_ref()?
+                .emission(u_position, u_direction)?,
         };
         s.throughput /= pmf;
         s.error = self.offset.spawn_error(s.error, s.normal);

@@ -2,6 +2,7 @@
 //! scene file and the line of the entry at fault (or the OBJ/MTL file and line).
 
 use super::description::*;
+use super::environment::{Environment, Radiance as EnvRadiance};
 use super::material::{Bsdf, Material, MaterialTextures};
 use super::obj::load_obj;
 use super::{Limits, MAX_COORDINATE, MovingInput, SceneInput, in_range};
@@ -15,7 +16,6 @@ use crate::error::{Error, Result, line_of};
 use crate::filter::PixelFilter;
 use crate::math::Rgb;
 use crate::scene::light::Light;
-use super::environment::{Environment, Radiance as EnvRadiance};
 use crate::texture::{Bitmap, Filter as TextureFilter, Texture, UvTransform, Wrap};
 use glam::{EulerRot, Mat4, Quat, Vec2, Vec3, Vec3A};
 use std::collections::HashMap;
@@ -411,11 +411,15 @@ fn default_material() -> Material {
 fn build_environment(d: &EnvironmentDesc, dir: &Path) -> std::result::Result<Environment, String> {
     let scale = d.scale.unwrap_or(1.0);
     if !(scale.is_finite() && scale >= 0.0) {
-        return Err(format!("environment: `scale` must be finite and >= 0, got {scale}"));
+        return Err(format!(
+            "environment: `scale` must be finite and >= 0, got {scale}"
+        ));
     }
     let rotate = d.rotate.unwrap_or([0.0; 3]);
     if !rotate.iter().all(|x| x.is_finite()) {
-        return Err(format!("environment: `rotate` must be finite, got {rotate:?}"));
+        return Err(format!(
+            "environment: `rotate` must be finite, got {rotate:?}"
+        ));
     }
     let to_world = glam::Mat3A::from_euler(
         EulerRot::ZYX,
@@ -430,17 +434,31 @@ fn build_environment(d: &EnvironmentDesc, dir: &Path) -> std::result::Result<Env
             }
             let radiance = d.radiance.unwrap_or([1.0; 3]);
             if !radiance.iter().all(|x| x.is_finite() && *x >= 0.0) {
-                return Err(format!("environment: `radiance` must be finite and >= 0, got {radiance:?}"));
+                return Err(format!(
+                    "environment: `radiance` must be finite and >= 0, got {radiance:?}"
+                ));
             }
-            Ok(Environment::new(EnvRadiance::Constant(Rgb::from(radiance)), scale, to_world))
+            Ok(Environment::new(
+                EnvRadiance::Constant(Rgb::from(radiance)),
+                scale,
+                to_world,
+            ))
         }
         "envmap" => {
             if d.radiance.is_some() {
                 return Err("environment: an envmap takes `file`, `scale` and `rotate`".into());
             }
-            let file = d.file.as_ref().ok_or("environment: an envmap needs `file`")?;
-            let map = Bitmap::read(&dir.join(file), false).map_err(|e| format!("environment: {e}"))?;
-            Ok(Environment::new(EnvRadiance::Map(std::sync::Arc::new(map)), scale, to_world))
+            let file = d
+                .file
+                .as_ref()
+                .ok_or("environment: an envmap needs `file`")?;
+            let map =
+                Bitmap::read(&dir.join(file), false).map_err(|e| format!("environment: {e}"))?;
+            Ok(Environment::new(
+                EnvRadiance::Map(std::sync::Arc::new(map)),
+                scale,
+                to_world,
+            ))
         }
         other => Err(format!(
             "environment: `type` must be \"constant\" or \"envmap\", got \"{other}\""

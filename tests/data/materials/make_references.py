@@ -86,7 +86,22 @@ TEXTURED = {
 }
 
 
-def scene(obj, rfilter=None, floor_bsdf=None):
+# Light from infinity, beside the area light: a constant environment, and a
+# synthetic sky (sky.exr, 64 x 32: a blue gradient, brown ground and a
+# 3 x 2-texel sun of radiance 800) lighting a copper sphere.
+ENVIRONMENTS = {
+    "environment_constant": (
+        sphere({"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.6, 0.6, 0.6]}}),
+        {"type": "constant", "radiance": {"type": "rgb", "value": [0.3, 0.35, 0.4]}},
+    ),
+    "environment_map": (
+        sphere({"type": "roughconductor", "material": "Cu", "distribution": "ggx", "alpha": 0.2}),
+        {"type": "envmap", "filename": "sky.exr", "scale": 0.5},
+    ),
+}
+
+
+def scene(obj, rfilter=None, floor_bsdf=None, environment=None):
     return {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": MAX_DEPTH, "rr_depth": 5},
@@ -112,17 +127,20 @@ def scene(obj, rfilter=None, floor_bsdf=None):
             "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [3, 3, 3]}},
         },
         "object": obj,
+        **({"environment": environment} if environment else {}),
     }
 
 
 def main(names):
     jobs = {name: (obj, None, None) for name, obj in MATERIALS.items()}
     jobs |= {name: (obj, rfilter, None) for name, (obj, rfilter) in FILTERS.items()}
-    jobs |= {name: (obj, None, floor) for name, (obj, floor) in TEXTURED.items()}
-    for name, (obj, rfilter, floor) in jobs.items():
+    jobs = {name: (obj, rfilter, floor, None) for name, (obj, rfilter, floor) in jobs.items()}
+    jobs |= {name: (obj, None, floor, None) for name, (obj, floor) in TEXTURED.items()}
+    jobs |= {name: (obj, None, None, env) for name, (obj, env) in ENVIRONMENTS.items()}
+    for name, (obj, rfilter, floor, env) in jobs.items():
         if names and name not in names:
             continue
-        s = mi.load_dict(scene(obj, rfilter, floor))
+        s = mi.load_dict(scene(obj, rfilter, floor, env))
         passes = np.stack([np.array(mi.render(s, seed=1000 * k + 7)) for k in range(PASSES)])
         mean = passes.mean(axis=0)
         var = passes.var(axis=0, ddof=1) / PASSES
