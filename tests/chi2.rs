@@ -25,7 +25,7 @@ use tracelab::scene::light::{Light, LightSampling, Lights, PlanarEmitter};
 use tracelab::scene::material::{Bsdf, fresnel_dielectric};
 
 /// Number of `assert_fits` calls below (the significance is split over them).
-const TESTS_IN_FILE: f64 = 63.0;
+const TESTS_IN_FILE: f64 = 65.0;
 const SAMPLES: u64 = 500_000;
 
 /// Uniform numbers for test `seed`, sample `i`.
@@ -749,6 +749,44 @@ fn thin_dielectric_chooses_reflection_with_the_slab_reflectance() {
             &format!("thin dielectric at {theta} deg"),
             &observed,
             &[n * expected_r, n * (1.0 - expected_r)],
+        );
+    }
+}
+
+/// The environment map's importance sampling against its density, on the
+/// test sky (a gradient, a ground and a small sun 800 times brighter), at
+/// two rotations.
+#[test]
+fn environment_map_sampling() {
+    use tracelab::scene::environment::{Environment, Radiance};
+    use tracelab::texture::Bitmap;
+    let sky = Bitmap::read(
+        &crate::common::repo_path("tests/data/materials/sky.exr"),
+        false,
+    )
+    .unwrap();
+    let sky = std::sync::Arc::new(sky);
+    for (k, to_world) in [
+        glam::Mat3A::IDENTITY,
+        glam::Mat3A::from_rotation_x(1.1) * glam::Mat3A::from_rotation_z(0.4),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let env = Environment::new(Radiance::Map(sky.clone()), 1.0, to_world);
+        let seed = 700 + k as u64;
+        check_directions(
+            &format!("environment map, rotation {k}"),
+            |i| {
+                let (d, _, pdf) = env.sample(Vec2::new(uniform(seed, i, 0), uniform(seed, i, 1)))?;
+                assert!(
+                    (pdf - env.pdf(d)).abs() <= 1e-3 * pdf.max(1.0),
+                    "sample pdf {pdf} vs pdf() {}",
+                    env.pdf(d)
+                );
+                Some(d)
+            },
+            |d| env.pdf(d) as f64,
         );
     }
 }

@@ -206,3 +206,42 @@ fn bidirectional_techniques_agree_with_path_tracing_on_every_material() {
         &path,
     );
 }
+
+/// Importance sampling of an environment map: the irradiance of an upward
+/// plane under the test sky (its sun 800 times the sky) estimated from the
+/// map's density and from uniform directions, at equal sample counts. Both
+/// means agree within 4 standard errors; the variance falls by more than
+/// 10x (per sample; the cost per sample is measured in docs/performance.md).
+#[test]
+fn environment_importance_sampling_cuts_the_variance() {
+    use tracelab::scene::environment::{Environment, Radiance};
+    use tracelab::texture::Bitmap;
+    let sky = std::sync::Arc::new(
+        Bitmap::read(&repo_path("tests/data/materials/sky.exr"), false).unwrap(),
+    );
+    let importance = Environment::new(Radiance::Map(sky), 1.0, glam::Mat3A::IDENTITY);
+    let uniform = importance.clone().with_uniform_sampling();
+    let n = 200_000u64;
+    let estimate = |env: &Environment, seed: u64| {
+        let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+        for i in 0..n {
+            let u = glam::Vec2::new(
+                tracelab::sampling::hash::to_unit_float(tracelab::sampling::hash::hash_combine(seed, 2 * i)),
+                tracelab::sampling::hash::to_unit_float(tracelab::sampling::hash::hash_combine(seed, 2 * i + 1)),
+            );
+            let x = env.sample(u).map_or(0.0, |(d, le, pdf)| {
+                (le.x * d.y.max(0.0) / pdf) as f64
+            });
+            sum += x;
+            sum_sq += x * x;
+        }
+        let mean = sum / n as f64;
+        (mean, (sum_sq / n as f64 - mean * mean).max(0.0))
+    };
+    let (m_i, v_i) = estimate(&importance, 1);
+    let (m_u, v_u) = estimate(&uniform, 2);
+    eprintln!("irradiance: importance {m_i:.3} (var {v_i:.3e}), uniform {m_u:.3} (var {v_u:.3e}), ratio {:.1}", v_u / v_i);
+    let se = ((v_i + v_u) / n as f64).sqrt();
+    assert!((m_i - m_u).abs() < 4.0 * se, "means {m_i} and {m_u} differ");
+    assert!(v_u > 10.0 * v_i, "variance only {:.1}x lower", v_u / v_i);
+}

@@ -73,6 +73,13 @@ impl Environment {
         }
     }
 
+    /// The same environment sampled uniformly over the sphere: the
+    /// baseline that importance sampling is measured against.
+    pub fn with_uniform_sampling(mut self) -> Environment {
+        self.distribution = None;
+        self
+    }
+
     /// Places the environment around a scene bounded by the given sphere.
     pub fn bound(&mut self, center: Vec3A, radius: f32) {
         self.center = center;
@@ -105,7 +112,10 @@ impl Environment {
             return None;
         }
         let d = (self.to_world * local).normalize();
-        Some((d, self.le(d), pdf_uv / (2.0 * PI * PI * sin_theta)))
+        // The density read back from the direction, as MIS reads it: at a
+        // cell's edge rounding may move the direction into its neighbour.
+        let pdf = self.pdf(d);
+        (pdf > 0.0).then(|| (d, self.le(d), pdf))
     }
 
     /// Density of [`Environment::sample`] at direction `d`.
