@@ -290,3 +290,19 @@ fn environments_match_mitsuba() {
     let ratio = check_scene("environment_map", &map);
     assert!(ratio <= 1.10, "environment_map: RMSE ratio {ratio:.3}");
 }
+
+/// A spot light (Mitsuba's falloff) and a directional light beside the
+/// area light, as Mitsuba's `spot` and `directional`.
+#[test]
+fn spot_and_directional_lights_match_mitsuba() {
+    let grey = "type = \"diffuse\"\nalbedo = [0.6, 0.6, 0.6]";
+    let spot = material_scene(grey, SPHERE)
+        + "\n[[spot_light]]\nposition = [-2.0, -2.0, 2.0]\ntarget = [0.0, 0.0, 0.3]\n\
+           intensity = [20.0, 18.0, 15.0]\ncutoff_angle = 25.0\nbeam_width = 15.0\n";
+    let ratio = check_scene("light_spot", &spot);
+    assert!(ratio <= 1.10, "light_spot: RMSE ratio {ratio:.3}");
+    let sun = material_scene(grey, SPHERE)
+        + "\n[[directional_light]]\ndirection = [0.8, 0.3, -0.5]\nirradiance = [1.5, 1.2, 0.9]\n";
+    let ratio = check_scene("light_directional", &sun);
+    assert!(ratio <= 1.10, "light_directional: RMSE ratio {ratio:.3}");
+}

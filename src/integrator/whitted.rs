@@ -248,6 +248,26 @@ fn point_equivalent(light: &Light, reference: Vec3A) -> (Vec3A, Vec3A, Rgb) {
             position,
             intensity,
         } => (position, position, intensity),
+        Light::Spot {
+            position,
+            intensity,
+            cone,
+        } => (
+            position,
+            position,
+            intensity * cone.falloff((reference - position).normalize_or_zero()),
+        ),
+        Light::Directional {
+            direction,
+            irradiance,
+            center,
+            radius,
+        } => {
+            // A point far against the light whose intensity gives E there.
+            let distance = 2.0 * radius + (reference - center).length();
+            let position = reference - direction * distance;
+            (position, position, irradiance * distance * distance)
+        }
         Light::Triangle(p) => planar_point(&p, p.p0 + (p.e1 + p.e2) / 3.0, reference),
         Light::Parallelogram(p) => planar_point(&p, p.p0 + (p.e1 + p.e2) * 0.5, reference),
         Light::Sphere {

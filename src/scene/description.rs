@@ -64,6 +64,10 @@ pub struct SceneFile {
     #[serde(default)]
     pub point_light: Vec<Spanned<PointLightDesc>>,
     #[serde(default)]
+    pub spot_light: Vec<Spanned<SpotLightDesc>>,
+    #[serde(default)]
+    pub directional_light: Vec<Spanned<DirectionalLightDesc>>,
+    #[serde(default)]
     pub materials: BTreeMap<String, Spanned<MaterialDesc>>,
     #[serde(default)]
     pub textures: BTreeMap<String, Spanned<TextureDesc>>,
@@ -92,6 +96,29 @@ pub struct TextureDesc {
     /// uv · uv_scale + uv_offset (Mitsuba's `to_uv`).
     pub uv_scale: Option<[f32; 2]>,
     pub uv_offset: Option<[f32; 2]>,
+}
+
+/// `[[spot_light]]`: Mitsuba's `spot`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpotLightDesc {
+    pub position: [f32; 3],
+    /// The point the spot aims at.
+    pub target: [f32; 3],
+    pub intensity: [f32; 3],
+    /// Degrees from the axis where the light ends (Mitsuba: 20).
+    pub cutoff_angle: Option<f32>,
+    /// Degrees from the axis of full intensity (Mitsuba: 3/4 of the cutoff).
+    pub beam_width: Option<f32>,
+}
+
+/// `[[directional_light]]`: Mitsuba's `directional`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DirectionalLightDesc {
+    /// The direction the light travels in.
+    pub direction: [f32; 3],
+    pub irradiance: [f32; 3],
 }
 
 /// `[environment]`: light from infinity (Mitsuba's `constant` and `envmap`).

@@ -7,6 +7,7 @@
 //! the shading point, so the integrators can combine them with BSDF densities.
 
 use super::environment::Environment;
+use crate::sampling::warp::square_to_concentric_disk;
 use crate::math::{Frame, OffsetMode, Rgb, gamma, luminance};
 use crate::sampling::warp::{
     cosine_hemisphere_pdf, square_to_cosine_hemisphere, square_to_uniform_cone,
@@ -51,6 +52,55 @@ pub enum Light {
     },
     /// An isotropic point light of `intensity` (W/sr per channel).
     Point { position: Vec3A, intensity: Rgb },
+    /// A point light emitting into a cone (Mitsuba's `spot`).
+    Spot {
+        position: Vec3A,
+        intensity: Rgb,
+        cone: SpotCone,
+    },
+    /// Parallel light of `irradiance` travelling along `direction` (unit;
+    /// Mitsuba's `directional`). Light paths start on a disc of the
+    /// scene's bounding radius (`center`, `radius`, set when the scene is
+    /// built).
+    Directional {
+        direction: Vec3A,
+        irradiance: Rgb,
+        center: Vec3A,
+        radius: f32,
+    },
+}
+
+/// A spot light's cone and falloff: full intensity within `beam_width` of
+/// the axis, falling linearly in angle to zero at `cutoff` (Mitsuba's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpotCone {
+    /// Unit axis the spot points along.
+    pub axis: Vec3A,
+    /// Angles from the axis, radians.
+    pub cutoff: f32,
+    pub beam_width: f32,
+}
+
+impl SpotCone {
+    /// The falloff towards unit direction `w`.
+    #[inline]
+    pub fn falloff(&self, w: Vec3A) -> f32 {
+        let cos = self.axis.dot(w);
+        if cos <= self.cutoff.cos() {
+            0.0
+        } else if cos >= self.beam_width.cos() {
+            1.0
+        } else {
+            ((self.cutoff - cos.clamp(-1.0, 1.0).acos()) / (self.cutoff - self.beam_width).max(1e-6))
+                .clamp(0.0, 1.0)
+        }
+    }
+
+    /// Density of a uniform direction within the cutoff cone.
+    #[inline]
+    pub fn pdf(&self) -> f32 {
+        1.0 / (2.0 * PI * (1.0 - self.cutoff.cos()).max(1e-7))
+    }
 }
 
 /// A flat emitter spanned by `e1` and `e2` from `p0`: a triangle or a
@@ -186,6 +236,12 @@ impl Light {
                     * if two_sided { 2.0 } else { 1.0 }
             }
             Light::Point { intensity, .. } => luminance(intensity) * 4.0 * PI,
+            Light::Spot {
+                intensity, cone, ..
+            } => luminance(intensity) / cone.pdf(),
+            Light::Directional {
+                irradiance, radius, ..
+            } => luminance(irradiance) * PI * radius * radius,
         }
     }
 
@@ -295,6 +351,48 @@ impl Light {
                     light: 0,
                 })
             }
+            Light::Spot {
+                position,
+                intensity,
+                cone,
+            } => {
+                let to_light = position - reference;
+                let dist2 = to_light.length_squared();
+                let distance = dist2.sqrt();
+                let wi = to_light / distance;
+                let falloff = cone.falloff(-wi);
+                (falloff > 0.0).then_some(LightSample {
+                    point: position,
+                    error: Vec3A::ZERO,
+                    normal: Vec3A::ZERO,
+                    wi,
+                    distance,
+                    radiance: intensity * (falloff / dist2),
+                    pdf: 1.0,
+                    delta: true,
+                    light: 0,
+                })
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+                center,
+                radius,
+            } => {
+                // A point beyond the bounding sphere, against the light.
+                let distance = 2.0 * radius + (reference - center).length();
+                Some(LightSample {
+                    point: reference - direction * distance,
+                    error: Vec3A::ZERO,
+                    normal: Vec3A::ZERO,
+                    wi: -direction,
+                    distance,
+                    radiance: irradiance,
+                    pdf: 1.0,
+                    delta: true,
+                    light: 0,
+                })
+            }
         }
     }
 
@@ -341,7 +439,7 @@ impl Light {
                     dist2 / (cos_light * 4.0 * PI * radius * radius)
                 }
             }
-            Light::Point { .. } => 0.0,
+            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => 0.0,
         }
     }
 }
@@ -432,12 +530,17 @@ pub struct EmissionSample {
     pub pdf_direction: f32,
     /// Which light ([`Lights::sample_emission`] sets it).
     pub light: u32,
+    /// A spot light's cone, whose falloff scales what it emits.
+    pub cone: Option<SpotCone>,
 }
 
 impl EmissionSample {
     /// Emitted radiance (or intensity) from the light point towards `w`.
     #[inline]
     pub fn emitted_towards(&self, w: Vec3A) -> Rgb {
+        if let Some(cone) = self.cone {
+            return self.emitted * cone.falloff(w);
+        }
         if self.normal == Vec3A::ZERO || self.two_sided || self.normal.dot(w) > 0.0 {
             self.emitted
         } else {
@@ -539,6 +642,54 @@ impl Light {
                     pdf_position: 1.0,
                     pdf_direction: 1.0 / (4.0 * PI),
                     light: 0,
+                    cone: None,
+                });
+            }
+            Light::Spot {
+                position,
+                intensity,
+                cone,
+            } => {
+                // Uniform within the cutoff cone.
+                let local = square_to_uniform_cone(u_direction, cone.cutoff.cos());
+                let direction = Frame::from_normal(cone.axis).to_world(local).normalize();
+                return Some(EmissionSample {
+                    point: position,
+                    error: Vec3A::ZERO,
+                    normal: Vec3A::ZERO,
+                    direction,
+                    throughput: intensity * (cone.falloff(direction) / cone.pdf()),
+                    emitted: intensity,
+                    two_sided: true,
+                    pdf_position: 1.0,
+                    pdf_direction: cone.pdf(),
+                    light: 0,
+                    cone: Some(cone),
+                });
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+                center,
+                radius,
+            } => {
+                let disk = square_to_concentric_disk(u_position) * radius;
+                let frame = Frame::from_normal(direction);
+                let point = center - radius * direction + frame.s * disk.x + frame.t * disk.y;
+                let pdf_position = 1.0 / (PI * radius * radius);
+                return Some(EmissionSample {
+                    point,
+                    error: Vec3A::ZERO,
+                    normal: direction,
+                    direction,
+                    throughput: irradiance / pdf_position,
+                    // The disc is not a surface the camera could see.
+                    emitted: Rgb::ZERO,
+                    two_sided: false,
+                    pdf_position,
+                    pdf_direction: 1.0,
+                    light: 0,
+                    cone: None,
                 });
             }
         };
@@ -558,6 +709,7 @@ impl Light {
             pdf_position: 1.0 / area,
             pdf_direction,
             light: 0,
+            cone: None,
         })
     }
 }
@@ -594,6 +746,16 @@ impl Lights {
         }
     }
 
+    /// True when a light is at infinity or a spot: bidirectional
+    /// techniques do not handle these yet.
+    pub fn has_lights_bidirectional_lacks(&self) -> bool {
+        self.environment.is_some()
+            || self
+                .lights
+                .iter()
+                .any(|l| matches!(l, Light::Spot { .. } | Light::Directional { .. }))
+    }
+
     /// The environment, if the scene has one.
     #[inline]
     pub fn environment(&self) -> Option<&Environment> {
@@ -623,7 +785,7 @@ impl Lights {
             match light {
                 Light::Triangle(p) | Light::Parallelogram(p) => p.sampling = mode,
                 Light::Sphere { sampling, .. } => *sampling = mode,
-                Light::Point { .. } => {}
+                Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => {}
             }
         }
         Lights {
@@ -743,6 +905,11 @@ impl Lights {
                 radius, two_sided, ..
             } => (4.0 * PI * radius * radius, two_sided),
             Light::Point { .. } => return (pmf, 1.0 / (4.0 * PI)),
+            Light::Spot { cone, .. } => {
+                let inside = cone.axis.dot(w) > cone.cutoff.cos();
+                return (pmf, if inside { cone.pdf() } else { 0.0 });
+            }
+            Light::Directional { radius, .. } => return (pmf / (PI * radius * radius), 1.0),
         };
         // Cosine-weighted about the normal, on one side or on each side
         // with probability 1/2 (see `emission_direction`).
@@ -793,6 +960,7 @@ impl Environment {
             pdf_position,
             pdf_direction,
             light: 0,
+            cone: None,
         })
     }
 }

@@ -15,7 +15,7 @@ use crate::camera::Camera;
 use crate::error::{Error, Result, line_of};
 use crate::filter::PixelFilter;
 use crate::math::Rgb;
-use crate::scene::light::Light;
+use crate::scene::light::{Light, SpotCone};
 use crate::texture::{Bitmap, Filter as TextureFilter, Texture, UvTransform, Wrap};
 use glam::{EulerRot, Mat4, Quat, Vec2, Vec3, Vec3A};
 use std::collections::HashMap;
@@ -247,6 +247,50 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         });
     }
 
+    for spot in &file.spot_light {
+        let d = spot.get_ref();
+        let bad = |m: String| at(spot.span(), format!("spot_light: {m}"));
+        let (position, target) = (Vec3A::from(d.position), Vec3A::from(d.target));
+        let axis = (target - position).normalize_or_zero();
+        if !in_range(position) || axis == Vec3A::ZERO {
+            return Err(bad("`position` and `target` must be finite and distinct".into()));
+        }
+        if !d.intensity.iter().all(|x| x.is_finite() && *x >= 0.0) {
+            return Err(bad("`intensity` must be finite and >= 0".into()));
+        }
+        let cutoff = d.cutoff_angle.unwrap_or(20.0);
+        let beam = d.beam_width.unwrap_or(0.75 * cutoff);
+        if !(cutoff > 0.0 && cutoff <= 90.0 && beam >= 0.0 && beam <= cutoff) {
+            return Err(bad(format!(
+                "need 0 < cutoff_angle <= 90 and 0 <= beam_width <= cutoff_angle degrees, got {cutoff} and {beam}"
+            )));
+        }
+        point_lights.push(Light::Spot {
+            position,
+            intensity: Rgb::from(d.intensity),
+            cone: SpotCone {
+                axis,
+                cutoff: cutoff.to_radians(),
+                beam_width: beam.to_radians(),
+            },
+        });
+    }
+    for light in &file.directional_light {
+        let d = light.get_ref();
+        let direction = Vec3A::from(d.direction).normalize_or_zero();
+        if direction == Vec3A::ZERO || !direction.is_finite() {
+            return Err(at(light.span(), "directional_light: `direction` must be a finite non-zero vector".into()));
+        }
+        if !d.irradiance.iter().all(|x| x.is_finite() && *x >= 0.0) {
+            return Err(at(light.span(), "directional_light: `irradiance` must be finite and >= 0".into()));
+        }
+        point_lights.push(Light::Directional {
+            direction,
+            irradiance: Rgb::from(d.irradiance),
+            center: Vec3A::ZERO,
+            radius: 1.0,
+        });
+    }
     let environment = match &file.environment {
         None => None,
         Some(e) => Some(build_environment(e.get_ref(), &dir).map_err(|m| at(e.span(), m))?),

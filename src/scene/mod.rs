@@ -129,12 +129,12 @@ impl Features {
             point_lights: lights
                 .as_slice()
                 .iter()
-                .any(|l| matches!(l, Light::Point { .. })),
+                .any(|l| matches!(l, Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. })),
             spheres: geometry.has_spheres(),
             area_lights: lights
                 .as_slice()
                 .iter()
-                .filter(|l| !matches!(l, Light::Point { .. }))
+                .filter(|l| !matches!(l, Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }))
                 .count(),
             motion: geometry.has_motion() && camera.has_shutter_interval(),
         }
@@ -170,6 +170,18 @@ impl Features {
             v.push("time dimension (static scene)");
         }
         v
+    }
+}
+
+/// The sphere around the geometry's bounding box (unit at the origin
+/// for an empty scene): where light from infinity enters.
+fn bounding_sphere(geometry: &Geometry) -> (Vec3A, f32) {
+    let b = geometry.bounds();
+    let (min, max) = (Vec3A::from(b.min), Vec3A::from(b.max));
+    if (max - min).is_finite() && max.cmpge(min).all() {
+        (0.5 * (min + max), (0.5 * (max - min).length()).max(1e-3))
+    } else {
+        (Vec3A::ZERO, 1.0)
     }
 }
 
@@ -376,16 +388,20 @@ impl Scene {
                 });
             }
         }
-        lights.extend(input.point_lights);
+        let (center, radius) = bounding_sphere(&geometry);
+        lights.extend(input.point_lights.into_iter().map(|mut l| {
+            if let Light::Directional {
+                center: c,
+                radius: r,
+                ..
+            } = &mut l
+            {
+                (*c, *r) = (center, radius);
+            }
+            l
+        }));
         let environment = input.environment.map(|mut env| {
-            let b = geometry.bounds();
-            let (min, max) = (Vec3A::from(b.min), Vec3A::from(b.max));
-            let radius = if (max - min).is_finite() && max.cmpge(min).all() {
-                0.5 * (max - min).length()
-            } else {
-                1.0
-            };
-            env.bound(0.5 * (min + max), radius);
+            env.bound(center, radius);
             env
         });
         let lights = Lights::with_environment(lights, environment);

@@ -666,6 +666,8 @@ fn emission_of(scene: &Scene, light: u32) -> (Rgb, bool) {
             ..
         } => (radiance, two_sided),
         Light::Point { intensity, .. } => (intensity, true),
+        // Never reached: sessions refuse BDPT on scenes with these.
+        Light::Spot { .. } | Light::Directional { .. } => (Rgb::ZERO, false),
     }
 }
 

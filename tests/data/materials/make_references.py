@@ -101,6 +101,18 @@ ENVIRONMENTS = {
 }
 
 
+# Delta lights beside the area light: a spot aimed at the sphere's side and
+# parallel light grazing in from the left.
+GREY = sphere({"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.6, 0.6, 0.6]}})
+LIGHTS = {
+    "light_spot": (GREY, {"type": "spot", "intensity": {"type": "rgb", "value": [20, 18, 15]},
+                          "cutoff_angle": 25, "beam_width": 15,
+                          "to_world": mi.ScalarTransform4f().look_at(origin=[-2, -2, 2], target=[0, 0, 0.3], up=[0, 0, 1])}),
+    "light_directional": (GREY, {"type": "directional", "irradiance": {"type": "rgb", "value": [1.5, 1.2, 0.9]},
+                                 "direction": [0.8, 0.3, -0.5]}),
+}
+
+
 def scene(obj, rfilter=None, floor_bsdf=None, environment=None):
     return {
         "type": "scene",
@@ -127,7 +139,7 @@ def scene(obj, rfilter=None, floor_bsdf=None, environment=None):
             "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [3, 3, 3]}},
         },
         "object": obj,
-        **({"environment": environment} if environment else {}),
+        **({"extra_light": environment} if environment else {}),
     }
 
 
@@ -137,6 +149,7 @@ def main(names):
     jobs = {name: (obj, rfilter, floor, None) for name, (obj, rfilter, floor) in jobs.items()}
     jobs |= {name: (obj, None, floor, None) for name, (obj, floor) in TEXTURED.items()}
     jobs |= {name: (obj, None, None, env) for name, (obj, env) in ENVIRONMENTS.items()}
+    jobs |= {name: (obj, None, None, light) for name, (obj, light) in LIGHTS.items()}
     for name, (obj, rfilter, floor, env) in jobs.items():
         if names and name not in names:
             continue
