@@ -245,3 +245,59 @@ fn environment_importance_sampling_cuts_the_variance() {
     assert!((m_i - m_u).abs() < 4.0 * se, "means {m_i} and {m_u} differ");
     assert!(v_u > 10.0 * v_i, "variance only {:.1}x lower", v_u / v_i);
 }
+
+/// Light from infinity and delta lights in light tracing: particles from
+/// the environment's and the directional light's discs and from the spot's
+/// cone agree with path tracing's light samples (the floor fills the
+/// frame, so no pixel sees the environment itself, which light tracing
+/// cannot).
+#[test]
+fn light_tracing_agrees_with_path_tracing_under_every_light() {
+    let text = r#"
+[camera]
+eye = [0.0, -4.0, 2.5]
+look_at = [0.0, 0.0, 0.5]
+up = [0.0, 0.0, 1.0]
+fov_y = 35.0
+width = 64
+height = 64
+
+[materials.floor]
+type = "diffuse"
+albedo = [0.4, 0.4, 0.4]
+
+[materials.ball]
+type = "roughplastic"
+distribution = "ggx"
+alpha = 0.3
+diffuse_reflectance = [0.6, 0.3, 0.2]
+
+[[quad]]
+corner = [-20.0, -20.0, 0.0]
+u = [40.0, 0.0, 0.0]
+v = [0.0, 40.0, 0.0]
+material = "floor"
+
+[[sphere]]
+center = [0.0, 0.0, 0.6]
+radius = 0.6
+material = "ball"
+
+[[spot_light]]
+position = [-2.0, -2.0, 2.0]
+target = [0.0, 0.0, 0.3]
+intensity = [20.0, 18.0, 15.0]
+
+[[directional_light]]
+direction = [0.8, 0.3, -0.5]
+irradiance = [1.5, 1.2, 0.9]
+
+[environment]
+type = "constant"
+radiance = [0.3, 0.35, 0.4]
+"#;
+    let scene = load_scene_text("every-light", text);
+    let path = render(scene.clone(), Integrator::from(PathTracer::default()), 256, 21);
+    let light = render(scene, Integrator::from(LightTracer::default()), 256, 22);
+    assert_agree("every light, light / path", &light, &path);
+}
