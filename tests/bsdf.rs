@@ -426,3 +426,148 @@ fn white_furnace_of_rough_conductors_matches_the_microfacet_albedo() {
         }
     }
 }
+
+/// Every model, at roughness from 1e-4 (the delta limit) to 1, IORs of
+/// 1.0001 and 1.5, from normal incidence to cos θ = 1e-6 on either side:
+/// sample weights, pdfs and values stay finite and non-negative; at α 1e-4
+/// a rough conductor reflects what the smooth one does (its mean weight
+/// within 1% of F, no fireflies: the largest weight at most 1.01).
+#[test]
+fn bsdfs_stay_finite_at_extremes() {
+    let gold = tracelab::bsdf::presets::conductor("Au").unwrap();
+    let (eta_au, k_au) = (Rgb::from(gold.0), Rgb::from(gold.1));
+    let mut models: Vec<(String, Bsdf)> = Vec::new();
+    for alpha in [1e-4f32, 1e-3, 1e-2, 0.3, 1.0] {
+        for distribution in [Distribution::Ggx, Distribution::Beckmann] {
+            let mf = Microfacet::new(distribution, alpha, alpha.sqrt());
+            for eta in [1.0001f32, 1.5] {
+                models.push((
+                    format!("rough glass {distribution:?} {alpha} eta {eta}"),
+                    Bsdf::RoughDielectric(RoughDielectric {
+                        microfacet: Microfacet::isotropic(distribution, alpha),
+                        eta,
+                        reflectance: Rgb::ONE,
+                        transmittance: Rgb::ONE,
+                    }),
+                ));
+                models.push((
+                    format!("rough plastic {distribution:?} {alpha} eta {eta}"),
+                    Bsdf::RoughPlastic {
+                        lobe: RoughPlastic::new(
+                            Microfacet::isotropic(distribution, alpha),
+                            eta,
+                            Rgb::splat(0.5),
+                            Rgb::ONE,
+                            true,
+                        ),
+                        two_sided: true,
+                    },
+                ));
+            }
+            models.push((
+                format!("rough gold {distribution:?} {alpha}/{}", alpha.sqrt()),
+                Bsdf::RoughConductor {
+                    lobe: RoughConductor {
+                        microfacet: mf,
+                        eta: eta_au,
+                        k: k_au,
+                        tint: Rgb::ONE,
+                    },
+                    two_sided: true,
+                },
+            ));
+        }
+        models.push((
+            format!("rough diffuse {alpha}"),
+            Bsdf::RoughDiffuse {
+                lobe: RoughDiffuse {
+                    albedo: Rgb::ONE,
+                    alpha,
+                },
+                two_sided: true,
+            },
+        ));
+    }
+    for eta in [1.0001f32, 1.5] {
+        models.push((
+            format!("thin glass {eta}"),
+            Bsdf::ThinDielectric(ThinDielectric {
+                eta,
+                reflectance: Rgb::ONE,
+                transmittance: Rgb::ONE,
+            }),
+        ));
+        models.push((
+            format!("plastic {eta}"),
+            Bsdf::Plastic {
+                lobe: Plastic::new(eta, Rgb::splat(0.5), Rgb::ONE, false),
+                two_sided: true,
+            },
+        ));
+    }
+    for (m, (name, bsdf)) in models.iter().enumerate() {
+        for cos in [1.0f32, 0.5, 1e-2, 1e-4, 1e-6] {
+            for side in [1.0f32, -1.0] {
+                let sin = (1.0 - cos * cos).sqrt();
+                let wo = Vec3A::new(sin * 0.6, sin * 0.8, side * cos);
+                for i in 0..2000u64 {
+                    let seed = 900 + m as u64;
+                    let u = Vec2::new(uniform(seed, i, 1), uniform(seed, i, 2));
+                    if let Some(s) = bsdf.sample(wo, uniform(seed, i, 0), u) {
+                        assert!(
+                            s.weight.is_finite()
+                                && s.weight.min_element() >= 0.0
+                                && s.pdf.is_finite(),
+                            "{name} at cos {cos} side {side}: weight {} pdf {}",
+                            s.weight,
+                            s.pdf
+                        );
+                    }
+                    let wi = square_to_uniform_sphere(u);
+                    let (f, p, pr) = bsdf.eval_with_pdfs(wo, wi);
+                    assert!(
+                        f.is_finite() && f.min_element() >= 0.0 && p.is_finite() && pr.is_finite(),
+                        "{name} at cos {cos}: f {f} pdf {p} {pr}"
+                    );
+                }
+            }
+        }
+    }
+    // The delta limit.
+    let rough = Bsdf::RoughConductor {
+        lobe: RoughConductor {
+            microfacet: Microfacet::isotropic(Distribution::Ggx, 1e-4),
+            eta: eta_au,
+            k: k_au,
+            tint: Rgb::ONE,
+        },
+        two_sided: false,
+    };
+    let smooth = Bsdf::Conductor {
+        lobe: Conductor {
+            eta: eta_au,
+            k: k_au,
+            tint: Rgb::ONE,
+        },
+        two_sided: false,
+    };
+    for theta in [0.0f32, 45.0, 85.0] {
+        let t = theta.to_radians();
+        let wo = Vec3A::new(t.sin(), 0.0, t.cos());
+        let f = smooth.sample(wo, 0.5, Vec2::ZERO).unwrap().weight.x;
+        let (mut sum, mut largest) = (0.0f64, 0.0f32);
+        let n = 20_000u64;
+        for i in 0..n {
+            let u = Vec2::new(uniform(5, i, 1), uniform(5, i, 2));
+            let w = rough.sample(wo, 0.5, u).map_or(0.0, |s| s.weight.x);
+            sum += w as f64;
+            largest = largest.max(w);
+        }
+        let mean = sum / n as f64;
+        assert!(
+            (mean - f as f64).abs() < 0.01 * f as f64,
+            "at {theta}: rough {mean} vs smooth {f}"
+        );
+        assert!(largest <= 1.01, "at {theta}: a weight of {largest}");
+    }
+}

@@ -778,7 +778,8 @@ fn environment_map_sampling() {
         check_directions(
             &format!("environment map, rotation {k}"),
             |i| {
-                let (d, _, pdf) = env.sample(Vec2::new(uniform(seed, i, 0), uniform(seed, i, 1)))?;
+                let (d, _, pdf) =
+                    env.sample(Vec2::new(uniform(seed, i, 0), uniform(seed, i, 1)))?;
                 assert!(
                     (pdf - env.pdf(d)).abs() <= 1e-3 * pdf.max(1.0),
                     "sample pdf {pdf} vs pdf() {}",

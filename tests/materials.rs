@@ -225,13 +225,18 @@ fn environment_importance_sampling_cuts_the_variance() {
     let estimate = |env: &Environment, seed: u64| {
         let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
         for i in 0..n {
-            let u = glam::Vec2::new(
-                tracelab::sampling::hash::to_unit_float(tracelab::sampling::hash::hash_combine(seed, 2 * i)),
-                tracelab::sampling::hash::to_unit_float(tracelab::sampling::hash::hash_combine(seed, 2 * i + 1)),
-            );
-            let x = env.sample(u).map_or(0.0, |(d, le, pdf)| {
-                (le.x * d.y.max(0.0) / pdf) as f64
-            });
+            let u =
+                glam::Vec2::new(
+                    tracelab::sampling::hash::to_unit_float(
+                        tracelab::sampling::hash::hash_combine(seed, 2 * i),
+                    ),
+                    tracelab::sampling::hash::to_unit_float(
+                        tracelab::sampling::hash::hash_combine(seed, 2 * i + 1),
+                    ),
+                );
+            let x = env
+                .sample(u)
+                .map_or(0.0, |(d, le, pdf)| (le.x * d.y.max(0.0) / pdf) as f64);
             sum += x;
             sum_sq += x * x;
         }
@@ -240,7 +245,10 @@ fn environment_importance_sampling_cuts_the_variance() {
     };
     let (m_i, v_i) = estimate(&importance, 1);
     let (m_u, v_u) = estimate(&uniform, 2);
-    eprintln!("irradiance: importance {m_i:.3} (var {v_i:.3e}), uniform {m_u:.3} (var {v_u:.3e}), ratio {:.1}", v_u / v_i);
+    eprintln!(
+        "irradiance: importance {m_i:.3} (var {v_i:.3e}), uniform {m_u:.3} (var {v_u:.3e}), ratio {:.1}",
+        v_u / v_i
+    );
     let se = ((v_i + v_u) / n as f64).sqrt();
     assert!((m_i - m_u).abs() < 4.0 * se, "means {m_i} and {m_u} differ");
     assert!(v_u > 10.0 * v_i, "variance only {:.1}x lower", v_u / v_i);
@@ -297,7 +305,110 @@ type = "constant"
 radiance = [0.3, 0.35, 0.4]
 "#;
     let scene = load_scene_text("every-light", text);
-    let path = render(scene.clone(), Integrator::from(PathTracer::default()), 256, 21);
+    let path = render(
+        scene.clone(),
+        Integrator::from(PathTracer::default()),
+        256,
+        21,
+    );
     let light = render(scene, Integrator::from(LightTracer::default()), 256, 22);
     assert_agree("every light, light / path", &light, &path);
+}
+
+/// An environment map with NaN and infinite texels (read as 0) and one
+/// texel of 1e6 (a sun a million times the sky), and a texture with NaN
+/// texels: no non-finite sample reaches the film, in path tracing or light
+/// tracing.
+#[test]
+fn extreme_texels_stay_finite() {
+    let dir = crate::common::temp_dir("extreme-texels");
+    let (w, h) = (16usize, 8usize);
+    let mut pfm = format!("PF\n{w} {h}\n-1.0\n").into_bytes();
+    for i in 0..w * h {
+        let v = match i {
+            5 => f32::NAN,
+            9 => f32::INFINITY,
+            40 => 1e6,
+            _ => 0.5,
+        };
+        for _ in 0..3 {
+            pfm.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    std::fs::write(dir.join("sky.pfm"), &pfm).unwrap();
+    let mut nan_texture = format!("PF\n2 2\n-1.0\n").into_bytes();
+    for v in [f32::NAN, 0.5, 0.5, f32::NEG_INFINITY]
+        .iter()
+        .flat_map(|v| [*v; 3])
+    {
+        nan_texture.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(dir.join("albedo.pfm"), &nan_texture).unwrap();
+    let text = format!(
+        r#"
+[camera]
+eye = [0.0, -4.0, 2.5]
+look_at = [0.0, 0.0, 0.5]
+up = [0.0, 0.0, 1.0]
+fov_y = 60.0
+width = 32
+height = 32
+
+[textures.bad]
+type = "bitmap"
+file = "{albedo}"
+
+[materials.floor]
+type = "diffuse"
+albedo_texture = "bad"
+
+[materials.ball]
+type = "roughconductor"
+conductor = "Cu"
+distribution = "ggx"
+alpha = 0.0001
+
+[[quad]]
+corner = [-3.0, -3.0, 0.0]
+u = [6.0, 0.0, 0.0]
+v = [0.0, 6.0, 0.0]
+material = "floor"
+
+[[sphere]]
+center = [0.0, 0.0, 0.6]
+radius = 0.6
+material = "ball"
+
+[environment]
+type = "envmap"
+file = "{sky}"
+"#,
+        albedo = dir.join("albedo.pfm").display(),
+        sky = dir.join("sky.pfm").display()
+    );
+    let scene = load_scene_text("extreme-texels", &text);
+    for integrator in [
+        Integrator::from(PathTracer::default()),
+        Integrator::from(LightTracer::default()),
+    ] {
+        let name = integrator.name();
+        let (snapshot, stats) = render_with(
+            scene.clone(),
+            integrator,
+            SamplerKind::Independent,
+            16,
+            3,
+            0,
+            1,
+        );
+        assert_eq!(stats.non_finite, 0, "{name}");
+        assert!(
+            snapshot
+                .image
+                .pixels
+                .iter()
+                .flatten()
+                .all(|c| c.is_finite())
+        );
+    }
 }

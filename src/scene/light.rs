@@ -7,8 +7,8 @@
 //! the shading point, so the integrators can combine them with BSDF densities.
 
 use super::environment::Environment;
-use crate::sampling::warp::square_to_concentric_disk;
 use crate::math::{Frame, OffsetMode, Rgb, gamma, luminance};
+use crate::sampling::warp::square_to_concentric_disk;
 use crate::sampling::warp::{
     cosine_hemisphere_pdf, square_to_cosine_hemisphere, square_to_uniform_cone,
     square_to_uniform_sphere, square_to_uniform_triangle, uniform_cone_pdf,
@@ -91,8 +91,9 @@ impl SpotCone {
         } else if cos >= self.beam_width.cos() {
             1.0
         } else {
-            ((self.cutoff - cos.clamp(-1.0, 1.0).acos()) / (self.cutoff - self.beam_width).max(1e-6))
-                .clamp(0.0, 1.0)
+            ((self.cutoff - cos.clamp(-1.0, 1.0).acos())
+                / (self.cutoff - self.beam_width).max(1e-6))
+            .clamp(0.0, 1.0)
         }
     }
 

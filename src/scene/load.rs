@@ -253,7 +253,9 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         let (position, target) = (Vec3A::from(d.position), Vec3A::from(d.target));
         let axis = (target - position).normalize_or_zero();
         if !in_range(position) || axis == Vec3A::ZERO {
-            return Err(bad("`position` and `target` must be finite and distinct".into()));
+            return Err(bad(
+                "`position` and `target` must be finite and distinct".into()
+            ));
         }
         if !d.intensity.iter().all(|x| x.is_finite() && *x >= 0.0) {
             return Err(bad("`intensity` must be finite and >= 0".into()));
@@ -279,10 +281,16 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         let d = light.get_ref();
         let direction = Vec3A::from(d.direction).normalize_or_zero();
         if direction == Vec3A::ZERO || !direction.is_finite() {
-            return Err(at(light.span(), "directional_light: `direction` must be a finite non-zero vector".into()));
+            return Err(at(
+                light.span(),
+                "directional_light: `direction` must be a finite non-zero vector".into(),
+            ));
         }
         if !d.irradiance.iter().all(|x| x.is_finite() && *x >= 0.0) {
-            return Err(at(light.span(), "directional_light: `irradiance` must be finite and >= 0".into()));
+            return Err(at(
+                light.span(),
+                "directional_light: `irradiance` must be finite and >= 0".into(),
+            ));
         }
         point_lights.push(Light::Directional {
             direction,

@@ -126,15 +126,22 @@ impl Features {
                         | Bsdf::Dielectric { .. }
                 )
             }),
-            point_lights: lights
-                .as_slice()
-                .iter()
-                .any(|l| matches!(l, Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. })),
+            point_lights: lights.as_slice().iter().any(|l| {
+                matches!(
+                    l,
+                    Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }
+                )
+            }),
             spheres: geometry.has_spheres(),
             area_lights: lights
                 .as_slice()
                 .iter()
-                .filter(|l| !matches!(l, Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }))
+                .filter(|l| {
+                    !matches!(
+                        l,
+                        Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }
+                    )
+                })
                 .count(),
             motion: geometry.has_motion() && camera.has_shutter_interval(),
         }
