@@ -577,19 +577,25 @@ impl Geometry {
             let normal = (ray.at(best_t) - s.center).normalize();
             let local = s.radius * normal;
             let point = s.center + local;
-            let phi = normal.y.atan2(normal.x);
-            let phi = if phi < 0.0 {
-                phi + std::f32::consts::TAU
+            // An atan2 and an acos per hit: only where textures are read.
+            let uv = if self.keep_uvs {
+                let phi = normal.y.atan2(normal.x);
+                let phi = if phi < 0.0 {
+                    phi + std::f32::consts::TAU
+                } else {
+                    phi
+                };
+                Vec2::new(
+                    phi * (0.5 * std::f32::consts::FRAC_1_PI),
+                    normal.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
+                )
             } else {
-                phi
+                Vec2::ZERO
             };
             return Some(SurfaceHit {
                 t: best_t,
                 point,
-                uv: Vec2::new(
-                    phi * (0.5 * std::f32::consts::FRAC_1_PI),
-                    normal.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
-                ),
+                uv,
                 // Re-projection onto the sphere (gamma(5), pbrt-v4 6.8.5) plus
                 // the translation by the centre.
                 error: gamma(5) * local.abs() + gamma(1) * point.abs(),

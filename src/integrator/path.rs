@@ -376,7 +376,8 @@ impl PathTracer {
                 observer.bsdf_sample(&sample);
                 beta *= sample.weight;
                 specular_bounce = !DIFFUSE_ONLY && sample.specular;
-                if !DIFFUSE_ONLY {
+                // Only refraction scales radiance by (eta_i / eta_t)^2.
+                if !DIFFUSE_ONLY && sample.wi.z * wo.z < 0.0 {
                     eta_scale /= bsdf.refraction_scale(wo, sample.wi);
                 }
                 prev_bsdf_pdf = sample.pdf;
