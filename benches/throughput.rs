@@ -186,6 +186,7 @@ fn rays() {
             vertices: cornell.geometry.triangles()[i],
             material: 0,
             uvs: None,
+            normals: None,
         })
         .collect();
     let rays = incoherent_rays(2_000_000, 250.0, Vec3A::new(278.0, 274.0, 280.0), 250.0);

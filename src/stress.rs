@@ -157,11 +157,13 @@ fn cuboid(min: Vec3A, max: Vec3A, material: u32) -> Vec<TriangleInput> {
                     vertices: [a, b, c],
                     material,
                     uvs: None,
+                    normals: None,
                 },
                 TriangleInput {
                     vertices: [a, c, d],
                     material,
                     uvs: None,
+                    normals: None,
                 },
             ]
         })
@@ -272,6 +274,7 @@ impl StressSuite {
             ],
             material: white,
             uvs: None,
+            normals: None,
         });
         for i in 0..64 {
             let p = Vec3A::new(
@@ -283,6 +286,7 @@ impl StressSuite {
                 vertices: [p, p + Vec3A::X * 1e-3, p + Vec3A::Z * 1e-3],
                 material: white,
                 uvs: None,
+                normals: None,
             });
         }
         add("tiny and huge triangles".into(), mixed, 0)?;

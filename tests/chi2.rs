@@ -228,6 +228,7 @@ fn emitter_above(
             vertices,
             material: 0,
             uvs: None,
+            normals: None,
         })
         .collect();
     (emitter, Geometry::build(&inputs, vec![]))

@@ -116,6 +116,7 @@ fn set_to_set(a: &[Element], b: &[Element], method: FormFactorMethod, n: u32, ru
             vertices: e.vertices,
             material: 0,
             uvs: None,
+            normals: None,
         })
         .collect();
     let geometry = Geometry::build(&inputs, vec![]);
@@ -307,6 +308,7 @@ fn a_probed_exchange_resumes_to_the_full_one() {
             vertices: e.vertices,
             material: 0,
             uvs: None,
+            normals: None,
         })
         .collect();
     let geometry = Geometry::build(&inputs, vec![]);

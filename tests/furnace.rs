@@ -89,11 +89,13 @@ fn cube_furnace() -> Scene {
             vertices: [a, b, c],
             material: 0,
             uvs: None,
+            normals: None,
         });
         triangles.push(TriangleInput {
             vertices: [a, c, d],
             material: 0,
             uvs: None,
+            normals: None,
         });
     }
     Scene::build(SceneInput {

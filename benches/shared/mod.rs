@@ -32,11 +32,13 @@ pub fn uv_sphere(n: usize) -> Vec<TriangleInput> {
                 vertices: [a, b, c],
                 material: 0,
                 uvs: None,
+                normals: None,
             });
             triangles.push(TriangleInput {
                 vertices: [a, c, d],
                 material: 0,
                 uvs: None,
+                normals: None,
             });
         }
     }

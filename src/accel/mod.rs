@@ -47,6 +47,8 @@ pub struct TriangleInput {
     /// Texture coordinates at the vertices; None gives (0, 0), (1, 0),
     /// (1, 1)'s barycentric default (b1, b2).
     pub uvs: Option<[Vec2; 3]>,
+    /// Shading normals at the vertices (unit), interpolated at hits.
+    pub normals: Option<[Vec3A; 3]>,
 }
 
 impl TriangleInput {
@@ -59,11 +61,13 @@ impl TriangleInput {
                 vertices: [corner, corner + u, corner + u + v],
                 material,
                 uvs: Some([Vec2::ZERO, Vec2::X, Vec2::ONE]),
+                normals: None,
             },
             TriangleInput {
                 vertices: [corner, corner + u + v, corner + v],
                 material,
                 uvs: Some([Vec2::ZERO, Vec2::ONE, Vec2::Y]),
+                normals: None,
             },
         ]
     }
@@ -87,6 +91,10 @@ pub struct SurfaceHit {
     pub light: u32,
     /// Time of the ray that found the hit, inherited by rays spawned here.
     pub time: f32,
+    /// Unit shading normal: the vertex normals interpolated, or the
+    /// geometric normal. BSDFs act in its frame; offsets, emission and
+    /// area densities use the geometric one.
+    pub shading_normal: Vec3A,
     /// Texture coordinates: interpolated from the triangle's (barycentrics
     /// where the geometry keeps none), or (φ / 2π, θ / π) on a sphere as
     /// Mitsuba's.
@@ -176,6 +184,9 @@ pub struct Geometry {
     /// Texture coordinates per triangle in BVH order; empty when no
     /// material reads textures (hits then carry barycentrics).
     tri_uvs: Vec<[Vec2; 3]>,
+    /// Vertex normals per triangle in BVH order; empty when no triangle
+    /// has any (hits then shade with the geometric normal).
+    tri_normals: Vec<[Vec3A; 3]>,
     sphere_bvh: Option<CwBvh>,
     spheres: Vec<Sphere>,
     /// Objects in linear motion, each tested by moving the ray instead.
@@ -187,6 +198,8 @@ pub struct Geometry {
     bvh_too_deep: bool,
     /// Whether hits interpolate the triangles' texture coordinates.
     keep_uvs: bool,
+    /// Whether hits interpolate vertex normals.
+    keep_normals: bool,
 }
 
 /// Geometry translated by `velocity * time`: at time t it is hit where the
@@ -285,6 +298,7 @@ impl Geometry {
     ) -> Self {
         let mut geometry = Geometry {
             keep_uvs,
+            keep_normals: triangles.iter().any(|t| t.normals.is_some()),
             ..Geometry::default()
         };
         let use_soup = match choice {
@@ -350,6 +364,10 @@ impl Geometry {
             if self.keep_uvs {
                 let barycentric = [Vec2::ZERO, Vec2::X, Vec2::Y];
                 self.tri_uvs.push(triangles[i].uvs.unwrap_or(barycentric));
+            }
+            if self.keep_normals {
+                let flat = [TriangleShading::new(&triangles[i]).normal; 3];
+                self.tri_normals.push(triangles[i].normals.unwrap_or(flat));
             }
         }
     }
@@ -478,6 +496,11 @@ impl Geometry {
         b
     }
 
+    /// True when some triangle shades with interpolated vertex normals.
+    pub fn has_shading_normals(&self) -> bool {
+        !self.tri_normals.is_empty() || self.moving.iter().any(|m| m.geometry.has_shading_normals())
+    }
+
     /// Sets how rays spawned at hits leave the surface.
     pub fn set_offset(&mut self, offset: OffsetMode) {
         self.offset = offset;
@@ -596,6 +619,7 @@ impl Geometry {
                 t: best_t,
                 point,
                 uv,
+                shading_normal: normal,
                 // Re-projection onto the sphere (gamma(5), pbrt-v4 6.8.5) plus
                 // the translation by the centre.
                 error: gamma(5) * local.abs() + gamma(1) * point.abs(),
@@ -632,10 +656,18 @@ impl Geometry {
             Some([t0, t1, t2]) => b0 * *t0 + best_b1 * *t1 + best_b2 * *t2,
             None => Vec2::new(best_b1, best_b2),
         };
+        let shading_normal = match self.tri_normals.get(index as usize) {
+            Some([n0, n1, n2]) => {
+                let n = (b0 * *n0 + best_b1 * *n1 + best_b2 * *n2).normalize_or_zero();
+                if n == Vec3A::ZERO { shading.normal } else { n }
+            }
+            None => shading.normal,
+        };
         SurfaceHit {
             t: best_t,
             point,
             uv,
+            shading_normal,
             // Barycentric interpolation (pbrt-v4 6.8.4).
             error: gamma(7) * ((b0 * p0).abs() + (best_b1 * p1).abs() + (best_b2 * p2).abs()),
             normal: shading.normal,

@@ -15,11 +15,13 @@ fn quad_mesh() -> Vec<TriangleInput> {
             vertices: [p[0], p[1], p[2]],
             material: 0,
             uvs: None,
+            normals: None,
         },
         TriangleInput {
             vertices: [p[0], p[2], p[3]],
             material: 1,
             uvs: None,
+            normals: None,
         },
     ]
 }

@@ -132,7 +132,8 @@ impl SplattingEstimator for LightTracer {
             if bsdf.is_black() {
                 break;
             }
-            let frame = Frame::from_normal(hit.normal);
+            let frame = Frame::from_normal(hit.shading_normal);
+            let ng = frame.to_local(hit.normal);
             // Direction back towards where the particle came from.
             let w_prev = frame.to_local(-ray.direction);
             let u_lens = sampler.next_2d_for(Domain::Lens);
@@ -144,7 +145,7 @@ impl SplattingEstimator for LightTracer {
                 && let Some(c) = camera.connect(hit.point, u_lens)
             {
                 let w_cam = frame.to_local(c.wi);
-                let f = bsdf.eval(w_cam, w_prev);
+                let f = bsdf.eval(w_cam, w_prev) * shading_correction(w_prev, w_cam, ng);
                 if f.max_element() > 0.0
                     && sees_lens(scene, hit.point, hit.error, hit.normal, &c, time, counts)
                 {
@@ -158,7 +159,7 @@ impl SplattingEstimator for LightTracer {
             let Some(sample) = bsdf.sample(w_prev, u_lobe, u_bsdf) else {
                 break;
             };
-            beta *= importance_weight(bsdf, w_prev, sample.wi, sample.weight);
+            beta *= importance_weight(bsdf, w_prev, sample.wi, ng, sample.weight);
             bounces += 1;
             if self.russian_roulette
                 && bounces > self.rr_depth
@@ -216,8 +217,44 @@ pub(super) fn sample_particle(scene: &Scene, sampler: &mut Sampler) -> Option<Em
 }
 
 /// The sample weight f cos / p in importance transport: as for radiance,
-/// except that refraction does not scale by (eta_i / eta_t)^2.
+/// except that refraction does not scale by (eta_i / eta_t)^2, and that
+/// with shading normals the adjoint BSDF carries
+/// [`shading_correction`] (`ng`: the geometric normal in the shading frame).
 #[inline]
-pub(super) fn importance_weight(bsdf: Bsdf, wo: Vec3A, wi: Vec3A, radiance_weight: Rgb) -> Rgb {
-    radiance_weight / bsdf.refraction_scale(wo, wi)
+pub(super) fn importance_weight(
+    bsdf: Bsdf,
+    wo: Vec3A,
+    wi: Vec3A,
+    ng: Vec3A,
+    radiance_weight: Rgb,
+) -> Rgb {
+    radiance_weight * (shading_correction(wo, wi, ng) / bsdf.refraction_scale(wo, wi))
+}
+
+/// Veach's correction of the adjoint BSDF for shading normals (thesis,
+/// 5.3): |wo·ns| |wi·ng| / (|wo·ng| |wi·ns|), directions in the shading
+/// frame (ns = +z), `wo` towards the light. 1 where ns = ng.
+#[inline]
+pub fn shading_correction(wo: Vec3A, wi: Vec3A, ng: Vec3A) -> f32 {
+    if ng == Vec3A::Z {
+        return 1.0;
+    }
+    let denominator = wo.dot(ng).abs() * wi.z.abs();
+    if denominator > 0.0 {
+        wo.z.abs() * wi.dot(ng).abs() / denominator
+    } else {
+        0.0
+    }
+}
+
+/// The factor |wi·ns| / |wi·ng| by which a density estimate (photons
+/// arriving along `wi`, flux per geometric area) turns into the shading
+/// integral: 1 where ns = ng.
+#[inline]
+pub fn photon_shading_factor(wi: Vec3A, ng: Vec3A) -> f32 {
+    if ng == Vec3A::Z {
+        return 1.0;
+    }
+    let c = wi.dot(ng).abs();
+    if c > 0.0 { wi.z.abs() / c } else { 0.0 }
 }

@@ -325,7 +325,7 @@ impl PathTracer {
                 break;
             }
 
-            let frame = Frame::from_normal(hit.normal);
+            let frame = Frame::from_normal(hit.shading_normal);
             let wo = frame.to_local(wo_world);
             // The lobe and roulette numbers are computed only when used.
             let u_lobe = if matches!(bsdf, Bsdf::Diffuse { .. }) {

@@ -19,6 +19,7 @@
 //! distance from the true image (the bias) is plain to see in the error
 //! plot's plateau and shrinks with the photon count.
 
+use super::light::photon_shading_factor;
 use super::photon_map::{self, MAX_K, PhotonMap};
 use super::{IntegratorOptions, MultiPassEstimator, RayCounts, Technique};
 use crate::math::{Frame, Ray, Rgb};
@@ -131,6 +132,7 @@ impl PhotonMap2Pass {
         point: Vec3A,
         facing: Vec3A,
         frame: &Frame,
+        ng: Vec3A,
         bsdf: &Bsdf,
         wo: Vec3A,
     ) -> Rgb {
@@ -142,7 +144,8 @@ impl PhotonMap2Pass {
         let mut sum = Rgb::ZERO;
         for &(_, index) in &nearest[..found] {
             let p = map.photon(index);
-            sum += bsdf.eval(wo, frame.to_local(p.wi)) * p.power;
+            let wi = frame.to_local(p.wi);
+            sum += bsdf.eval(wo, wi) * p.power * photon_shading_factor(wi, ng);
         }
         sum / (PI * r2)
     }
@@ -169,7 +172,7 @@ impl PhotonMap2Pass {
             if !bsdf.is_specular() {
                 return Some((hit, ray.direction, beta));
             }
-            let frame = Frame::from_normal(hit.normal);
+            let frame = Frame::from_normal(hit.shading_normal);
             let wo = frame.to_local(-ray.direction);
             let u_lobe = sampler.next_1d_for(Domain::Bsdf);
             let u = sampler.next_2d_for(Domain::Bsdf);
@@ -231,6 +234,7 @@ impl MultiPassEstimator for PhotonMap2Pass {
                 x.hit.point,
                 x.facing,
                 &x.frame,
+                x.frame.to_local(x.hit.normal),
                 &x.bsdf,
                 x.wo,
             )
@@ -245,11 +249,19 @@ impl MultiPassEstimator for PhotonMap2Pass {
             if let Some((y, arrived, chain)) = self.through_specular(scene, gather, sampler, counts)
             {
                 let bsdf_y = scene.bsdf_at(&y);
-                let frame_y = Frame::from_normal(y.normal);
+                let frame_y = Frame::from_normal(y.shading_normal);
                 let wo_y = frame_y.to_local(-arrived);
-                let facing_y = if wo_y.z > 0.0 { y.normal } else { -y.normal };
-                let reflected =
-                    self.density_estimate(&maps.global, y.point, facing_y, &frame_y, &bsdf_y, wo_y);
+                let facing_y = if y.normal.dot(arrived) < 0.0 { y.normal } else { -y.normal };
+                let ng_y = frame_y.to_local(y.normal);
+                let reflected = self.density_estimate(
+                    &maps.global,
+                    y.point,
+                    facing_y,
+                    &frame_y,
+                    ng_y,
+                    &bsdf_y,
+                    wo_y,
+                );
                 radiance += x.beta * sample.weight * chain * reflected * maps.per_photon;
             }
         }

@@ -326,13 +326,18 @@ fn trace_photon(
         if bsdf.is_black() {
             break;
         }
-        let frame = Frame::from_normal(hit.normal);
+        let frame = Frame::from_normal(hit.shading_normal);
+        let ng = frame.to_local(hit.normal);
         let wo = frame.to_local(-ray.direction);
         let u_lobe = sampler.next_1d_for(Domain::Bsdf);
         let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
         let u_roulette = sampler.next_1d();
         if !bsdf.is_specular() {
-            let facing = if wo.z > 0.0 { hit.normal } else { -hit.normal };
+            let facing = if hit.normal.dot(ray.direction) < 0.0 {
+                hit.normal
+            } else {
+                -hit.normal
+            };
             store(
                 Photon {
                     point: hit.point,
@@ -353,7 +358,7 @@ fn trace_photon(
         let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
             break;
         };
-        beta *= importance_weight(bsdf, wo, sample.wi, sample.weight);
+        beta *= importance_weight(bsdf, wo, sample.wi, ng, sample.weight);
         // Roulette from the first bounce: a photon is cheap and the map
         // only needs its density right.
         if !super::survives_roulette(&mut beta, roulette_scale, u_roulette) {
@@ -411,12 +416,16 @@ pub fn camera_to_diffuse(
         if bsdf.is_black() {
             break;
         }
-        let frame = Frame::from_normal(hit.normal);
+        let frame = Frame::from_normal(hit.shading_normal);
         let wo = frame.to_local(wo_world);
         let u_lobe = sampler.next_1d_for(Domain::Bsdf);
         let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
         if !bsdf.is_specular() {
-            let facing = if wo.z > 0.0 { hit.normal } else { -hit.normal };
+            let facing = if hit.normal.dot(wo_world) > 0.0 {
+                hit.normal
+            } else {
+                -hit.normal
+            };
             let diffuse = DiffuseHit {
                 hit,
                 beta,

@@ -18,6 +18,7 @@
 //! Photons are found through the hash grid of `photon_map.rs`, built per
 //! iteration for that iteration's radius.
 
+use super::light::photon_shading_factor;
 use super::photon_map::{self, PhotonMap};
 use super::{IntegratorOptions, MultiPassEstimator, RayCounts, Technique};
 use crate::math::{Ray, Rgb};
@@ -139,8 +140,10 @@ impl MultiPassEstimator for PhotonMapper {
         }
         // Everything after a bounce: the density estimate.
         let mut sum = Rgb::ZERO;
+        let ng = x.frame.to_local(x.hit.normal);
         iteration.map.for_each_near(x.hit.point, x.facing, |p| {
-            sum += x.bsdf.eval(x.wo, x.frame.to_local(p.wi)) * p.power;
+            let wi = x.frame.to_local(p.wi);
+            sum += x.bsdf.eval(x.wo, wi) * p.power * photon_shading_factor(wi, ng);
         });
         emitted + x.direct_light(scene, sampler, counts) + x.beta * sum * iteration.normalisation
     }

@@ -395,6 +395,7 @@ impl Fixtures {
                     vertices: triangle,
                     material: 0,
                     uvs: None,
+                    normals: None,
                 }],
                 vec![],
             ),

@@ -134,15 +134,16 @@ impl Session {
     /// Refuses, before allocating, a render whose film would not fit in
     /// the memory available ([`Session::memory_estimate`]).
     pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Result<Session> {
-        if scene.lights.has_lights_bidirectional_lacks()
+        if (scene.lights.has_lights_bidirectional_lacks() || scene.features.shading_normals)
             && matches!(
                 settings.integrator.kind(),
                 crate::integrator::IntegratorKind::Bdpt | crate::integrator::IntegratorKind::Vcm
             )
         {
             return Err(Error::new(format!(
-                "{} does not handle environment, directional or spot lights yet (its MIS \
-                 needs their densities): use path, light, mcrt or photon mapping",
+                "{} does not handle environment, directional or spot lights or shading \
+                 normals yet (its MIS needs their densities and the adjoint's correction): \
+                 use path, light, mcrt or photon mapping",
                 settings.integrator.name()
             )));
         }

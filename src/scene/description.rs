@@ -202,6 +202,9 @@ pub struct MeshDesc {
     pub material: Option<String>,
     #[serde(default)]
     pub velocity: [f32; 3],
+    /// Shade flat, ignoring the file's `vn` normals (Mitsuba's `face_normals`).
+    #[serde(default)]
+    pub face_normals: bool,
 }
 
 /// `[[sphere]]`.

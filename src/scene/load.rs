@@ -126,7 +126,10 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         }
         let mut default_id = None;
         let mut mesh_triangles = Vec::with_capacity(obj.triangles.len());
-        for (vertices, mtl) in obj.triangles {
+        // Normals transform by the inverse transpose.
+        let normal_matrix = glam::Mat3A::from_mat4(transform).inverse().transpose();
+        for t in obj.triangles {
+            let (vertices, mtl) = (t.vertices, t.material);
             let material = match (override_id, mtl) {
                 (Some(id), _) => id,
                 (None, Some(i)) if i < obj_ids.len() => obj_ids[i],
@@ -136,10 +139,16 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
                 }),
             };
             let vertices = vertices.map(|v| transform.transform_point3a(v));
+            let normals = t
+                .normals
+                .filter(|_| !desc.face_normals)
+                .map(|n| n.map(|n| (normal_matrix * n).normalize_or_zero()))
+                .filter(|n| n.iter().all(|v| *v != Vec3A::ZERO && v.is_finite()));
             mesh_triangles.push(TriangleInput {
                 vertices,
                 material,
-                uvs: None,
+                uvs: t.uvs,
+                normals,
             });
             if triangles.len() + mesh_triangles.len() > limits.max_triangles {
                 return Err(at(

@@ -103,6 +103,8 @@ pub struct Features {
     pub area_lights: usize,
     /// Something moves while the shutter is open: camera rays need a time.
     pub motion: bool,
+    /// Some triangle has vertex normals.
+    pub shading_normals: bool,
 }
 
 impl Features {
@@ -144,6 +146,7 @@ impl Features {
                 })
                 .count(),
             motion: geometry.has_motion() && camera.has_shutter_interval(),
+            shading_normals: geometry.has_shading_normals(),
         }
     }
 

@@ -8,14 +8,26 @@
 use crate::error::{Error, Result};
 use crate::math::Rgb;
 use crate::scene::material::{Bsdf, Material};
-use glam::Vec3A;
+use glam::{Vec2, Vec3A};
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-/// Triangles of one OBJ file with the index of their MTL material, if any.
+/// One triangle of an OBJ file.
+pub struct ObjTriangle {
+    /// Vertex positions in file units.
+    pub vertices: [Vec3A; 3],
+    /// The `vn` normals of its vertices, if the face gives them.
+    pub normals: Option<[Vec3A; 3]>,
+    /// The `vt` coordinates, v flipped (1 − v) as Mitsuba flips them, so
+    /// that v = 0 reads an image's top row.
+    pub uvs: Option<[Vec2; 3]>,
+    /// Index of its MTL material, if any.
+    pub material: Option<usize>,
+}
+
+/// Triangles of one OBJ file.
 pub struct ObjMesh {
-    /// Vertex positions, three per triangle, in file units.
-    pub triangles: Vec<([Vec3A; 3], Option<usize>)>,
+    pub triangles: Vec<ObjTriangle>,
     /// Materials from the file's MTL libraries, converted.
     pub materials: Vec<Material>,
 }
@@ -64,11 +76,36 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh> {
                 mesh.positions[i + 2],
             )
         };
-        for face in mesh.indices.chunks_exact(3) {
-            triangles.push((
-                [vertex(face[0]), vertex(face[1]), vertex(face[2])],
-                mesh.material_id,
-            ));
+        let normal = |i: u32| -> Option<Vec3A> {
+            let i = i as usize * 3;
+            let n = Vec3A::new(
+                *mesh.normals.get(i)?,
+                *mesh.normals.get(i + 1)?,
+                *mesh.normals.get(i + 2)?,
+            )
+            .normalize_or_zero();
+            (n != Vec3A::ZERO && n.is_finite()).then_some(n)
+        };
+        let uv = |i: u32| -> Option<Vec2> {
+            let i = i as usize * 2;
+            let t = Vec2::new(*mesh.texcoords.get(i)?, 1.0 - *mesh.texcoords.get(i + 1)?);
+            t.is_finite().then_some(t)
+        };
+        for (f, face) in mesh.indices.chunks_exact(3).enumerate() {
+            let corners = |indices: &[u32]| -> Option<[u32; 3]> {
+                let c = indices.get(3 * f..3 * f + 3)?;
+                Some([c[0], c[1], c[2]])
+            };
+            let normals = corners(&mesh.normal_indices)
+                .and_then(|[a, b, c]| Some([normal(a)?, normal(b)?, normal(c)?]));
+            let uvs = corners(&mesh.texcoord_indices)
+                .and_then(|[a, b, c]| Some([uv(a)?, uv(b)?, uv(c)?]));
+            triangles.push(ObjTriangle {
+                vertices: [vertex(face[0]), vertex(face[1]), vertex(face[2])],
+                normals,
+                uvs,
+                material: mesh.material_id,
+            });
         }
     }
     Ok(ObjMesh {

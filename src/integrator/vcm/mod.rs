@@ -267,7 +267,7 @@ impl Vcm {
         let u_roulette = sampler.next_1d_for(Domain::Other);
         let sample = bsdf.sample(wo, u_lobe, u_bsdf)?;
         let weight = if importance {
-            importance_weight(bsdf, wo, sample.wi, sample.weight)
+            importance_weight(bsdf, wo, sample.wi, Vec3A::Z, sample.weight)
         } else {
             walk.relative /= bsdf.refraction_scale(wo, sample.wi);
             sample.weight
