@@ -418,18 +418,27 @@ file = "{sky}"
 fn smooth_sphere_obj() -> String {
     let (nu, nv) = (12usize, 6usize);
     let mut text = String::new();
-    let mut index = |i: usize, j: usize| 1 + j * (nu + 1) + i;
+    let index = |i: usize, j: usize| 1 + j * (nu + 1) + i;
     for j in 0..=nv {
         for i in 0..=nu {
             let theta = std::f32::consts::PI * j as f32 / nv as f32;
             let phi = std::f32::consts::TAU * i as f32 / nu as f32;
-            let n = glam::Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+            let n = glam::Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            );
             text += &format!("v {} {} {}\nvn {} {} {}\n", n.x, n.y, n.z, n.x, n.y, n.z);
         }
     }
     for j in 0..nv {
         for i in 0..nu {
-            let (a, b, c, d) = (index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1));
+            let (a, b, c, d) = (
+                index(i, j),
+                index(i + 1, j),
+                index(i + 1, j + 1),
+                index(i, j + 1),
+            );
             // Counter-clockwise seen from outside.
             text += &format!("f {a}//{a} {d}//{d} {c}//{c}\nf {a}//{a} {c}//{c} {b}//{b}\n");
         }
@@ -491,13 +500,76 @@ material = "ball"
     );
     let scene = load_scene_text("smooth-sphere", &text);
     assert!(scene.features.shading_normals);
-    let path = render(scene.clone(), Integrator::from(PathTracer::default()), 512, 31);
-    let light = render(scene.clone(), Integrator::from(LightTracer::default()), 512, 32);
+    let path = render(
+        scene.clone(),
+        Integrator::from(PathTracer::default()),
+        512,
+        31,
+    );
+    let light = render(
+        scene.clone(),
+        Integrator::from(LightTracer::default()),
+        512,
+        32,
+    );
     assert_agree("shading normals, light / path", &light, &path);
     // Flat shading differs visibly from smooth (the normals matter here).
-    let flat = load_scene_text("flat-sphere", &text.replace("material = \"ball\"\n", "material = \"ball\"\nface_normals = true\n"));
+    let flat = load_scene_text(
+        "flat-sphere",
+        &text.replace(
+            "material = \"ball\"\n",
+            "material = \"ball\"\nface_normals = true\n",
+        ),
+    );
     assert!(!flat.features.shading_normals);
     let faceted = render(flat, Integrator::from(PathTracer::default()), 512, 33);
     let worst = crate::strategies::largest_block_z(&faceted, &path);
     assert!(worst > 4.5, "flat and smooth shading agree (z {worst:.2})");
+}
+
+/// BDPT and VCM refuse what they do not handle yet, on the command line
+/// (non-zero exit, the reason) and in a session the viewer drives (a
+/// failure, no pass rendered), instead of rendering a wrong image.
+#[test]
+fn bidirectional_techniques_refuse_environment_light() {
+    let dir = crate::common::temp_dir("refuse-env");
+    let path = dir.join("env.toml");
+    let text = std::fs::read_to_string(repo_path("scenes/cornell_box.toml"))
+        .unwrap()
+        .replace(
+            "cornell_box.obj",
+            &repo_path("scenes/cornell_box.obj").display().to_string(),
+        )
+        + "\n[environment]\ntype = \"constant\"\nradiance = [0.1, 0.1, 0.1]\n";
+    std::fs::write(&path, text).unwrap();
+    for technique in ["bdpt", "vcm"] {
+        let out = crate::cli::tracelab(&[
+            "render",
+            path.to_str().unwrap(),
+            "--integrator",
+            technique,
+            "--spp",
+            "1",
+            "--out",
+            dir.join("x.exr").to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{technique} rendered");
+        assert!(stderr.contains("does not handle environment"), "{stderr}");
+    }
+    let scene = std::sync::Arc::new(tracelab::scene::Scene::load(&path).unwrap());
+    let settings = tracelab::render::RenderSettings {
+        integrator: Integrator::from(Bdpt::default()),
+        sampler: SamplerKind::Independent,
+        seed: 0,
+        planned_spp: 0,
+        threads: 1,
+        adaptive: None,
+        domains: Default::default(),
+        clamp: None,
+    };
+    let pool = tracelab::render::thread_pool(1).unwrap();
+    let session = tracelab::render::Session::with_pool(scene, settings, pool);
+    assert!(session.failure().is_some());
+    assert!(!session.render_pass(1));
 }

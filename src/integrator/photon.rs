@@ -251,7 +251,11 @@ impl MultiPassEstimator for PhotonMap2Pass {
                 let bsdf_y = scene.bsdf_at(&y);
                 let frame_y = Frame::from_normal(y.shading_normal);
                 let wo_y = frame_y.to_local(-arrived);
-                let facing_y = if y.normal.dot(arrived) < 0.0 { y.normal } else { -y.normal };
+                let facing_y = if y.normal.dot(arrived) < 0.0 {
+                    y.normal
+                } else {
+                    -y.normal
+                };
                 let ng_y = frame_y.to_local(y.normal);
                 let reflected = self.density_estimate(
                     &maps.global,

@@ -134,18 +134,8 @@ impl Session {
     /// Refuses, before allocating, a render whose film would not fit in
     /// the memory available ([`Session::memory_estimate`]).
     pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Result<Session> {
-        if (scene.lights.has_lights_bidirectional_lacks() || scene.features.shading_normals)
-            && matches!(
-                settings.integrator.kind(),
-                crate::integrator::IntegratorKind::Bdpt | crate::integrator::IntegratorKind::Vcm
-            )
-        {
-            return Err(Error::new(format!(
-                "{} does not handle environment, directional or spot lights or shading \
-                 normals yet (its MIS needs their densities and the adjoint's correction): \
-                 use path, light, mcrt or photon mapping",
-                settings.integrator.name()
-            )));
+        if let Some(e) = Session::unsupported(&scene, &settings) {
+            return Err(e);
         }
         let needed = Session::memory_estimate(&scene, &settings);
         if let Some(available) = available_memory()
@@ -163,12 +153,33 @@ impl Session {
         Ok(Self::with_pool(scene, settings, pool))
     }
 
+    /// Why `settings` cannot render `scene`, if they cannot: BDPT and VCM
+    /// do not yet handle light from infinity, spot lights or shading
+    /// normals.
+    pub fn unsupported(scene: &Scene, settings: &RenderSettings) -> Option<Error> {
+        let bidirectional = matches!(
+            settings.integrator.kind(),
+            crate::integrator::IntegratorKind::Bdpt | crate::integrator::IntegratorKind::Vcm
+        );
+        (bidirectional
+            && (scene.lights.has_lights_bidirectional_lacks() || scene.features.shading_normals))
+            .then(|| {
+                Error::new(format!(
+                    "{} does not handle environment, directional or spot lights or shading \
+                     normals yet (its MIS needs their densities and the adjoint's correction): \
+                     use path, light, mcrt or photon mapping",
+                    settings.integrator.name()
+                ))
+            })
+    }
+
     /// Starts a session on an existing pool (sessions that take turns share one).
     pub fn with_pool(
         scene: Arc<Scene>,
         settings: RenderSettings,
         pool: Arc<rayon::ThreadPool>,
     ) -> Session {
+        let unsupported = Session::unsupported(&scene, &settings);
         let settings = RenderSettings {
             integrator: settings.integrator.for_scene(&scene),
             ..settings
@@ -196,7 +207,7 @@ impl Session {
             solver_state: Mutex::new(None),
             solver_progress: Mutex::new(None),
             solver_notes: Mutex::new(Vec::new()),
-            failure: Mutex::new(None),
+            failure: Mutex::new(unsupported),
         }
     }
 
@@ -254,6 +265,9 @@ impl Session {
     /// render the whole pass with part 0 and skip the others. The pass
     /// counts (in [`RenderStats`]) once complete.
     pub fn render_pass_part(&self, k: u32, part: u32, parts: u32) -> bool {
+        if lock(&self.failure).is_some() {
+            return false;
+        }
         let start = Instant::now();
         let first = self.spp.load(Ordering::Relaxed);
         let parts = parts.max(1);

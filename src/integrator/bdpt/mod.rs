@@ -459,7 +459,9 @@ impl Bdpt {
                     relative /= bsdf.refraction_scale(wo, sample.wi);
                     sample.weight
                 }
-                Transport::Importance => importance_weight(bsdf, wo, sample.wi, Vec3A::Z, sample.weight),
+                Transport::Importance => {
+                    importance_weight(bsdf, wo, sample.wi, Vec3A::Z, sample.weight)
+                }
             };
             let (pdf_fwd, pdf_rev) = if sample.specular {
                 (0.0, 0.0)
