@@ -26,7 +26,9 @@ fn scene(name: &str) -> Scene {
     scene
 }
 
-fn render(scene: Scene, integrator: Integrator, spp: u32, seed: u64) -> FilmSnapshot {
+/// Renders in passes of 1 spp for splatting estimators (their film's
+/// standard error is then exact), 8 otherwise.
+pub(crate) fn render(scene: Scene, integrator: Integrator, spp: u32, seed: u64) -> FilmSnapshot {
     let pass = if matches!(integrator, Integrator::Splatting(_)) {
         1
     } else {

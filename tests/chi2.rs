@@ -119,30 +119,7 @@ fn uniform_cone() {
 }
 
 fn check_bsdf(name: &str, bsdf: Bsdf, wo: Vec3A, seed: u64) {
-    check_directions(
-        name,
-        |i| {
-            let s = bsdf.sample(
-                wo,
-                uniform(seed, i, 0),
-                Vec2::new(uniform(seed, i, 1), uniform(seed, i, 2)),
-            )?;
-            // The sample's own pdf and weight must agree with pdf() and eval().
-            let pdf = bsdf.pdf(wo, s.wi);
-            assert!(
-                (s.pdf - pdf).abs() <= 1e-4 * pdf.max(1.0),
-                "{name}: sample pdf {} vs pdf() {pdf}",
-                s.pdf
-            );
-            let weight = bsdf.eval(wo, s.wi) * s.wi.z.abs() / pdf;
-            assert!(
-                (s.weight - weight).abs().max_element() <= 1e-3 * weight.max_element().max(1.0),
-                "{name}: weight"
-            );
-            Some(s.wi)
-        },
-        |w| bsdf.pdf(wo, w) as f64,
-    );
+    check_bsdf_events(name, bsdf, wo, seed);
 }
 
 #[test]

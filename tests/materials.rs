@@ -5,9 +5,9 @@
 //! tracing cannot see directly), BDPT and VCM agree with path tracing and
 //! SPPM converges to the same mean.
 
+use crate::bidirectional::render;
 use crate::common::{load_scene_text, render_with, repo_path};
 use crate::strategies::{SIZE, assert_agree};
-use tracelab::film::FilmSnapshot;
 use tracelab::integrator::vcm::Vcm;
 use tracelab::integrator::{Bdpt, Integrator, LightTracer, MultiPassIntegrator, PathTracer};
 use tracelab::sampling::SamplerKind;
@@ -133,25 +133,6 @@ center = [0.0, 1.2, -0.8]
 radius = 0.25
 material = "wet"
 "#;
-
-fn render(scene: Scene, integrator: Integrator, spp: u32, seed: u64) -> FilmSnapshot {
-    let pass = if matches!(integrator, Integrator::Splatting(_)) {
-        1
-    } else {
-        8
-    };
-    let (snapshot, stats) = render_with(
-        scene,
-        integrator,
-        SamplerKind::Independent,
-        spp,
-        seed,
-        0,
-        pass,
-    );
-    assert_eq!(stats.non_finite, 0);
-    snapshot
-}
 
 #[test]
 fn every_technique_agrees_on_rough_materials() {

@@ -73,6 +73,10 @@ impl TriangleInput {
     }
 }
 
+/// Set in [`SurfaceHit::primitive`] for hits on moving objects, whose
+/// indices are their own object's.
+pub const MOVING_PRIMITIVE: u32 = 1 << 31;
+
 /// What a closest-hit query found.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceHit {
@@ -91,14 +95,10 @@ pub struct SurfaceHit {
     pub light: u32,
     /// Time of the ray that found the hit, inherited by rays spawned here.
     pub time: f32,
-    /// Unit shading normal: the vertex normals interpolated, or the
-    /// geometric normal. BSDFs act in its frame; offsets, emission and
-    /// area densities use the geometric one.
-    pub shading_normal: Vec3A,
-    /// Texture coordinates: interpolated from the triangle's (barycentrics
-    /// where the geometry keeps none), or (φ / 2π, θ / π) on a sphere as
-    /// Mitsuba's.
-    pub uv: Vec2,
+    /// Barycentric coordinates (b1, b2) of a triangle hit, from which
+    /// [`Geometry::shading_normal`] and [`Geometry::uv`] interpolate only
+    /// when asked (they fit in the record's padding).
+    pub barycentric: Vec2,
     /// Which primitive: a triangle's index, or the triangle count plus a
     /// sphere's index (within one object, for diagnostics such as counting
     /// self-intersections).
@@ -496,6 +496,48 @@ impl Geometry {
         b
     }
 
+    /// The unit shading normal at `hit`: its triangle's vertex normals
+    /// interpolated, else the geometric normal. BSDFs act in its frame;
+    /// offsets, emission and area densities keep the geometric one.
+    /// Moving objects shade with their geometric normals.
+    #[inline(always)]
+    pub fn shading_normal(&self, hit: &SurfaceHit) -> Vec3A {
+        match self.tri_normals.get(hit.primitive as usize) {
+            Some([n0, n1, n2]) => {
+                let (b1, b2) = (hit.barycentric.x, hit.barycentric.y);
+                let n = ((1.0 - b1 - b2) * *n0 + b1 * *n1 + b2 * *n2).normalize_or_zero();
+                if n == Vec3A::ZERO { hit.normal } else { n }
+            }
+            None => hit.normal,
+        }
+    }
+
+    /// Texture coordinates at `hit`: interpolated from its triangle's (the
+    /// barycentrics where none were kept), or (φ / 2π, θ / π) on a sphere as
+    /// Mitsuba's.
+    #[inline]
+    pub fn uv(&self, hit: &SurfaceHit) -> Vec2 {
+        let i = hit.primitive as usize;
+        if let Some([t0, t1, t2]) = self.tri_uvs.get(i) {
+            let (b1, b2) = (hit.barycentric.x, hit.barycentric.y);
+            return (1.0 - b1 - b2) * *t0 + b1 * *t1 + b2 * *t2;
+        }
+        if hit.primitive & MOVING_PRIMITIVE == 0 && i >= self.tri_vertices.len() {
+            let n = hit.normal;
+            let phi = n.y.atan2(n.x);
+            let phi = if phi < 0.0 {
+                phi + std::f32::consts::TAU
+            } else {
+                phi
+            };
+            return Vec2::new(
+                phi * (0.5 * std::f32::consts::FRAC_1_PI),
+                n.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
+            );
+        }
+        hit.barycentric
+    }
+
     /// True when some triangle shades with interpolated vertex normals.
     pub fn has_shading_normals(&self) -> bool {
         !self.tri_normals.is_empty() || self.moving.iter().any(|m| m.geometry.has_shading_normals())
@@ -545,6 +587,8 @@ impl Geometry {
             };
             if let Some(mut hit) = m.geometry.intersect_static(&local) {
                 hit.point += shift;
+                // Its arrays are the object's own: interpolation reads none.
+                hit.primitive |= MOVING_PRIMITIVE;
                 // The translation back adds one rounding per component.
                 hit.error += gamma(1) * hit.point.abs();
                 best = Some(hit);
@@ -600,26 +644,10 @@ impl Geometry {
             let normal = (ray.at(best_t) - s.center).normalize();
             let local = s.radius * normal;
             let point = s.center + local;
-            // An atan2 and an acos per hit: only where textures are read.
-            let uv = if self.keep_uvs {
-                let phi = normal.y.atan2(normal.x);
-                let phi = if phi < 0.0 {
-                    phi + std::f32::consts::TAU
-                } else {
-                    phi
-                };
-                Vec2::new(
-                    phi * (0.5 * std::f32::consts::FRAC_1_PI),
-                    normal.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
-                )
-            } else {
-                Vec2::ZERO
-            };
             return Some(SurfaceHit {
                 t: best_t,
                 point,
-                uv,
-                shading_normal: normal,
+                barycentric: Vec2::ZERO,
                 // Re-projection onto the sphere (gamma(5), pbrt-v4 6.8.5) plus
                 // the translation by the centre.
                 error: gamma(5) * local.abs() + gamma(1) * point.abs(),
@@ -652,22 +680,10 @@ impl Geometry {
         let shading = self.tri_shading[index as usize];
         let b0 = 1.0 - best_b1 - best_b2;
         let point = b0 * p0 + best_b1 * p1 + best_b2 * p2;
-        let uv = match self.tri_uvs.get(index as usize) {
-            Some([t0, t1, t2]) => b0 * *t0 + best_b1 * *t1 + best_b2 * *t2,
-            None => Vec2::new(best_b1, best_b2),
-        };
-        let shading_normal = match self.tri_normals.get(index as usize) {
-            Some([n0, n1, n2]) => {
-                let n = (b0 * *n0 + best_b1 * *n1 + best_b2 * *n2).normalize_or_zero();
-                if n == Vec3A::ZERO { shading.normal } else { n }
-            }
-            None => shading.normal,
-        };
         SurfaceHit {
             t: best_t,
             point,
-            uv,
-            shading_normal,
+            barycentric: Vec2::new(best_b1, best_b2),
             // Barycentric interpolation (pbrt-v4 6.8.4).
             error: gamma(7) * ((b0 * p0).abs() + (best_b1 * p1).abs() + (best_b2 * p2).abs()),
             normal: shading.normal,

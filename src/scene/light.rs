@@ -336,43 +336,14 @@ impl Light {
             Light::Point {
                 position,
                 intensity,
-            } => {
-                let to_light = position - reference;
-                let dist2 = to_light.length_squared();
-                let distance = dist2.sqrt();
-                Some(LightSample {
-                    point: position,
-                    error: Vec3A::ZERO,
-                    normal: Vec3A::ZERO,
-                    wi: to_light / distance,
-                    distance,
-                    radiance: intensity / dist2,
-                    pdf: 1.0,
-                    delta: true,
-                    light: 0,
-                })
-            }
+            } => Some(point_sample(reference, position, |_| intensity)),
             Light::Spot {
                 position,
                 intensity,
                 cone,
             } => {
-                let to_light = position - reference;
-                let dist2 = to_light.length_squared();
-                let distance = dist2.sqrt();
-                let wi = to_light / distance;
-                let falloff = cone.falloff(-wi);
-                (falloff > 0.0).then_some(LightSample {
-                    point: position,
-                    error: Vec3A::ZERO,
-                    normal: Vec3A::ZERO,
-                    wi,
-                    distance,
-                    radiance: intensity * (falloff / dist2),
-                    pdf: 1.0,
-                    delta: true,
-                    light: 0,
-                })
+                let s = point_sample(reference, position, |w| intensity * cone.falloff(w));
+                (s.radiance.max_element() > 0.0).then_some(s)
             }
             Light::Directional {
                 direction,
@@ -442,6 +413,31 @@ impl Light {
             }
             Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => 0.0,
         }
+    }
+}
+
+/// The sample of a light at a point: radiance I(w) / d², `w` the unit
+/// direction from the light to `reference`.
+#[inline(always)]
+fn point_sample(
+    reference: Vec3A,
+    position: Vec3A,
+    intensity: impl Fn(Vec3A) -> Rgb,
+) -> LightSample {
+    let to_light = position - reference;
+    let dist2 = to_light.length_squared();
+    let distance = dist2.sqrt();
+    let wi = to_light / distance;
+    LightSample {
+        point: position,
+        error: Vec3A::ZERO,
+        normal: Vec3A::ZERO,
+        wi,
+        distance,
+        radiance: intensity(-wi) / dist2,
+        pdf: 1.0,
+        delta: true,
+        light: 0,
     }
 }
 

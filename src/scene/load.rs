@@ -839,6 +839,23 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
             )),
         }
     };
+    // A dielectric's reflection and transmission tints.
+    let tints = || -> std::result::Result<(Rgb, Rgb), String> {
+        Ok((
+            colour(
+                "specular_reflectance",
+                d.specular_reflectance,
+                Rgb::ONE,
+                1.0,
+            )?,
+            colour(
+                "specular_transmittance",
+                d.specular_transmittance,
+                Rgb::ONE,
+                1.0,
+            )?,
+        ))
+    };
     let two_sided = d.twosided.unwrap_or(false);
     let bsdf = match d.kind {
         K::Diffuse => Bsdf::Diffuse {
@@ -896,37 +913,23 @@ fn build_material(name: &str, d: &MaterialDesc) -> std::result::Result<Material,
                 two_sided,
             }
         }
-        K::ThinDielectric => Bsdf::ThinDielectric(ThinDielectric {
-            eta: relative_ior(1.5046)?,
-            reflectance: colour(
-                "specular_reflectance",
-                d.specular_reflectance,
-                Rgb::ONE,
-                1.0,
-            )?,
-            transmittance: colour(
-                "specular_transmittance",
-                d.specular_transmittance,
-                Rgb::ONE,
-                1.0,
-            )?,
-        }),
-        K::RoughDielectric => Bsdf::RoughDielectric(RoughDielectric {
-            microfacet: microfacet()?,
-            eta: relative_ior(1.5046)?,
-            reflectance: colour(
-                "specular_reflectance",
-                d.specular_reflectance,
-                Rgb::ONE,
-                1.0,
-            )?,
-            transmittance: colour(
-                "specular_transmittance",
-                d.specular_transmittance,
-                Rgb::ONE,
-                1.0,
-            )?,
-        }),
+        K::ThinDielectric => {
+            let (reflectance, transmittance) = tints()?;
+            Bsdf::ThinDielectric(ThinDielectric {
+                eta: relative_ior(1.5046)?,
+                reflectance,
+                transmittance,
+            })
+        }
+        K::RoughDielectric => {
+            let (reflectance, transmittance) = tints()?;
+            Bsdf::RoughDielectric(RoughDielectric {
+                microfacet: microfacet()?,
+                eta: relative_ior(1.5046)?,
+                reflectance,
+                transmittance,
+            })
+        }
         K::Plastic | K::RoughPlastic => {
             let eta = relative_ior(1.49)?;
             let diffuse = colour(

@@ -447,7 +447,11 @@ impl Scene {
     /// The BSDF at `hit`, its textures read.
     #[inline]
     pub fn bsdf_at(&self, hit: &SurfaceHit) -> crate::bsdf::Bsdf {
-        self.materials[hit.material as usize].bsdf_at(&self.textures, hit.uv)
+        let material = &self.materials[hit.material as usize];
+        if material.textures.is_empty() {
+            return material.bsdf;
+        }
+        material.bsdf_at(&self.textures, self.geometry.uv(hit))
     }
 
     /// Samples every area light by `mode` (the CLI's `--light-sampling`).

@@ -355,7 +355,7 @@ impl Vcm {
                     wo: wo_world,
                     beta: walk.beta,
                     material: hit.material,
-                    uv: hit.uv,
+                    uv: scene.geometry.uv(&hit),
                     segments,
                     d_vcm: walk.d_vcm,
                     d_vc: walk.d_vc,
