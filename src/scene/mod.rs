@@ -1,6 +1,7 @@
 //! Scenes: camera, geometry, materials and lights, loaded from TOML + OBJ/MTL
 //! and checked before anything renders.
 
+mod appearance;
 pub mod description;
 pub mod emitters;
 pub mod environment;
