@@ -245,6 +245,9 @@ impl Hierarchy {
                  patches, and camera rays are traced through them (caustics are missing)"
             ));
         }
+        if let Some(note) = super::mesh::unpatched_lights(scene) {
+            h.notes.push(note);
+        }
         // Without clustering every pair of patches starts with a link.
         if h.nodes.len() > MAX_PATCHES {
             return Err(format!(

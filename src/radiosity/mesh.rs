@@ -204,6 +204,9 @@ impl Mesh {
                  patches, and camera rays are traced through them (caustics are missing)"
             ));
         }
+        if let Some(note) = unpatched_lights(scene) {
+            mesh.notes.push(note);
+        }
         if !mesh.elements.iter().any(|e| e.emission.max_element() > 0.0) {
             return Err(
                 "radiosity needs an emissive diffuse surface: the scene has none \
@@ -418,6 +421,18 @@ pub fn child_at(b: &mut [f32; 3]) -> usize {
         }
     };
     child
+}
+
+/// A note naming the lights radiosity cannot see: only emissive patches
+/// emit in it.
+pub(crate) fn unpatched_lights(scene: &Scene) -> Option<String> {
+    let points = scene.features.point_lights;
+    let environment = scene.lights.environment().is_some();
+    (points || environment).then(|| {
+        "point, spot and directional lights and the environment are not patches: \
+         radiosity ignores them"
+            .to_string()
+    })
 }
 
 #[cfg(test)]
