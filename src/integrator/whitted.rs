@@ -264,7 +264,7 @@ fn point_equivalent(light: &Light, reference: Vec3A) -> (Vec3A, Vec3A, Rgb) {
             radius,
         } => {
             // A point far against the light whose intensity gives E there.
-            let distance = 2.0 * radius + (reference - center).length();
+            let distance = crate::scene::light::beyond_bounds(reference, center, radius);
             let position = reference - direction * distance;
             (position, position, irradiance * distance * distance)
         }

@@ -7,9 +7,9 @@
 //! p(u, v) / (2π² sin θ). Light paths start on a disc of the scene's
 //! bounding radius facing the sampled direction.
 
-use crate::math::{Frame, Rgb, luminance};
+use crate::math::{Rgb, luminance};
 use crate::sampling::piecewise::Piecewise2D;
-use crate::sampling::warp::{square_to_concentric_disk, square_to_uniform_sphere};
+use crate::sampling::warp::square_to_uniform_sphere;
 use crate::texture::Bitmap;
 use glam::{Mat3A, Vec2, Vec3A};
 use std::f32::consts::PI;
@@ -163,9 +163,7 @@ impl Environment {
         u_direction: Vec2,
     ) -> Option<(Vec3A, Vec3A, Rgb, f32, f32)> {
         let (d, le, pdf_direction) = self.sample(u_direction)?;
-        let disk = square_to_concentric_disk(u_position) * self.radius;
-        let frame = Frame::from_normal(d);
-        let point = self.center + self.radius * d + frame.s * disk.x + frame.t * disk.y;
+        let point = super::light::disc_point(self.center, self.radius, d, u_position);
         let pdf_position = 1.0 / (PI * self.radius * self.radius);
         Some((point, -d, le, pdf_position, pdf_direction))
     }

@@ -351,7 +351,7 @@ impl Light {
                 radius,
             } => {
                 // A point beyond the bounding sphere, against the light.
-                let distance = 2.0 * radius + (reference - center).length();
+                let distance = beyond_bounds(reference, center, radius);
                 Some(LightSample {
                     point: reference - direction * distance,
                     error: Vec3A::ZERO,
@@ -413,6 +413,23 @@ impl Light {
             Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => 0.0,
         }
     }
+}
+
+/// A distance from `reference` that ends beyond the bounding sphere
+/// (`center`, `radius`): where shadow rays towards light at infinity stop.
+#[inline]
+pub fn beyond_bounds(reference: Vec3A, center: Vec3A, radius: f32) -> f32 {
+    2.0 * radius + (reference - center).length()
+}
+
+/// A point, uniform by area for `u`, on the disc of the bounding sphere's
+/// radius that faces unit direction `toward` from outside the sphere:
+/// where light paths from infinity start.
+#[inline]
+pub fn disc_point(center: Vec3A, radius: f32, toward: Vec3A, u: Vec2) -> Vec3A {
+    let disk = square_to_concentric_disk(u) * radius;
+    let frame = Frame::from_normal(toward);
+    center + radius * toward + frame.s * disk.x + frame.t * disk.y
 }
 
 /// The sample of a light at a point: radiance I(w) / d², `w` the unit
@@ -673,9 +690,7 @@ impl Light {
                 center,
                 radius,
             } => {
-                let disk = square_to_concentric_disk(u_position) * radius;
-                let frame = Frame::from_normal(direction);
-                let point = center - radius * direction + frame.s * disk.x + frame.t * disk.y;
+                let point = disc_point(center, radius, -direction, u_position);
                 let pdf_position = 1.0 / (PI * radius * radius);
                 return Some(EmissionSample {
                     point,

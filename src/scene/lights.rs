@@ -225,7 +225,7 @@ impl Environment {
     #[inline]
     fn sample_from(&self, reference: Vec3A, u: Vec2) -> Option<LightSample> {
         let (wi, radiance, pdf) = self.sample(u)?;
-        let distance = 2.0 * self.radius + (reference - self.center).length();
+        let distance = super::light::beyond_bounds(reference, self.center, self.radius);
         Some(LightSample {
             point: reference + wi * distance,
             error: Vec3A::ZERO,
