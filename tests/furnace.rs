@@ -46,6 +46,8 @@ fn camera() -> Camera {
 
 fn sphere_furnace() -> Scene {
     Scene::build(SceneInput {
+        warnings: Vec::new(),
+        hints: Default::default(),
         environment: None,
         textures: Vec::new(),
         camera: camera(),
@@ -99,6 +101,8 @@ fn cube_furnace() -> Scene {
         });
     }
     Scene::build(SceneInput {
+        warnings: Vec::new(),
+        hints: Default::default(),
         environment: None,
         textures: Vec::new(),
         camera: camera(),

@@ -21,7 +21,7 @@ use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
 use tracelab::replay::replay_sample;
 use tracelab::sampling::{Domains, SamplerKind};
 use tracelab::scene::light::LightSampling;
-use tracelab::scene::{Limits, Scene};
+use tracelab::scene::{Limits, LoadOptions, RenderHints, Scene};
 use tracelab::{Error, Result};
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -87,10 +87,17 @@ enum MisArg {
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Scene file (TOML).
+    /// Scene file: tracelab TOML, Mitsuba XML, or a bare OBJ or PLY mesh.
     scene: PathBuf,
-    #[arg(long, value_enum, default_value = "path")]
-    integrator: IntegratorArg,
+    /// Technique (default: the scene file's integrator, else path).
+    #[arg(long, value_enum)]
+    integrator: Option<IntegratorArg>,
+    /// Mitsuba XML: set a parameter `$name` (as Mitsuba's -D).
+    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+    define: Vec<(String, String)>,
+    /// Make every warning about the scene file an error.
+    #[arg(long)]
+    strict: bool,
     /// Samples per pixel.
     #[arg(long, conflicts_with_all = ["time", "rays_per_pixel"])]
     spp: Option<u32>,
@@ -101,18 +108,21 @@ pub struct RenderArgs {
     /// Render until this many rays per pixel (all kinds) are cast: equal-cost comparisons.
     #[arg(long)]
     rays_per_pixel: Option<f64>,
-    #[arg(long, value_enum, default_value = "independent")]
-    sampler: SamplerArg,
+    /// Sampler (default: the scene file's, else independent).
+    #[arg(long, value_enum)]
+    sampler: Option<SamplerArg>,
     /// Domains the sampler applies to, the rest independent: any of
     /// pixel,lens,time,light,bsdf (default all).
     #[arg(long, value_parser = parse_domains)]
     domains: Option<Domains>,
-    /// Maximum bounces (1 = direct lighting); Mitsuba's max_depth is one more.
-    #[arg(long, default_value_t = 8)]
-    max_depth: u32,
-    /// Russian roulette starts after this many bounces.
-    #[arg(long, default_value_t = 5)]
-    rr_depth: u32,
+    /// Maximum bounces (1 = direct lighting); Mitsuba's max_depth is one
+    /// more (default: the scene file's, else 8).
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Russian roulette starts after this many bounces (default: the scene
+    /// file's, else 5).
+    #[arg(long)]
+    rr_depth: Option<u32>,
     /// Turn Russian roulette off.
     #[arg(long)]
     no_rr: bool,
@@ -299,7 +309,15 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         max_triangles: args.max_triangles,
     };
     let load_start = Instant::now();
-    let mut scene = Scene::load_with_limits(&args.scene, &limits)?;
+    let mut scene = Scene::load_with(
+        &args.scene,
+        &LoadOptions {
+            limits,
+            defines: args.define.clone(),
+            strict: args.strict,
+        },
+    )?;
+    let hints = scene.hints.clone();
     override_resolution(&mut scene, args.width, args.height, &limits)?;
     if let Some(mode) = args.light_sampling {
         scene.set_light_sampling(match mode {
@@ -309,17 +327,28 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     }
     scene.set_offset(args.offset);
     for w in &scene.warnings {
-        eprintln!("warning: {}: {w}", args.scene.display());
+        // Importer warnings already name their file and line.
+        match w.starts_with(&args.scene.display().to_string()) {
+            true => eprintln!("warning: {w}"),
+            false => eprintln!("warning: {}: {w}", args.scene.display()),
+        }
     }
     let load_time = load_start.elapsed();
 
-    let integrator = integrator_options(args)?.build();
-    let sampler = args.sampler.kind();
+    let integrator = integrator_options(args, &hints)?.build();
+    let sampler = match (args.sampler, &hints.sampler) {
+        (Some(s), _) => s.kind(),
+        (None, Some(name)) => SamplerArg::from_str(name, true)
+            .map_err(|e| Error::new(format!("the scene's sampler: {e}")))?
+            .kind(),
+        (None, None) => SamplerKind::Independent,
+    };
+    let spp_arg = args.spp.or(hints.spp);
     if let Some(dir) = &args.strategies {
         let Integrator::Splatting(SplattingIntegrator::Bdpt(bdpt)) = integrator else {
             return Err(Error::new("--strategies needs --integrator bdpt"));
         };
-        let spp = args.spp.unwrap_or(16);
+        let spp = spp_arg.unwrap_or(16);
         let sampler = tracelab::sampling::Sampler::new(sampler, args.seed, spp)
             .with_domains(args.domains.unwrap_or_default());
         return super::strategies::write(&scene, &bdpt, &sampler, spp, dir);
@@ -349,7 +378,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     } else if args.time.is_some() || args.rays_per_pixel.is_some() {
         None
     } else {
-        Some(args.spp.unwrap_or(64))
+        Some(spp_arg.unwrap_or(64))
     };
     let settings = RenderSettings {
         integrator,
@@ -508,7 +537,20 @@ fn render_rays(session: &Session, budget: f64) -> RenderStats {
 }
 
 /// Estimator options from the command line.
-fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
+fn integrator_options(args: &RenderArgs, hints: &RenderHints) -> Result<IntegratorOptions> {
+    let kind = match (args.integrator, &hints.integrator) {
+        (Some(i), _) => integrator_kind(i),
+        (None, Some(name)) => IntegratorKind::ALL
+            .iter()
+            .copied()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| {
+                Error::new(format!(
+                    "the scene asks for an unknown technique \"{name}\""
+                ))
+            })?,
+        (None, None) => IntegratorKind::Path,
+    };
     let strategy = match (args.strategy, args.no_nee, args.mis) {
         (Some(StrategyArg::Bsdf), ..) | (None, true, _) => Strategy::Bsdf,
         (Some(StrategyArg::Light), ..) | (None, false, MisArg::None) => Strategy::Light,
@@ -545,18 +587,16 @@ fn integrator_options(args: &RenderArgs) -> Result<IntegratorOptions> {
             args.alpha
         )));
     }
-    if integrator_kind(args.integrator) == IntegratorKind::Mcrt
-        && args.shadow_rays + args.glossy_rays == 0
-    {
+    if kind == IntegratorKind::Mcrt && args.shadow_rays + args.glossy_rays == 0 {
         return Err(Error::new(
             "--shadow-rays and --glossy-rays cannot both be 0",
         ));
     }
     Ok(IntegratorOptions {
-        kind: integrator_kind(args.integrator),
-        max_depth: args.max_depth,
+        kind,
+        max_depth: args.max_depth.or(hints.max_depth).unwrap_or(8),
         russian_roulette: !args.no_rr,
-        rr_depth: args.rr_depth,
+        rr_depth: args.rr_depth.or(hints.rr_depth).unwrap_or(5),
         strategy,
         mis: match args.mis {
             MisArg::Balance => MisHeuristic::Balance,
@@ -695,4 +735,12 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         stats.samples as f64 / seconds * 1e-6,
         stats.non_finite
     );
+}
+
+/// `-D name=value`.
+fn parse_define(s: &str) -> std::result::Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((n, v)) if !n.is_empty() => Ok((n.to_string(), v.to_string())),
+        _ => Err(format!("expected NAME=VALUE, got \"{s}\"")),
+    }
 }

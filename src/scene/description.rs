@@ -239,9 +239,10 @@ pub struct PointLightDesc {
 }
 
 /// Kinds of material in `[materials.NAME]`.
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum MaterialKind {
+    #[default]
     Diffuse,
     Glossy,
     Mirror,
@@ -266,7 +267,7 @@ pub enum IorDesc {
 
 /// `[materials.NAME]`. Which fields apply depends on `type`; the loader
 /// rejects the others so that a typo never goes unnoticed.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDesc {
     #[serde(rename = "type")]

@@ -5,7 +5,7 @@ use super::appearance::{build_environment, build_material, build_texture, materi
 use super::description::*;
 use super::material::{Bsdf, Material};
 use super::obj::load_obj;
-use super::{Limits, MAX_COORDINATE, MovingInput, SceneInput, in_range};
+use super::{Limits, LoadOptions, MAX_COORDINATE, MovingInput, SceneInput, in_range};
 use crate::accel::{NO_LIGHT, Sphere, TriangleInput};
 use crate::camera::Camera;
 use crate::error::{Error, Result, line_of};
@@ -16,6 +16,42 @@ use glam::{EulerRot, Mat4, Quat, Vec3, Vec3A};
 use std::collections::HashMap;
 use std::path::Path;
 use toml::Spanned;
+
+/// Reads a scene of any format the loader knows, by its extension: tracelab
+/// TOML, Mitsuba XML, or a bare OBJ or PLY mesh (framed by a default camera
+/// and lit by a constant environment).
+pub fn load_any(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let not_toml = |what: &str| {
+        if !options.defines.is_empty() {
+            return Err(Error::at(
+                path,
+                None,
+                format!("-D applies to Mitsuba XML files, not {what}"),
+            ));
+        }
+        Ok(())
+    };
+    match extension.as_deref() {
+        Some("xml") => super::mitsuba::load_mitsuba(path, options),
+        Some("obj" | "ply") => {
+            not_toml("meshes")?;
+            super::framing::bare_mesh(path, &options.limits)
+        }
+        Some("gltf" | "glb") => Err(Error::at(
+            path,
+            None,
+            "glTF import is not built yet (scenes: .toml, .xml; meshes: .obj, .ply)",
+        )),
+        _ => {
+            not_toml("TOML scenes")?;
+            load_scene_file(path, &options.limits)
+        }
+    }
+}
 
 /// Reads a scene file and everything it references.
 pub fn load_scene_file(path: &Path, limits: &Limits) -> Result<SceneInput> {
@@ -318,6 +354,8 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         moving,
         sphere_sampling: file.lights.sphere_sampling,
         triangle_sampling: file.lights.triangle_sampling,
+        warnings: Vec::new(),
+        hints: Default::default(),
     })
 }
 

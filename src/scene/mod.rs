@@ -5,11 +5,16 @@ mod appearance;
 pub mod description;
 pub mod emitters;
 pub mod environment;
+pub mod framing;
 pub mod light;
 pub mod lights;
 pub mod load;
 pub mod material;
+pub mod mesh;
+pub mod mitsuba;
 pub mod obj;
+pub mod ply;
+pub mod serialized;
 
 use crate::accel::{AccelChoice, Geometry, NO_LIGHT, Sphere, SurfaceHit, TriangleInput};
 use crate::camera::Camera;
@@ -63,6 +68,33 @@ impl Limits {
     }
 }
 
+/// How a scene file is read: limits, parameters for Mitsuba's `$name`s
+/// (`-D name=value`), and whether warnings are errors.
+#[derive(Clone, Debug, Default)]
+pub struct LoadOptions {
+    pub limits: Limits,
+    pub defines: Vec<(String, String)>,
+    pub strict: bool,
+}
+
+/// Bounces that stand for Mitsuba's unbounded `max_depth = -1` (Russian
+/// roulette ends paths long before).
+pub const UNBOUNDED_DEPTH: u32 = 100;
+
+/// What an imported file asks of the renderer (Mitsuba's integrator and
+/// sampler), used where the command line does not say otherwise.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct RenderHints {
+    /// A technique's name (`IntegratorKind::name`).
+    pub integrator: Option<String>,
+    /// Bounces, tracelab's count (Mitsuba's `max_depth` − 1).
+    pub max_depth: Option<u32>,
+    pub rr_depth: Option<u32>,
+    pub spp: Option<u32>,
+    /// A sampler's name as the CLI takes it.
+    pub sampler: Option<String>,
+}
+
 /// Everything a scene is made of, before acceleration structures are built.
 #[derive(Clone, Debug)]
 pub struct SceneInput {
@@ -79,6 +111,9 @@ pub struct SceneInput {
     pub moving: Vec<MovingInput>,
     pub sphere_sampling: LightSampling,
     pub triangle_sampling: LightSampling,
+    /// What the file asked for and did not get exactly (file:line: what).
+    pub warnings: Vec<String>,
+    pub hints: RenderHints,
 }
 
 /// One object moving by `velocity` per unit of time, given at time 0.
@@ -244,6 +279,8 @@ pub struct Scene {
     pub features: Features,
     /// Things the user should know that did not stop loading (dropped triangles, ...).
     pub warnings: Vec<String>,
+    /// What the scene file asked of the renderer.
+    pub hints: RenderHints,
     /// What the renderer knows in advance about the rays of a small scene
     /// (`crate::shortcuts`): per-pixel candidates for camera rays, built for
     /// `camera` when first asked for, and per-voxel occluders of shadow rays.
@@ -273,13 +310,25 @@ impl Scene {
 
     /// Loads a scene file.
     pub fn load_with_limits(path: &Path, limits: &Limits) -> Result<Scene> {
-        Scene::build(load::load_scene_file(path, limits)?)
+        Self::load_with(
+            path,
+            &LoadOptions {
+                limits: *limits,
+                ..Default::default()
+            },
+        )
+    }
+
+    /// Loads a scene file of any format ([`load::load_any`]).
+    pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene> {
+        Scene::build(load::load_any(path, options)?)
     }
 
     /// Drops degenerate primitives (with a warning that counts them), builds
     /// the BVHs and turns every emissive primitive into a light.
     pub fn build(input: SceneInput) -> Result<Scene> {
-        let mut warnings = Vec::new();
+        let mut warnings = input.warnings;
+        let hints = input.hints;
         let mut dropped = Dropped::default();
         let triangles = dropped.triangles(input.triangles);
         let spheres = dropped.spheres(input.spheres);
@@ -430,6 +479,7 @@ impl Scene {
             textures: input.textures,
             lights,
             warnings,
+            hints,
             shortcuts,
         })
     }

@@ -1,0 +1,235 @@
+//! Indexed triangle meshes as the importers read them (PLY, Mitsuba's
+//! serialized format, glTF, Mitsuba's built-in shapes), placed into the
+//! scene by a transform.
+
+use crate::accel::TriangleInput;
+use glam::{Mat3A, Mat4, Vec2, Vec3, Vec3A};
+use std::f32::consts::TAU;
+
+/// A mesh in its own coordinates.
+#[derive(Clone, Debug, Default)]
+pub struct MeshData {
+    pub positions: Vec<Vec3>,
+    /// Per-vertex normals (smooth shading), if the file has them.
+    pub normals: Option<Vec<Vec3>>,
+    pub uvs: Option<Vec<Vec2>>,
+    pub indices: Vec<[u32; 3]>,
+}
+
+/// How a mesh's orientation follows a mirroring transform.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Orientation {
+    /// The front is where the transformed winding says (mesh files in
+    /// Mitsuba: a mirror turns them inside out).
+    Winding,
+    /// The front follows the normal transformed by the inverse transpose
+    /// (Mitsuba's analytic shapes: a mirror keeps them outward).
+    Normal,
+}
+
+impl MeshData {
+    /// Checks indices and values; the message says what is wrong.
+    pub fn validate(&self) -> Result<(), String> {
+        let n = self.positions.len();
+        if let Some(bad) = self.indices.iter().flatten().find(|&&i| i as usize >= n) {
+            return Err(format!("vertex index {bad} out of range ({n} vertices)"));
+        }
+        if !self.positions.iter().all(|p| p.is_finite()) {
+            return Err("a vertex position is not finite".into());
+        }
+        for (what, len) in [
+            ("normals", self.normals.as_ref().map(Vec::len)),
+            ("texture coordinates", self.uvs.as_ref().map(Vec::len)),
+        ] {
+            if let Some(len) = len.filter(|&l| l != n) {
+                return Err(format!("{len} {what} for {n} vertices"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The triangles in world space. `flip` turns the front to the back
+    /// (Mitsuba's `flip_normals`); `face_normals` drops vertex normals.
+    pub fn triangles(
+        &self,
+        to_world: Mat4,
+        orientation: Orientation,
+        flip: bool,
+        face_normals: bool,
+        material: u32,
+        out: &mut Vec<TriangleInput>,
+    ) {
+        let normal_matrix = Mat3A::from_mat4(to_world).inverse().transpose();
+        let mirrored = to_world.determinant() < 0.0;
+        let reverse = flip ^ (mirrored && orientation == Orientation::Normal);
+        let normal_sign = if flip { -1.0 } else { 1.0 };
+        let normals = self.normals.as_ref().filter(|_| !face_normals);
+        out.reserve(self.indices.len());
+        for &[a, b, c] in &self.indices {
+            let order = if reverse { [a, c, b] } else { [a, b, c] };
+            let vertices =
+                order.map(|i| to_world.transform_point3a(Vec3A::from(self.positions[i as usize])));
+            let normals = normals
+                .map(|n| {
+                    order.map(|i| {
+                        (normal_matrix * Vec3A::from(n[i as usize])).normalize_or_zero()
+                            * normal_sign
+                    })
+                })
+                .filter(|n| n.iter().all(|v| *v != Vec3A::ZERO && v.is_finite()));
+            let uvs = self.uvs.as_ref().map(|uv| order.map(|i| uv[i as usize]));
+            out.push(TriangleInput {
+                vertices,
+                material,
+                uvs,
+                normals,
+            });
+        }
+    }
+
+    /// Mitsuba's `rectangle`: [-1, 1]² at z = 0, facing +z, uv from the corner (-1, -1).
+    pub fn rectangle() -> MeshData {
+        MeshData {
+            positions: vec![
+                Vec3::new(-1.0, -1.0, 0.0),
+                Vec3::new(1.0, -1.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(-1.0, 1.0, 0.0),
+            ],
+            normals: None,
+            uvs: Some(vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y]),
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    }
+
+    /// Mitsuba's `cube`: [-1, 1]³, faces outward, each face's uv over [0, 1]².
+    pub fn cube() -> MeshData {
+        let mut m = MeshData {
+            uvs: Some(Vec::new()),
+            ..Default::default()
+        };
+        for axis in 0..3 {
+            for sign in [-1.0f32, 1.0] {
+                let n = Vec3::AXES[axis] * sign;
+                let u = Vec3::AXES[(axis + 1) % 3];
+                let v = n.cross(u);
+                let base = m.positions.len() as u32;
+                for (s, t) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+                    m.positions
+                        .push(n + u * (2.0 * s - 1.0) + v * (2.0 * t - 1.0));
+                    m.uvs.as_mut().unwrap().push(Vec2::new(s, t));
+                }
+                m.indices
+                    .extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+            }
+        }
+        m
+    }
+
+    /// Mitsuba's `disk` (unit radius at z = 0, facing +z) as a fan of
+    /// `segments` triangles whose radius keeps the disk's area.
+    pub fn disk(segments: u32) -> MeshData {
+        let step = TAU / segments as f32;
+        let radius = (TAU / (segments as f32 * step.sin())).sqrt();
+        let mut m = MeshData {
+            positions: vec![Vec3::ZERO],
+            uvs: Some(vec![Vec2::ZERO]),
+            ..Default::default()
+        };
+        for i in 0..segments {
+            let phi = i as f32 * step;
+            m.positions
+                .push(Vec3::new(phi.cos(), phi.sin(), 0.0) * radius);
+            m.uvs
+                .as_mut()
+                .unwrap()
+                .push(Vec2::new(1.0, i as f32 / segments as f32));
+            m.indices.push([0, 1 + i, 1 + (i + 1) % segments]);
+        }
+        m
+    }
+
+    /// Mitsuba's `cylinder`: an open tube of radius 1 from z = 0 to z = 1,
+    /// facing outward, smooth normals.
+    pub fn cylinder(segments: u32) -> MeshData {
+        let mut m = MeshData {
+            normals: Some(Vec::new()),
+            uvs: Some(Vec::new()),
+            ..Default::default()
+        };
+        for i in 0..=segments {
+            let phi = i as f32 * TAU / segments as f32;
+            let n = Vec3::new(phi.cos(), phi.sin(), 0.0);
+            for z in [0.0, 1.0] {
+                m.positions.push(n + Vec3::Z * z);
+                m.normals.as_mut().unwrap().push(n);
+                m.uvs
+                    .as_mut()
+                    .unwrap()
+                    .push(Vec2::new(i as f32 / segments as f32, z));
+            }
+        }
+        for i in 0..segments {
+            let (a, b) = (2 * i, 2 * i + 2);
+            m.indices.extend([[a, b, b + 1], [a, b + 1, a + 1]]);
+        }
+        m
+    }
+
+    /// Smooth vertex normals, area-weighted, for a mesh that has none.
+    pub fn compute_smooth_normals(&mut self) {
+        let mut normals = vec![Vec3::ZERO; self.positions.len()];
+        for &[a, b, c] in &self.indices {
+            let [pa, pb, pc] = [a, b, c].map(|i| self.positions[i as usize]);
+            let n = (pb - pa).cross(pc - pa);
+            for i in [a, b, c] {
+                normals[i as usize] += n;
+            }
+        }
+        for n in &mut normals {
+            *n = n.normalize_or_zero();
+        }
+        self.normals = Some(normals);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn area(m: &MeshData) -> f32 {
+        m.indices
+            .iter()
+            .map(|&[a, b, c]| {
+                let [pa, pb, pc] = [a, b, c].map(|i| m.positions[i as usize]);
+                0.5 * (pb - pa).cross(pc - pa).length()
+            })
+            .sum()
+    }
+
+    #[test]
+    fn built_in_shapes_have_mitsubas_areas_and_face_outward() {
+        assert!((area(&MeshData::rectangle()) - 4.0).abs() < 1e-6);
+        assert!((area(&MeshData::cube()) - 24.0).abs() < 1e-5);
+        assert!((area(&MeshData::disk(64)) - std::f32::consts::PI).abs() < 1e-4);
+        let cube = MeshData::cube();
+        for &[a, b, c] in &cube.indices {
+            let [pa, pb, pc] = [a, b, c].map(|i| cube.positions[i as usize]);
+            let centroid = (pa + pb + pc) / 3.0;
+            assert!((pb - pa).cross(pc - pa).dot(centroid) > 0.0);
+        }
+    }
+
+    #[test]
+    fn a_mirror_keeps_analytic_shapes_facing_out_and_turns_meshes_inside_out() {
+        let mirror = Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0));
+        let facing = |orientation| {
+            let mut out = Vec::new();
+            MeshData::rectangle().triangles(mirror, orientation, false, false, 0, &mut out);
+            let [a, b, c] = out[0].vertices;
+            (b - a).cross(c - a).z
+        };
+        assert!(facing(Orientation::Normal) > 0.0);
+        assert!(facing(Orientation::Winding) < 0.0);
+    }
+}

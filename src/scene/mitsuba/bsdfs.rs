@@ -1,0 +1,423 @@
+//! Mitsuba's BSDF and texture plugins onto tracelab's materials. The models
+//! of [`crate::bsdf`] take Mitsuba's parameter names, so a plugin becomes a
+//! [`MaterialDesc`] and goes through the same checks as a TOML material.
+
+use super::Importer;
+use super::props::{Colour, Props};
+use super::xml::Element;
+use crate::error::Result;
+use crate::math::Rgb;
+use crate::scene::appearance::build_material;
+use crate::scene::description::{IorDesc, MaterialDesc, MaterialKind};
+use crate::scene::material::{Material, MaterialTextures};
+use crate::texture::{Bitmap, Filter, Texture, UvTransform, Wrap};
+use glam::Vec2;
+use std::sync::Arc;
+
+/// Plugins whose parameters are read but whose effect is not rendered:
+/// each is replaced by the BSDF it wraps, with a warning.
+const WRAPPERS: [(&str, &str); 4] = [
+    ("mask", "opacity mask ignored (the surface is opaque)"),
+    ("bumpmap", "bump map ignored"),
+    ("normalmap", "normal map ignored"),
+    ("blendbsdf", "blend of two BSDFs: the first one is used"),
+];
+
+impl<'a> Importer<'a> {
+    /// The material of a shape: its BSDF plus an area emitter's radiance.
+    pub(super) fn material(
+        &mut self,
+        bsdf: Option<&'a Element>,
+        emission: Option<Rgb>,
+    ) -> Result<u32> {
+        let key = bsdf.map_or(std::ptr::null(), |b| b as *const Element);
+        if emission.is_none()
+            && let Some(&id) = self.material_ids.get(&key)
+        {
+            return Ok(id);
+        }
+        let mut material = match bsdf {
+            Some(b) => self.bsdf(b, false)?,
+            // Mitsuba's default: a one-sided diffuse of reflectance 0.5.
+            None => self.built(
+                "default",
+                MaterialDesc {
+                    kind: MaterialKind::RoughDiffuse,
+                    albedo: Some([0.5; 3]),
+                    alpha: Some(0.0),
+                    ..Default::default()
+                },
+                MaterialTextures::default(),
+                None,
+            )?,
+        };
+        if let Some(e) = emission {
+            material.emission = e;
+            material.name = format!("{} (emitter)", material.name);
+        }
+        let id = self.materials.len() as u32;
+        self.materials.push(material);
+        if emission.is_none() {
+            self.material_ids.insert(key, id);
+        }
+        Ok(id)
+    }
+
+    fn built(
+        &mut self,
+        name: &str,
+        desc: MaterialDesc,
+        textures: MaterialTextures,
+        at: Option<&Element>,
+    ) -> Result<Material> {
+        let mut m = build_material(name, &desc).map_err(|m| match at {
+            Some(e) => e.loc.error(m),
+            None => crate::error::Error::new(m),
+        })?;
+        m.textures = textures;
+        Ok(m)
+    }
+
+    /// One BSDF element; `two_sided` when a `twosided` wraps it.
+    fn bsdf(&mut self, e: &'a Element, two_sided: bool) -> Result<Material> {
+        let p = Props::new(e, self.ids);
+        let name = e.attr("id").unwrap_or(e.plugin()).to_string();
+        let kind = e.plugin();
+        if kind == "twosided" {
+            let nested = p.objects("bsdf")?;
+            let Some(&front) = nested.first() else {
+                return Err(e.loc.error("twosided needs a nested <bsdf>"));
+            };
+            if nested.len() > 1 {
+                self.warn(
+                    &e.loc,
+                    "twosided with a different back BSDF: the front one is used on both sides",
+                );
+            }
+            p.unused(&mut self.warnings);
+            return self.bsdf(front, true);
+        }
+        if let Some((_, what)) = WRAPPERS.iter().find(|(k, _)| *k == kind) {
+            let nested = p.objects("bsdf")?;
+            let Some(&inner) = nested.first() else {
+                return Err(e.loc.error(format!("{kind} needs a nested <bsdf>")));
+            };
+            self.warn(&e.loc, what);
+            // The wrapper's own parameters (opacity, weight, the map) are
+            // covered by the warning above.
+            return self.bsdf(inner, two_sided);
+        }
+        let mut d = MaterialDesc {
+            twosided: Some(two_sided),
+            ..Default::default()
+        };
+        let mut textures = MaterialTextures::default();
+        let ior = |p: &Props, name: &str| -> Result<Option<IorDesc>> {
+            if p.tag_of(name) == Some("string") {
+                return Ok(p.string(name)?.map(|s| IorDesc::Name(s.to_string())));
+            }
+            Ok(p.float(name)?.map(IorDesc::Value))
+        };
+        let rough = |p: &Props, d: &mut MaterialDesc| -> Result<()> {
+            d.distribution = match p.string("distribution")? {
+                None | Some("beckmann") => Some(crate::bsdf::Distribution::Beckmann),
+                Some("ggx") => Some(crate::bsdf::Distribution::Ggx),
+                Some(other) => {
+                    return Err(p
+                        .loc()
+                        .error(format!("distribution \"{other}\" is not beckmann or ggx")));
+                }
+            };
+            // Visible-normal sampling is always on: it changes noise, not the image.
+            let _ = p.bool("sample_visible")?;
+            d.alpha_u = p.float("alpha_u")?;
+            d.alpha_v = p.float("alpha_v")?;
+            if d.alpha_u.is_none() && d.alpha_v.is_none() {
+                d.alpha = Some(p.float("alpha")?.unwrap_or(0.1));
+            }
+            Ok(())
+        };
+        match kind {
+            "diffuse" | "roughdiffuse" => {
+                d.kind = match (kind, two_sided) {
+                    // The Lambertian model is two-sided; one-sided diffuse is
+                    // Oren–Nayar at zero roughness, which is Lambert exactly.
+                    ("diffuse", true) => MaterialKind::Diffuse,
+                    _ => MaterialKind::RoughDiffuse,
+                };
+                if d.kind == MaterialKind::Diffuse {
+                    d.twosided = None;
+                }
+                let albedo = self.colour(&p, "reflectance", 0.5, &mut textures.diffuse)?;
+                d.albedo = Some(albedo);
+                if d.kind == MaterialKind::RoughDiffuse {
+                    d.alpha = Some(p.float_or("alpha", 0.0)?);
+                    if p.bool("use_fast_approx")? == Some(true) {
+                        self.warn(
+                            &e.loc,
+                            "useFastApprox ignored: the full Oren–Nayar model is used",
+                        );
+                    }
+                }
+            }
+            "conductor" | "roughconductor" => {
+                d.kind = match kind {
+                    "conductor" => MaterialKind::Conductor,
+                    _ => MaterialKind::RoughConductor,
+                };
+                d.conductor = p
+                    .string("material")?
+                    .filter(|m| *m != "none")
+                    .map(String::from);
+                d.eta = p.rgb("eta", false)?.map(|c| c.to_array());
+                d.k = p.rgb("k", false)?.map(|c| c.to_array());
+                if d.conductor.is_none()
+                    && d.eta.is_none()
+                    && d.k.is_none()
+                    && self.doc.major_version == 0
+                {
+                    d.conductor = Some("Cu".into()); // Mitsuba 0.6's default; 3's is a mirror
+                }
+                d.specular_reflectance =
+                    Some(self.colour(&p, "specular_reflectance", 1.0, &mut textures.specular)?);
+                if kind == "roughconductor" {
+                    rough(&p, &mut d)?;
+                    self.alpha_texture(&p, &mut d, &mut textures)?;
+                }
+            }
+            "dielectric" => {
+                d.kind = MaterialKind::Dielectric;
+                d.twosided = None;
+                let int = ior(&p, "int_ior")?;
+                let ext = ior(&p, "ext_ior")?;
+                d.ior = Some(relative_ior(&e.loc, int, ext, 1.5046)?);
+                if let Some(r) = p.rgb("specular_reflectance", false)?
+                    && r != Rgb::ONE
+                {
+                    self.warn(
+                        &e.loc,
+                        "specular_reflectance of a smooth dielectric ignored (1)",
+                    );
+                }
+                d.tint = p
+                    .rgb("specular_transmittance", false)?
+                    .map(|c| c.to_array());
+            }
+            "thindielectric" | "roughdielectric" => {
+                d.kind = match kind {
+                    "thindielectric" => MaterialKind::ThinDielectric,
+                    _ => MaterialKind::RoughDielectric,
+                };
+                d.twosided = None;
+                d.int_ior = ior(&p, "int_ior")?;
+                d.ext_ior = ior(&p, "ext_ior")?;
+                d.specular_reflectance =
+                    Some(self.colour(&p, "specular_reflectance", 1.0, &mut textures.specular)?);
+                d.specular_transmittance = p
+                    .rgb("specular_transmittance", false)?
+                    .map(|c| c.to_array());
+                if kind == "roughdielectric" {
+                    rough(&p, &mut d)?;
+                    self.alpha_texture(&p, &mut d, &mut textures)?;
+                }
+            }
+            "plastic" | "roughplastic" => {
+                d.kind = match kind {
+                    "plastic" => MaterialKind::Plastic,
+                    _ => MaterialKind::RoughPlastic,
+                };
+                d.int_ior = ior(&p, "int_ior")?;
+                d.ext_ior = ior(&p, "ext_ior")?;
+                d.diffuse_reflectance =
+                    Some(self.colour(&p, "diffuse_reflectance", 0.5, &mut textures.diffuse)?);
+                d.specular_reflectance =
+                    Some(self.colour(&p, "specular_reflectance", 1.0, &mut textures.specular)?);
+                d.nonlinear = p.bool("nonlinear")?;
+                if kind == "roughplastic" {
+                    rough(&p, &mut d)?;
+                    if d.alpha.is_none() {
+                        return Err(e.loc.error("roughplastic is isotropic: give `alpha`"));
+                    }
+                }
+            }
+            "null" => {
+                self.warn(
+                    &e.loc,
+                    "null BSDF rendered as a black surface (light does not pass through it)",
+                );
+                d.kind = MaterialKind::Diffuse;
+                d.twosided = None;
+                d.albedo = Some([0.0; 3]);
+            }
+            other => {
+                self.warn(
+                    &e.loc,
+                    &format!("BSDF \"{other}\" is not supported: rendered as diffuse 0.5"),
+                );
+                p.mark_all_used();
+                d.kind = MaterialKind::Diffuse;
+                d.twosided = None;
+                d.albedo = Some([0.5; 3]);
+            }
+        }
+        p.unused(&mut self.warnings);
+        self.built(&name, d, textures, Some(e))
+    }
+
+    /// A colour parameter: its value, or its texture's id in `slot` (the
+    /// value then is the texture's mean, for whatever reads one value).
+    fn colour(
+        &mut self,
+        p: &Props<'a>,
+        name: &str,
+        default: f32,
+        slot: &mut Option<u32>,
+    ) -> Result<[f32; 3]> {
+        match p.colour(name, false)? {
+            None => Ok([default; 3]),
+            Some(Colour::Value(c)) => Ok(c.to_array()),
+            Some(Colour::Texture(t)) => {
+                let id = self.texture(t)?;
+                *slot = Some(id);
+                Ok(self.textures[id as usize].mean().min(Rgb::ONE).to_array())
+            }
+        }
+    }
+
+    fn alpha_texture(
+        &mut self,
+        p: &Props<'a>,
+        d: &mut MaterialDesc,
+        textures: &mut MaterialTextures,
+    ) -> Result<()> {
+        if d.alpha.is_some() {
+            return Ok(());
+        }
+        if let Some(Colour::Texture(t)) = p.colour("alpha", false)? {
+            textures.alpha = Some(self.texture(t)?);
+            d.alpha = Some(self.textures[textures.alpha.unwrap() as usize].mean().x);
+        }
+        Ok(())
+    }
+
+    /// A texture plugin, loaded once however many materials read it.
+    pub(super) fn texture(&mut self, e: &'a Element) -> Result<u32> {
+        let key = e as *const Element;
+        if let Some(&id) = self.texture_ids.get(&key) {
+            return Ok(id);
+        }
+        let p = Props::new(e, self.ids);
+        let to_uv = self.uv_transform(&p)?;
+        let texture = match e.plugin() {
+            "bitmap" => {
+                let file = p
+                    .string("filename")?
+                    .ok_or_else(|| e.loc.error("a bitmap needs `filename`"))?;
+                let path = self.doc.resolve(file, &e.loc)?;
+                let wrap = match p.string("wrap_mode")? {
+                    None | Some("repeat") => Wrap::Repeat,
+                    Some("mirror") => Wrap::Mirror,
+                    Some("clamp") => Wrap::Clamp,
+                    Some(w) => {
+                        self.warn(&e.loc, &format!("wrap_mode \"{w}\" read as repeat"));
+                        Wrap::Repeat
+                    }
+                };
+                let filter = match p.string("filter_type")? {
+                    None | Some("bilinear") => Filter::Bilinear,
+                    Some("nearest") => Filter::Nearest,
+                    Some(f) => {
+                        self.warn(&e.loc, &format!("filter type {f} read as bilinear"));
+                        Filter::Bilinear
+                    }
+                };
+                let raw = p.bool("raw")?.unwrap_or(false);
+                if let Some(g) = p.float("gamma")? {
+                    self.warn(
+                        &e.loc,
+                        &format!("gamma {g} ignored: 8-bit images are read as sRGB"),
+                    );
+                }
+                let image = Bitmap::read(&path, raw).map_err(|m| e.loc.error(m))?;
+                Texture::Bitmap {
+                    image: Arc::new(image),
+                    wrap,
+                    filter,
+                    to_uv,
+                }
+            }
+            "checkerboard" => {
+                let colour = |name: &str, default: f32| -> Result<Rgb> {
+                    Ok(p.rgb(name, false)?.unwrap_or(Rgb::splat(default)))
+                };
+                Texture::Checkerboard {
+                    color0: colour("color0", 0.4)?,
+                    color1: colour("color1", 0.2)?,
+                    to_uv,
+                }
+            }
+            other => {
+                self.warn(
+                    &e.loc,
+                    &format!("texture \"{other}\" is not supported: a constant 0.5 is used"),
+                );
+                p.mark_all_used();
+                Texture::Checkerboard {
+                    color0: Rgb::splat(0.5),
+                    color1: Rgb::splat(0.5),
+                    to_uv,
+                }
+            }
+        };
+        p.unused(&mut self.warnings);
+        let id = self.textures.len() as u32;
+        self.textures.push(texture);
+        self.texture_ids.insert(key, id);
+        Ok(id)
+    }
+
+    /// Mitsuba 3's `to_uv`, or 0.6's `uscale`, `vscale`, `uoffset`, `voffset`.
+    fn uv_transform(&mut self, p: &Props) -> Result<UvTransform> {
+        let mut t = UvTransform::default();
+        if let Some(m) = p.transform("to_uv")? {
+            t.scale = Vec2::new(m.x_axis.x, m.y_axis.y);
+            t.offset = Vec2::new(m.w_axis.x, m.w_axis.y);
+            if m.x_axis.y != 0.0 || m.y_axis.x != 0.0 {
+                self.warn(
+                    p.loc(),
+                    "to_uv: rotation or shear ignored (scale and offset kept)",
+                );
+            }
+        }
+        for (name, value) in [
+            ("uscale", &mut t.scale.x),
+            ("vscale", &mut t.scale.y),
+            ("uoffset", &mut t.offset.x),
+            ("voffset", &mut t.offset.y),
+        ] {
+            if let Some(v) = p.float(name)? {
+                *value = v;
+            }
+        }
+        Ok(t)
+    }
+}
+
+/// Interior over exterior IOR, names or numbers, Mitsuba's defaults.
+fn relative_ior(
+    loc: &super::xml::Loc,
+    int: Option<IorDesc>,
+    ext: Option<IorDesc>,
+    default_int: f32,
+) -> Result<f32> {
+    let value = |d: Option<IorDesc>, default: f32| -> Result<f32> {
+        match d {
+            None => Ok(default),
+            Some(IorDesc::Value(v)) if v > 0.0 => Ok(v),
+            Some(IorDesc::Value(v)) => Err(loc.error(format!("an IOR must be > 0, got {v}"))),
+            Some(IorDesc::Name(n)) => crate::bsdf::presets::ior(&n)
+                .ok_or_else(|| loc.error(format!("\"{n}\" is not a known IOR"))),
+        }
+    };
+    Ok(value(int, default_int)? / value(ext, 1.000277)?)
+}

@@ -1,0 +1,524 @@
+//! Mitsuba scene files (XML, Mitsuba 3 and 0.5/0.6) into a [`SceneInput`].
+//!
+//! What a file asks for and tracelab cannot render is never dropped in
+//! silence: each such place gives a warning with file:line:column and what
+//! was done instead, and `strict` makes the first one an error.
+
+mod bsdfs;
+mod props;
+mod shapes;
+mod spectrum;
+pub mod xml;
+
+use super::environment::{Environment, Radiance};
+use super::material::Material;
+use super::{Limits, LoadOptions, RenderHints, SceneInput, in_range};
+use crate::accel::{Sphere, TriangleInput};
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::filter::PixelFilter;
+use crate::math::Rgb;
+use crate::scene::light::{Light, LightSampling, SpotCone};
+use crate::texture::{Bitmap, Texture};
+use glam::{Mat3A, Mat4, Vec3A};
+use props::Props;
+use std::collections::HashMap;
+use std::path::Path;
+use xml::{Document, Element, Loc};
+
+/// Reads a Mitsuba scene file.
+pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
+    let doc = xml::read(path, &options.defines)?;
+    let mut ids = HashMap::new();
+    collect_ids(&doc.root, &mut ids)?;
+    let mut importer = Importer {
+        doc: &doc,
+        ids: &ids,
+        limits: options.limits,
+        warnings: Vec::new(),
+        materials: Vec::new(),
+        material_ids: HashMap::new(),
+        textures: Vec::new(),
+        texture_ids: HashMap::new(),
+        triangles: Vec::new(),
+        spheres: Vec::new(),
+        lights: Vec::new(),
+        environment: None,
+        hints: RenderHints::default(),
+    };
+    let camera = importer.scene()?;
+    if options.strict && !importer.warnings.is_empty() {
+        return Err(Error::new(format!(
+            "{} (--strict: warnings are errors)",
+            importer.warnings[0]
+        )));
+    }
+    Ok(SceneInput {
+        camera,
+        materials: importer.materials,
+        textures: importer.textures,
+        environment: importer.environment,
+        triangles: importer.triangles,
+        spheres: importer.spheres,
+        point_lights: importer.lights,
+        moving: Vec::new(),
+        // Mitsuba samples spheres by solid angle and triangles by area.
+        sphere_sampling: LightSampling::SolidAngle,
+        triangle_sampling: LightSampling::Area,
+        warnings: importer.warnings,
+        hints: importer.hints,
+    })
+}
+
+/// Every element with an `id`, for `<ref>`.
+fn collect_ids<'a>(e: &'a Element, ids: &mut HashMap<String, &'a Element>) -> Result<()> {
+    for c in &e.children {
+        if let Some(id) = c.attr("id")
+            && c.tag != "ref"
+            && ids.insert(id.to_string(), c).is_some()
+        {
+            return Err(c.loc.error(format!("id \"{id}\" is used twice")));
+        }
+        collect_ids(c, ids)?;
+    }
+    Ok(())
+}
+
+pub(super) struct Importer<'a> {
+    doc: &'a Document,
+    ids: &'a HashMap<String, &'a Element>,
+    limits: Limits,
+    warnings: Vec<String>,
+    materials: Vec<Material>,
+    /// Materials by the BSDF element they came from (shared, not copied).
+    material_ids: HashMap<*const Element, u32>,
+    textures: Vec<Texture>,
+    texture_ids: HashMap<*const Element, u32>,
+    triangles: Vec<TriangleInput>,
+    spheres: Vec<Sphere>,
+    lights: Vec<Light>,
+    environment: Option<Environment>,
+    hints: RenderHints,
+}
+
+impl<'a> Importer<'a> {
+    fn warn(&mut self, at: &Loc, what: &str) {
+        self.warnings.push(format!("{at}: {what}"));
+    }
+
+    /// The top level, in file order; returns the camera.
+    fn scene(&mut self) -> Result<Camera> {
+        let root = &self.doc.root;
+        let mut sensor = None;
+        for e in &root.children {
+            match e.tag.as_str() {
+                "shape" => self.shape(e, Mat4::IDENTITY)?,
+                "emitter" => self.emitter(e)?,
+                "sensor" => match sensor {
+                    None => sensor = Some(e),
+                    Some(_) => self.warn(&e.loc, "a second sensor ignored (the first one renders)"),
+                },
+                "integrator" => self.integrator(e)?,
+                // Declarations, used where referenced.
+                "bsdf" | "texture" => {}
+                "medium" | "phase" => self.warn(&e.loc, "participating medium ignored"),
+                other => self.warn(&e.loc, &format!("<{other}> ignored")),
+            }
+        }
+        match sensor {
+            Some(s) => self.sensor(s),
+            None => {
+                self.warn(&root.loc, "no sensor: a default camera frames the scene");
+                Ok(super::framing::default_camera(
+                    &self.triangles,
+                    &self.spheres,
+                ))
+            }
+        }
+    }
+
+    fn integrator(&mut self, e: &'a Element) -> Result<()> {
+        let p = Props::new(e, self.ids);
+        let technique = match e.plugin() {
+            "path" | "volpath" | "volpathmis" | "prb" | "direct" => "path",
+            "bdpt" => "bdpt",
+            "ptracer" => "light",
+            "sppm" => "sppm",
+            "photonmapper" => "photon",
+            "aov" | "moment" | "stokes" => {
+                // Wrappers: the integrator inside renders the image.
+                let inner = p.objects("integrator")?;
+                p.mark_all_used();
+                self.warn(
+                    &e.loc,
+                    &format!("{} integrator: its inner integrator renders", e.plugin()),
+                );
+                return match inner.first() {
+                    Some(i) => self.integrator(i),
+                    None => Ok(()),
+                };
+            }
+            other => {
+                self.warn(
+                    &e.loc,
+                    &format!(
+                        "integrator \"{other}\" is not one of tracelab's: path tracing renders"
+                    ),
+                );
+                p.mark_all_used();
+                "path"
+            }
+        };
+        self.hints.integrator = Some(technique.to_string());
+        // Mitsuba counts segments (1: emitters seen directly, -1: unbounded);
+        // tracelab counts bounces, one fewer.
+        let max_depth = match e.plugin() {
+            "direct" => Some(2),
+            _ => p.int("max_depth")?,
+        };
+        self.hints.max_depth = match max_depth {
+            None => None,
+            Some(-1) => Some(super::UNBOUNDED_DEPTH),
+            Some(d) if d >= 1 => Some((d - 1) as u32),
+            Some(d) => {
+                return Err(e
+                    .loc
+                    .error(format!("max_depth must be -1 or >= 1, got {d}")));
+            }
+        };
+        self.hints.rr_depth = match p.int("rr_depth")? {
+            Some(d) if d >= 1 => Some(d as u32),
+            Some(d) => return Err(e.loc.error(format!("rr_depth must be >= 1, got {d}"))),
+            None => None,
+        };
+        // Settings that change speed or noise, not the image.
+        for quiet in [
+            "hide_emitters",
+            "samples_per_pass",
+            "timeout",
+            "strict_normals",
+        ] {
+            let _ = p.tag_of(quiet).map(|_| p.string(quiet));
+        }
+        p.unused(&mut self.warnings);
+        Ok(())
+    }
+
+    fn emitter(&mut self, e: &'a Element) -> Result<()> {
+        let p = Props::new(e, self.ids);
+        let to_world = p.transform("to_world")?;
+        let bad = |m: &str| e.loc.error(format!("{} emitter: {m}", e.plugin()));
+        let colour = |name: &str| -> Result<Rgb> {
+            let c = p.rgb(name, true)?.unwrap_or(Rgb::ONE);
+            if !(c.min_element() >= 0.0) {
+                return Err(bad(&format!("`{name}` must be >= 0")));
+            }
+            Ok(c)
+        };
+        match e.plugin() {
+            "point" => {
+                let position = match p.point("position")? {
+                    Some(v) => Vec3A::from(v),
+                    None => Vec3A::from(to_world.unwrap_or_default().w_axis.truncate()),
+                };
+                if !in_range(position) {
+                    return Err(bad("position out of range"));
+                }
+                let intensity = colour("intensity")?;
+                self.lights.push(Light::Point {
+                    position,
+                    intensity,
+                });
+            }
+            "spot" => {
+                let m = to_world.unwrap_or_default();
+                let position = Vec3A::from(m.w_axis.truncate());
+                let axis = Vec3A::from(m.z_axis.truncate()).normalize_or_zero();
+                let cutoff = p.float_or("cutoff_angle", 20.0)?;
+                let beam = p.float_or("beam_width", 0.75 * cutoff)?;
+                if !(cutoff > 0.0 && cutoff <= 90.0 && beam >= 0.0 && beam <= cutoff) {
+                    return Err(bad(
+                        "need 0 < cutoff_angle <= 90 and 0 <= beam_width <= cutoff_angle",
+                    ));
+                }
+                if axis == Vec3A::ZERO || !in_range(position) {
+                    return Err(bad("to_world must be a finite frame"));
+                }
+                let intensity = colour("intensity")?;
+                self.lights.push(Light::Spot {
+                    position,
+                    intensity,
+                    cone: SpotCone {
+                        axis,
+                        cutoff: cutoff.to_radians(),
+                        beam_width: beam.to_radians(),
+                    },
+                });
+            }
+            "directional" => {
+                let direction = match p.point("direction")? {
+                    Some(d) => Vec3A::from(d),
+                    None => Vec3A::from(to_world.unwrap_or_default().z_axis.truncate()),
+                }
+                .normalize_or_zero();
+                if direction == Vec3A::ZERO || !direction.is_finite() {
+                    return Err(bad("`direction` must be a finite non-zero vector"));
+                }
+                let irradiance = colour("irradiance")?;
+                self.lights.push(Light::Directional {
+                    direction,
+                    irradiance,
+                    center: Vec3A::ZERO,
+                    radius: 1.0,
+                });
+            }
+            "constant" | "envmap" => {
+                let rotation = Mat3A::from_mat4(to_world.unwrap_or_default());
+                let radiance = if e.plugin() == "constant" {
+                    Radiance::Constant(colour("radiance")?)
+                } else {
+                    let file = p
+                        .string("filename")?
+                        .ok_or_else(|| bad("needs `filename`"))?;
+                    let path = self.doc.resolve(file, &e.loc)?;
+                    let map = Bitmap::read(&path, false).map_err(|m| e.loc.error(m))?;
+                    Radiance::Map(std::sync::Arc::new(map))
+                };
+                let scale = p.float_or("scale", 1.0)?;
+                if !(scale >= 0.0 && scale.is_finite()) {
+                    return Err(bad("`scale` must be >= 0"));
+                }
+                if self.environment.is_some() {
+                    self.warn(
+                        &e.loc,
+                        "a second environment ignored (one light at infinity)",
+                    );
+                } else {
+                    self.environment = Some(Environment::new(radiance, scale, rotation));
+                }
+            }
+            other => {
+                self.warn(
+                    &e.loc,
+                    &format!("emitter \"{other}\" is not supported: skipped"),
+                );
+                p.mark_all_used();
+            }
+        }
+        p.unused(&mut self.warnings);
+        Ok(())
+    }
+
+    fn sensor(&mut self, e: &'a Element) -> Result<Camera> {
+        let p = Props::new(e, self.ids);
+        let kind = e.plugin();
+        if kind != "perspective" && kind != "thinlens" {
+            return Err(e.loc.error(format!(
+                "sensor \"{kind}\" is not supported (perspective and thinlens are)"
+            )));
+        }
+        let films = p.objects("film")?;
+        let film = films.first().copied();
+        let (width, height, filter) = match film {
+            Some(f) => self.film(f)?,
+            None => (
+                768,
+                576,
+                PixelFilter::Gaussian {
+                    stddev: 0.5,
+                    radius: 2.0,
+                },
+            ),
+        };
+        self.limits
+            .check_resolution(width, height)
+            .map_err(|m| e.loc.error(m))?;
+        if let Some(s) = p.objects("sampler")?.first() {
+            self.sampler(s)?;
+        }
+        let m = p.transform("to_world")?.unwrap_or_default();
+        let eye = Vec3A::from(m.w_axis.truncate());
+        let forward = Vec3A::from(m.z_axis.truncate()).normalize_or_zero();
+        let up = Vec3A::from(m.y_axis.truncate()).normalize_or_zero();
+        if forward == Vec3A::ZERO || up == Vec3A::ZERO || forward.cross(up).length() < 1e-6 {
+            return Err(e.loc.error("the sensor's to_world is degenerate"));
+        }
+        let aspect = width as f32 / height as f32;
+        let mut axis = None;
+        let fov = match (p.float("fov")?, p.string("focal_length")?) {
+            (Some(f), _) => f,
+            (None, Some(length)) => {
+                let mm: f32 = length.trim_end_matches("mm").trim().parse().map_err(|_| {
+                    e.loc
+                        .error(format!("focal_length \"{length}\" is not like \"50mm\""))
+                })?;
+                // Mitsuba: a 35 mm film's diagonal.
+                let diagonal = (36.0f32 * 36.0 + 24.0 * 24.0).sqrt();
+                axis = Some("diagonal");
+                2.0 * (diagonal / (2.0 * mm)).atan().to_degrees()
+            }
+            (None, None) => 45.0,
+        };
+        let axis = match axis {
+            Some(a) => a,
+            None => p.string("fov_axis")?.unwrap_or("x"),
+        };
+        let tan_half = (fov.to_radians() * 0.5).tan();
+        let tan_half_y = match axis {
+            "x" => tan_half / aspect,
+            "y" => tan_half,
+            "diagonal" => tan_half / (1.0 + aspect * aspect).sqrt(),
+            "smaller" => tan_half / aspect.min(1.0),
+            "larger" => tan_half / aspect.max(1.0),
+            other => {
+                return Err(e.loc.error(format!(
+                    "fov_axis \"{other}\" is not x, y, diagonal, smaller or larger"
+                )));
+            }
+        };
+        let fov_y = 2.0 * tan_half_y.atan().to_degrees();
+        if !(fov_y > 0.0 && fov_y < 180.0) {
+            return Err(e
+                .loc
+                .error(format!("the field of view ({fov} degrees) is out of range")));
+        }
+        let (aperture, focus) = if kind == "thinlens" {
+            let a = p.float_or("aperture_radius", 0.03)?;
+            let f = p.float_or("focus_distance", 0.0)?;
+            if !(a >= 0.0 && f > 0.0) {
+                return Err(e
+                    .loc
+                    .error("thinlens needs aperture_radius >= 0 and focus_distance > 0"));
+            }
+            (a, f)
+        } else {
+            (0.0, 1.0)
+        };
+        for quiet in ["near_clip", "far_clip", "shutter_open", "shutter_close"] {
+            let _ = p.float(quiet)?;
+        }
+        let mut camera = Camera::look_at(
+            eye,
+            eye + forward,
+            up,
+            fov_y,
+            width,
+            height,
+            aperture,
+            focus,
+        )
+        .with_filter(filter);
+        // Mitsuba's camera x is image left; a mirroring to_world flips the image.
+        if Vec3A::from(m.x_axis.truncate()).dot(camera.right) > 0.0 {
+            camera.right = -camera.right;
+        }
+        p.unused(&mut self.warnings);
+        Ok(camera)
+    }
+
+    fn film(&mut self, e: &'a Element) -> Result<(u32, u32, PixelFilter)> {
+        let p = Props::new(e, self.ids);
+        let size = |name: &str, default: i64| -> Result<u32> {
+            let v = p.int(name)?.unwrap_or(default);
+            u32::try_from(v).map_err(|_| e.loc.error(format!("`{name}` must be >= 1, got {v}")))
+        };
+        let (width, height) = (size("width", 768)?, size("height", 576)?);
+        for crop in [
+            "crop_offset_x",
+            "crop_offset_y",
+            "crop_width",
+            "crop_height",
+        ] {
+            if p.int(crop)?.is_some() {
+                self.warn(&e.loc, &format!("{crop} ignored: the whole frame renders"));
+            }
+        }
+        // Output format settings: the CLI's output file decides.
+        for quiet in [
+            "file_format",
+            "pixel_format",
+            "component_format",
+            "banner",
+            "high_quality_edges",
+            "sample_border",
+            "compensate",
+            "rgb_tonemap",
+        ] {
+            if p.tag_of(quiet).is_some() {
+                let _ = p.string(quiet)?;
+            }
+        }
+        let filter = match p.objects("rfilter")?.first() {
+            // Mitsuba's default: a Gaussian of standard deviation 0.5.
+            None => PixelFilter::Gaussian {
+                stddev: 0.5,
+                radius: 2.0,
+            },
+            Some(f) => {
+                let fp = Props::new(f, self.ids);
+                let filter = match f.plugin() {
+                    "box" => PixelFilter::Box,
+                    "tent" => PixelFilter::Tent {
+                        radius: fp.float_or("radius", 1.0)?,
+                    },
+                    "gaussian" => {
+                        let stddev = fp.float_or("stddev", 0.5)?;
+                        PixelFilter::Gaussian {
+                            stddev,
+                            radius: 4.0 * stddev,
+                        }
+                    }
+                    other => {
+                        self.warn(
+                            &f.loc,
+                            &format!(
+                                "reconstruction filter \"{other}\" read as gaussian (stddev 0.5)"
+                            ),
+                        );
+                        fp.mark_all_used();
+                        PixelFilter::Gaussian {
+                            stddev: 0.5,
+                            radius: 2.0,
+                        }
+                    }
+                };
+                fp.unused(&mut self.warnings);
+                filter
+            }
+        };
+        p.unused(&mut self.warnings);
+        Ok((width, height, filter))
+    }
+
+    fn sampler(&mut self, e: &'a Element) -> Result<()> {
+        let p = Props::new(e, self.ids);
+        self.hints.sampler = Some(
+            match e.plugin() {
+                "independent" => "independent",
+                "stratified" => "stratified",
+                "multijitter" => "multijitter",
+                "ldsampler" | "sobol" | "halton" | "hammersley" | "orthogonal" => "sobol",
+                other => {
+                    self.warn(&e.loc, &format!("sampler \"{other}\" read as independent"));
+                    "independent"
+                }
+            }
+            .to_string(),
+        );
+        if let Some(n) = p.int("sample_count")? {
+            self.hints.spp = Some(
+                u32::try_from(n)
+                    .ok()
+                    .filter(|&n| n > 0)
+                    .ok_or_else(|| e.loc.error(format!("sample_count must be >= 1, got {n}")))?,
+            );
+        }
+        for quiet in ["seed", "jitter", "scramble", "dimension"] {
+            if p.tag_of(quiet).is_some() {
+                let _ = p.string(quiet)?;
+            }
+        }
+        p.unused(&mut self.warnings);
+        Ok(())
+    }
+}

@@ -1,0 +1,244 @@
+//! Mitsuba's shape plugins: mesh files (obj, ply, serialized), the built-in
+//! shapes (rectangle, cube, sphere, disk, cylinder) and instances of shape
+//! groups, with their BSDFs and area emitters.
+
+use super::Importer;
+use super::props::{Colour, Props};
+use super::xml::Element;
+use crate::accel::{NO_LIGHT, Sphere};
+use crate::error::Result;
+use crate::scene::mesh::{MeshData, Orientation};
+use crate::scene::{MAX_COORDINATE, in_range};
+use glam::{Mat4, Vec2, Vec3A};
+
+/// Segments of a tessellated disk or cylinder.
+const SEGMENTS: u32 = 128;
+
+impl<'a> Importer<'a> {
+    /// One `<shape>`, placed by `parent` (an instance's transform).
+    pub(super) fn shape(&mut self, e: &'a Element, parent: Mat4) -> Result<()> {
+        let p = Props::new(e, self.ids);
+        let kind = e.plugin();
+        if kind == "shapegroup" {
+            // Drawn only through instances.
+            p.mark_all_used();
+            return Ok(());
+        }
+        if kind == "instance" {
+            let groups = p.objects("shape")?;
+            let to_world = parent * p.transform("to_world")?.unwrap_or(Mat4::IDENTITY);
+            p.unused(&mut self.warnings);
+            for group in groups {
+                if group.plugin() != "shapegroup" {
+                    return Err(e.loc.error("an instance refers to a shapegroup"));
+                }
+                for child in group.children.iter().filter(|c| c.tag == "shape") {
+                    self.shape(child, to_world)?;
+                }
+            }
+            return Ok(());
+        }
+        let to_world = parent * p.transform("to_world")?.unwrap_or(Mat4::IDENTITY);
+        let flip = p.bool("flip_normals")?.unwrap_or(false);
+        let bsdf = p.objects("bsdf")?.first().copied();
+        let emission = self.area_emitter(&p)?;
+        for medium in p.objects("medium")? {
+            self.warn(&medium.loc, "participating medium ignored");
+        }
+        let material = self.material(bsdf, emission)?;
+        let start = self.triangles.len();
+        let (mesh, orientation, face_normals) = match kind {
+            "obj" | "ply" | "serialized" => {
+                let file = p
+                    .string("filename")?
+                    .ok_or_else(|| e.loc.error(format!("a {kind} shape needs `filename`")))?;
+                let path = self.doc.resolve(file, &e.loc)?;
+                let face_normals = p.bool("face_normals")?.unwrap_or(false);
+                let mesh = match kind {
+                    "obj" => {
+                        let flip_uv = p.bool("flip_tex_coords")?.unwrap_or(true);
+                        obj_mesh(&path, flip_uv)?
+                    }
+                    "ply" => crate::scene::ply::load_ply(&path)?,
+                    _ => {
+                        let index = p.int("shape_index")?.unwrap_or(0);
+                        let index = usize::try_from(index)
+                            .map_err(|_| e.loc.error("shape_index must be >= 0"))?;
+                        crate::scene::serialized::load_serialized(&path, index)?
+                    }
+                };
+                (mesh, Orientation::Winding, face_normals)
+            }
+            "rectangle" => (MeshData::rectangle(), Orientation::Normal, false),
+            "cube" => (MeshData::cube(), Orientation::Normal, false),
+            "disk" | "cylinder" => {
+                let mesh = if kind == "disk" {
+                    MeshData::disk(SEGMENTS)
+                } else {
+                    let p0 = p.point("p0")?.unwrap_or(glam::Vec3::ZERO);
+                    let p1 = p.point("p1")?.unwrap_or(glam::Vec3::Z);
+                    let radius = p.float_or("radius", 1.0)?;
+                    let axis = p1 - p0;
+                    if axis.length_squared() == 0.0 || !(radius > 0.0) {
+                        return Err(e.loc.error("a cylinder needs p0 != p1 and radius > 0"));
+                    }
+                    // Unit tube onto the given axis and radius.
+                    let rotation = glam::Quat::from_rotation_arc(glam::Vec3::Z, axis.normalize());
+                    let local = Mat4::from_translation(p0)
+                        * Mat4::from_quat(rotation)
+                        * Mat4::from_scale(glam::Vec3::new(radius, radius, axis.length()));
+                    let mut out = Vec::new();
+                    MeshData::cylinder(SEGMENTS).triangles(
+                        to_world * local,
+                        Orientation::Normal,
+                        flip,
+                        false,
+                        material,
+                        &mut out,
+                    );
+                    self.warn(
+                        &e.loc,
+                        &format!("cylinder tessellated into {} triangles", out.len()),
+                    );
+                    self.push_triangles(e, out)?;
+                    p.unused(&mut self.warnings);
+                    return Ok(());
+                };
+                self.warn(
+                    &e.loc,
+                    &format!("disk tessellated into {SEGMENTS} triangles (area kept)"),
+                );
+                (mesh, Orientation::Normal, false)
+            }
+            "sphere" => {
+                let center = p.point("center")?.unwrap_or(glam::Vec3::ZERO);
+                let radius = p.float_or("radius", 1.0)?;
+                // The sphere's own frame: to_world ∘ translate(center) ∘ scale(radius).
+                let m = to_world
+                    * Mat4::from_translation(center)
+                    * Mat4::from_scale(glam::Vec3::splat(radius));
+                let axes = [m.x_axis, m.y_axis, m.z_axis].map(|a| a.truncate().length());
+                let r = axes.iter().sum::<f32>() / 3.0;
+                if axes.iter().any(|a| (a - r).abs() > 1e-4 * r) {
+                    self.warn(&e.loc, &format!("a sphere scaled unevenly ({axes:?}) is rendered as a sphere of radius {r}"));
+                }
+                if flip {
+                    self.warn(
+                        &e.loc,
+                        "flip_normals on a sphere ignored (spheres face outward)",
+                    );
+                }
+                let center = Vec3A::from(m.w_axis.truncate());
+                if !in_range(center) || !(r > 0.0 && r <= MAX_COORDINATE) {
+                    return Err(e.loc.error("the sphere's center or radius is out of range"));
+                }
+                p.unused(&mut self.warnings);
+                self.spheres.push(Sphere {
+                    center,
+                    radius: r,
+                    material,
+                    light: NO_LIGHT,
+                });
+                return Ok(());
+            }
+            other => {
+                self.warn(
+                    &e.loc,
+                    &format!("shape \"{other}\" is not supported: skipped"),
+                );
+                p.mark_all_used();
+                return Ok(());
+            }
+        };
+        mesh.validate().map_err(|m| e.loc.error(m))?;
+        let mut out = Vec::new();
+        mesh.triangles(
+            to_world,
+            orientation,
+            flip,
+            face_normals,
+            material,
+            &mut out,
+        );
+        self.push_triangles(e, out)?;
+        debug_assert!(self.triangles.len() >= start);
+        p.unused(&mut self.warnings);
+        Ok(())
+    }
+
+    fn push_triangles(&mut self, e: &Element, out: Vec<crate::accel::TriangleInput>) -> Result<()> {
+        if self.triangles.len() + out.len() > self.limits.max_triangles {
+            return Err(e.loc.error(format!(
+                "more than {} triangles (raise the limit with --max-triangles)",
+                self.limits.max_triangles
+            )));
+        }
+        if !out.iter().all(|t| t.vertices.iter().all(|&v| in_range(v))) {
+            return Err(e.loc.error(format!(
+                "after its transform, the shape reaches beyond ±{MAX_COORDINATE:e}"
+            )));
+        }
+        self.triangles.extend(out);
+        Ok(())
+    }
+
+    /// The radiance of a shape's `area` emitter, if it has one.
+    fn area_emitter(&mut self, p: &Props<'a>) -> Result<Option<crate::math::Rgb>> {
+        let emitters = p.objects("emitter")?;
+        let Some(&e) = emitters.first() else {
+            return Ok(None);
+        };
+        if e.plugin() != "area" {
+            return Err(e.loc.error(format!(
+                "a shape's emitter must be `area`, not `{}`",
+                e.plugin()
+            )));
+        }
+        let ep = Props::new(e, self.ids);
+        let radiance = match ep.colour("radiance", true)? {
+            None => crate::math::Rgb::ONE,
+            Some(Colour::Value(c)) => c,
+            Some(Colour::Texture(t)) => {
+                let id = self.texture(t)?;
+                self.warn(
+                    &t.loc,
+                    "textured emission: the texture's mean radiance is used",
+                );
+                self.textures[id as usize].mean()
+            }
+        };
+        ep.unused(&mut self.warnings);
+        if !(radiance.min_element() >= 0.0) {
+            return Err(e.loc.error("radiance must be >= 0"));
+        }
+        Ok(Some(radiance))
+    }
+}
+
+/// An OBJ file as an indexed mesh (its MTL materials are Mitsuba's to ignore).
+fn obj_mesh(path: &std::path::Path, flip_uv: bool) -> Result<MeshData> {
+    let obj = crate::scene::obj::load_obj(path)?;
+    let mut mesh = MeshData::default();
+    let has_normals =
+        obj.triangles.iter().all(|t| t.normals.is_some()) && !obj.triangles.is_empty();
+    let has_uvs = obj.triangles.iter().all(|t| t.uvs.is_some()) && !obj.triangles.is_empty();
+    let (mut normals, mut uvs) = (Vec::new(), Vec::new());
+    for t in &obj.triangles {
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(t.vertices.map(glam::Vec3::from));
+        if has_normals {
+            normals.extend(t.normals.unwrap().map(glam::Vec3::from));
+        }
+        if has_uvs {
+            // load_obj flips v as Mitsuba does by default; undo on request.
+            uvs.extend(t.uvs.unwrap().map(|uv| match flip_uv {
+                true => uv,
+                false => Vec2::new(uv.x, 1.0 - uv.y),
+            }));
+        }
+        mesh.indices.push([base, base + 1, base + 2]);
+    }
+    mesh.normals = has_normals.then_some(normals);
+    mesh.uvs = has_uvs.then_some(uvs);
+    Ok(mesh)
+}
