@@ -7,6 +7,10 @@ mod common;
 mod reference;
 // Each material model against Mitsuba 3 renders of the same scene.
 mod material_references;
+// Veach's scenes from Bitterli's Mitsuba files against Mitsuba 3 and Tungsten.
+mod bitterli;
+// Mitsuba XML, PLY and serialized import: every element, every error.
+mod import;
 // White furnace: closed sphere with known radiance Le / (1 - albedo).
 mod furnace;
 // Chi-square goodness of fit of every sampling routine against its pdf.

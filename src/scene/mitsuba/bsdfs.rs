@@ -37,7 +37,14 @@ impl<'a> Importer<'a> {
             return Ok(id);
         }
         let mut material = match bsdf {
-            Some(b) => self.bsdf(b, false)?,
+            Some(b) => {
+                let mut m = self.bsdf(b, false)?;
+                // Named after the outermost element (a `twosided`'s id).
+                if let Some(id) = b.attr("id") {
+                    m.name = id.to_string();
+                }
+                m
+            }
             // Mitsuba's default: a one-sided diffuse of reflectance 0.5.
             None => self.built(
                 "default",

@@ -1,0 +1,322 @@
+//! Mitsuba XML import: a file Mitsuba rendered gives Mitsuba's image, every
+//! element the importer reads lands where Mitsuba puts it, and every
+//! mistake is an error or a warning naming file, line and column.
+
+use crate::common::{reference, render_adaptive, repo_path, temp_dir};
+use glam::Vec3A;
+use std::io::Write;
+use tracelab::integrator::{Integrator, PathTracer};
+use tracelab::sampling::SamplerKind;
+use tracelab::scene::{LoadOptions, Scene};
+
+fn load(name: &str, xml: &str, defines: &[(&str, &str)], strict: bool) -> tracelab::Result<Scene> {
+    let dir = temp_dir(name);
+    write_assets(&dir);
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, xml).unwrap();
+    let options = LoadOptions {
+        defines: defines
+            .iter()
+            .map(|(n, v)| (n.to_string(), v.to_string()))
+            .collect(),
+        strict,
+        ..Default::default()
+    };
+    Scene::load_with(&path, &options)
+}
+
+/// A unit quad as ASCII PLY, a one-triangle serialized mesh, an include.
+fn write_assets(dir: &std::path::Path) {
+    std::fs::write(
+        dir.join("quad.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n",
+    )
+    .unwrap();
+    // Mitsuba's serialized format, version 4: header, zlib stream, offset table.
+    let mut shape = Vec::new();
+    shape.extend(0u32.to_le_bytes()); // flags: single precision, no normals or uvs
+    shape.extend(b"tri\0");
+    shape.extend(3u64.to_le_bytes());
+    shape.extend(1u64.to_le_bytes());
+    for v in [0f32, 0., 0., 1., 0., 0., 0., 1., 0.] {
+        shape.extend(v.to_le_bytes());
+    }
+    for i in [0u32, 1, 2] {
+        shape.extend(i.to_le_bytes());
+    }
+    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+    z.write_all(&shape).unwrap();
+    let mut file = vec![0x1C, 0x04, 4, 0];
+    file.extend(z.finish().unwrap());
+    file.extend(0u64.to_le_bytes());
+    file.extend(1u32.to_le_bytes());
+    std::fs::write(dir.join("tri.serialized"), file).unwrap();
+    std::fs::write(
+        dir.join("light.xml"),
+        r##"<scene version="3.0.0">
+  <shape type="rectangle">
+    <transform name="to_world"><rotate x="1" angle="90"/><translate y="4"/></transform>
+    <emitter type="area"><rgb name="radiance" value="$power"/></emitter>
+  </shape>
+</scene>"##,
+    )
+    .unwrap();
+}
+
+const SENSOR: &str = r##"
+  <sensor type="perspective">
+    <float name="fov" value="60"/>
+    <transform name="to_world"><lookat origin="0, 1, 5" target="0, 1, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="$res"/><integer name="height" value="16"/></film>
+    <sampler type="stratified"><integer name="sample_count" value="$spp"/></sampler>
+  </sensor>"##;
+
+#[test]
+fn mitsubas_cornell_box_file_matches_mitsubas_render_of_it() {
+    // The file that made tests/data/cornell_box_path_ref.exr, read by the
+    // importer: the RMSE test of reference.rs (see its comment).
+    let scene = Scene::load_with(
+        &repo_path("bench/peer/cornell_box_mitsuba.xml"),
+        &LoadOptions::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(
+        scene.hints.max_depth,
+        Some(8),
+        "max_depth 9 segments = 8 bounces"
+    );
+    assert_eq!(scene.hints.spp, Some(64));
+    let integrator = PathTracer {
+        max_depth: 8,
+        ..Default::default()
+    };
+    let (snapshot, stats) = render_adaptive(
+        Integrator::from(integrator),
+        SamplerKind::Independent,
+        None,
+        scene,
+        64,
+        3,
+        0,
+        8,
+    );
+    assert_eq!(stats.non_finite, 0);
+    let reference_image = reference("cornell_box_path_ref.exr");
+    let variance = reference("cornell_box_path_ref_var.exr");
+    let rmse = snapshot.image.compare(&reference_image).unwrap().rmse;
+    let mut expected = 0.0f64;
+    for (se, v) in snapshot.standard_error.pixels.iter().zip(&variance.pixels) {
+        for c in 0..3 {
+            expected += (se[c] as f64).powi(2) + v[c] as f64;
+        }
+    }
+    let expected = (expected / (snapshot.image.pixels.len() * 3) as f64).sqrt();
+    eprintln!("imported Cornell box: RMSE {rmse:.5}, expected {expected:.5}");
+    assert!(rmse <= 1.10 * expected, "RMSE {rmse} against {expected}");
+}
+
+#[test]
+fn every_element_lands_where_mitsuba_puts_it() {
+    let xml = format!(
+        r##"<scene version="3.0.0">
+  <default name="res" value="24"/>
+  <default name="spp" value="4"/>
+  <default name="power" value="2"/>
+  <integrator type="volpath"><integer name="max_depth" value="-1"/><integer name="rr_depth" value="3"/></integrator>
+  {SENSOR}
+  <texture type="checkerboard" id="checks">
+    <rgb name="color0" value="0.1"/><srgb name="color1" value="#ff0000"/>
+    <transform name="to_uv"><scale x="4" y="2"/></transform>
+  </texture>
+  <bsdf type="twosided" id="floor">
+    <bsdf type="diffuse"><ref name="reflectance" id="checks"/></bsdf>
+  </bsdf>
+  <bsdf type="roughconductor" id="metal">
+    <string name="material" value="Au"/><float name="alpha" value="0.2"/>
+    <string name="distribution" value="ggx"/>
+  </bsdf>
+  <include filename="light.xml"/>
+  <shape type="ply"><string name="filename" value="quad.ply"/>
+    <transform name="to_world"><scale value="2"/><translate x="1"/></transform>
+    <ref id="floor"/>
+  </shape>
+  <shape type="serialized"><string name="filename" value="tri.serialized"/><ref id="metal"/></shape>
+  <shape type="cube"><transform name="to_world"><scale value="0.5"/></transform></shape>
+  <shape type="sphere"><point name="center" x="0" y="1" z="0"/><float name="radius" value="0.25"/>
+    <transform name="to_world"><scale value="2"/></transform>
+    <bsdf type="dielectric"><string name="int_ior" value="water"/></bsdf>
+  </shape>
+  <shape type="shapegroup" id="group">
+    <shape type="rectangle"><transform name="to_world"><translate z="-3"/></transform></shape>
+  </shape>
+  <shape type="instance"><ref id="group"/><transform name="to_world"><translate x="5"/></transform></shape>
+  <shape type="instance"><ref id="group"/><transform name="to_world"><translate x="-5"/></transform></shape>
+  <emitter type="point"><point name="position" x="0" y="3" z="0"/><spectrum name="intensity" value="5"/></emitter>
+</scene>"##
+    );
+    let scene = load("elements", &xml, &[("res", "32")], false).unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    // Hints: volpath is path tracing; -1 is unbounded; the sampler's count.
+    assert_eq!(scene.hints.integrator.as_deref(), Some("path"));
+    assert_eq!(
+        scene.hints.max_depth,
+        Some(tracelab::scene::UNBOUNDED_DEPTH)
+    );
+    assert_eq!(scene.hints.rr_depth, Some(3));
+    assert_eq!(
+        (scene.hints.spp, scene.hints.sampler.as_deref()),
+        (Some(4), Some("stratified"))
+    );
+    // -D wins over <default>; fov is along x (Mitsuba's default axis).
+    let camera = &scene.camera;
+    assert_eq!((camera.width, camera.height), (32, 16));
+    let tan_half_x = 30f32.to_radians().tan();
+    assert!((camera.tan_half_fov_y - tan_half_x * 16.0 / 32.0).abs() < 1e-5);
+    assert!((camera.eye - Vec3A::new(0.0, 1.0, 5.0)).length() < 1e-5);
+    assert!((camera.forward - Vec3A::new(0.0, 0.0, -1.0)).length() < 1e-5);
+    // Image right is +x looking down -z with y up.
+    assert!(
+        (camera.right - Vec3A::X).length() < 1e-5,
+        "{:?}",
+        camera.right
+    );
+    // Triangles: light 2 + ply 2 + serialized 1 + cube 12 + two instances 2 each.
+    assert_eq!(scene.geometry.triangle_count(), 2 + 2 + 1 + 12 + 4);
+    // The included light: rotated about x by 90 degrees, then lifted to y = 4,
+    // facing down (Mitsuba's rectangle faces +z; +z rotated about x is -y).
+    let lights = scene.lights.as_slice();
+    let light = lights
+        .iter()
+        .find_map(|l| match l {
+            tracelab::scene::light::Light::Parallelogram(p) => Some(p),
+            _ => None,
+        })
+        .expect("the rectangle is a parallelogram light");
+    assert!(
+        (light.p0.y - 4.0).abs() < 1e-5 && light.normal.y < -0.999,
+        "{light:?}"
+    );
+    assert!((light.area - 4.0).abs() < 1e-4);
+    assert!((light.radiance - Vec3A::splat(2.0)).length() < 1e-6);
+    // The sphere: to_world scales its center and radius.
+    let sphere = scene.geometry.spheres()[0];
+    assert!((sphere.center - Vec3A::new(0.0, 2.0, 0.0)).length() < 1e-5);
+    assert!((sphere.radius - 0.5).abs() < 1e-6);
+    // Materials: textured twosided diffuse, gold, water, the default.
+    let names: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
+    assert!(
+        names.contains(&"floor") && names.contains(&"metal"),
+        "{names:?}"
+    );
+    let floor = scene.materials.iter().find(|m| m.name == "floor").unwrap();
+    assert!(floor.textures.diffuse.is_some());
+    assert_eq!(scene.textures.len(), 1, "the texture is loaded once");
+    let red = scene.textures[0].eval(glam::Vec2::new(0.15, 0.1));
+    let dark = scene.textures[0].eval(glam::Vec2::new(0.05, 0.1));
+    assert!(
+        (red - Vec3A::X).length() < 1e-6 && (dark - Vec3A::splat(0.1)).length() < 1e-6,
+        "to_uv scales u by 4: {red:?} {dark:?}"
+    );
+}
+
+#[test]
+fn mitsuba_06_names_read_as_mitsuba_3s() {
+    let xml = r##"<scene version="0.6.0">
+  <sensor type="perspective">
+    <float name="fov" value="40"/><string name="fovAxis" value="y"/>
+    <transform name="toWorld"><lookat origin="0, 0, 4" target="0, 0, 0"/></transform>
+    <film type="ldrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+    <sampler type="ldsampler"><integer name="sampleCount" value="16"/></sampler>
+  </sensor>
+  <shape type="rectangle">
+    <bsdf type="roughplastic"><float name="intIOR" value="1.6"/><srgb name="diffuseReflectance" value="#808080"/><float name="alpha" value="0.3"/></bsdf>
+  </shape>
+  <emitter type="constant"><spectrum name="radiance" value="400:1, 700:1"/></emitter>
+</scene>"##;
+    let scene = load("v06", xml, &[], false).unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(scene.hints.spp, Some(16));
+    assert_eq!(scene.hints.sampler.as_deref(), Some("sobol"));
+    assert!((scene.camera.tan_half_fov_y - 20f32.to_radians().tan()).abs() < 1e-6);
+    assert!(matches!(
+        scene.materials[0].bsdf,
+        tracelab::bsdf::Bsdf::RoughPlastic { .. }
+    ));
+}
+
+#[test]
+fn mistakes_name_file_line_and_column() {
+    let error = |name: &str, xml: &str| -> String {
+        match load(name, xml, &[], false) {
+            Ok(_) => panic!("{name}: loaded"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let e = error(
+        "syntax",
+        "<scene version=\"3.0.0\">\n  <shape type=\"cube\">\n</scene>",
+    );
+    assert!(e.contains("scene.xml:3:"), "{e}");
+    let e = error(
+        "param",
+        "<scene version=\"3.0.0\">\n  <integer name=\"x\" value=\"$nope\"/>\n</scene>",
+    );
+    assert!(e.contains("scene.xml:2:3: `$nope` is not defined"), "{e}");
+    let e = error(
+        "file",
+        "<scene version=\"3.0.0\">\n<shape type=\"obj\"><string name=\"filename\" value=\"none.obj\"/></shape>\n</scene>",
+    );
+    assert!(
+        e.contains("scene.xml:2:1: file `none.obj` not found"),
+        "{e}"
+    );
+    let e = error(
+        "ref",
+        "<scene version=\"3.0.0\">\n<shape type=\"cube\">\n  <ref id=\"missing\"/>\n</shape>\n</scene>",
+    );
+    assert!(e.contains("scene.xml:3:3:") && e.contains("missing"), "{e}");
+    let e = error("version", "<scene>\n</scene>");
+    assert!(e.contains("needs a `version`"), "{e}");
+    let e = error("root", "<mesh/>");
+    assert!(e.contains("not <scene>"), "{e}");
+    let e = error(
+        "number",
+        "<scene version=\"3.0.0\">\n<shape type=\"sphere\"><float name=\"radius\" value=\"big\"/></shape>\n</scene>",
+    );
+    assert!(
+        e.contains("scene.xml:2:") && e.contains("\"big\" is not a number"),
+        "{e}"
+    );
+}
+
+#[test]
+fn what_is_not_rendered_is_a_warning_and_strict_makes_it_an_error() {
+    let xml = format!(
+        r##"<scene version="3.0.0">
+  <default name="res" value="8"/><default name="spp" value="1"/><default name="power" value="1"/>
+  {SENSOR}
+  <shape type="cube">
+    <bsdf type="bumpmap"><texture type="bitmap" name="arbitrary"><string name="filename" value="x.png"/></texture>
+      <bsdf type="diffuse"/></bsdf>
+    <float name="mystery" value="1"/>
+  </shape>
+  <shape type="hair"/>
+  <emitter type="sunsky"/>
+</scene>"##
+    );
+    let scene = load("warnings", &xml, &[], false).unwrap_or_else(|e| panic!("{e}"));
+    let w = scene.warnings.join("\n");
+    for expected in [
+        "scene.xml:11:5: bump map ignored",
+        "scene.xml:13:5: shape `cube`: property `mystery` ignored",
+        "scene.xml:15:3: shape \"hair\" is not supported: skipped",
+        "scene.xml:16:3: emitter \"sunsky\" is not supported: skipped",
+    ] {
+        assert!(w.contains(expected), "missing {expected:?} in\n{w}");
+    }
+    let e = load("strict", &xml, &[], true)
+        .err()
+        .expect("strict refuses");
+    assert!(e.to_string().contains("bump map ignored") && e.to_string().contains("--strict"));
+}
