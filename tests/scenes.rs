@@ -1,4 +1,5 @@
-//! Every scene shipped in `scenes/` loads without warnings and renders
+//! Every scene shipped in `scenes/` (TOML, and Mitsuba XML in its own
+//! folder) loads without warnings and renders
 //! without a single non-finite sample.
 
 use crate::common::{render, repo_path};
@@ -6,14 +7,25 @@ use tracelab::integrator::{Integrator, PathTracer};
 use tracelab::sampling::SamplerKind;
 use tracelab::scene::Scene;
 
+/// tracelab's TOML scenes, and the imported ones (`scenes/NAME/scene.xml`).
+fn shipped_scenes() -> Vec<std::path::PathBuf> {
+    let mut paths = Vec::new();
+    for entry in std::fs::read_dir(repo_path("scenes")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            paths.push(path);
+        } else if path.join("scene.xml").is_file() {
+            paths.push(path.join("scene.xml"));
+        }
+    }
+    paths.sort();
+    paths
+}
+
 #[test]
 fn every_shipped_scene_renders_cleanly() {
     let mut count = 0;
-    for entry in std::fs::read_dir(repo_path("scenes")).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_none_or(|e| e != "toml") {
-            continue;
-        }
+    for path in shipped_scenes() {
         let mut scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
         assert!(
             scene.warnings.is_empty(),
@@ -45,18 +57,14 @@ fn every_shipped_scene_renders_cleanly() {
         }
         count += 1;
     }
-    assert!(count >= 6);
+    assert!(count >= 8);
 }
 
 /// Every estimator on every scene for 64 spp: not one non-finite sample.
 #[test]
 fn every_estimator_renders_every_scene_without_non_finite_samples() {
     use tracelab::integrator::{IntegratorKind, IntegratorOptions};
-    for entry in std::fs::read_dir(repo_path("scenes")).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_none_or(|e| e != "toml") {
-            continue;
-        }
+    for path in shipped_scenes() {
         let mut scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
         scene.set_resolution(24, 18);
         for kind in [

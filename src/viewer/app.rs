@@ -184,17 +184,50 @@ impl ViewerApp {
                 for w in &scene.warnings {
                     self.toast(format!("{path}: {w}"));
                 }
+                self.apply_hints(&scene.hints);
                 self.scene = Some(Arc::new(scene));
                 self.camera = None;
                 self.settings.scene_path = path.to_string();
                 self.scene_field = path.to_string();
-                self.scene_name = Path::new(path)
-                    .file_stem()
+                // An imported scene is named after its folder (veach-mis/scene.xml).
+                let p = Path::new(path);
+                let named = match p.file_stem().is_some_and(|s| s == "scene") {
+                    true => p.parent().and_then(Path::file_name),
+                    false => p.file_stem(),
+                };
+                self.scene_name = named
                     .map(|s| s.to_string_lossy().into_owned())
                     .unwrap_or_else(|| "scene".into());
                 self.view = ViewTransform::default();
             }
             Err(e) => self.errors.push(e.to_string()),
+        }
+    }
+
+    /// What an imported file asks for (Mitsuba's integrator block): the
+    /// technique and depths of view A, said in a toast.
+    fn apply_hints(&mut self, hints: &crate::scene::RenderHints) {
+        let a = &mut self.settings.a.integrator;
+        let mut said = Vec::new();
+        if let Some(kind) = hints.integrator.as_deref().and_then(|name| {
+            crate::integrator::IntegratorKind::ALL
+                .iter()
+                .copied()
+                .find(|k| k.name() == name)
+        }) {
+            a.kind = kind;
+            said.push(kind.label().to_string());
+        }
+        if let Some(d) = hints.max_depth {
+            a.max_depth = d;
+            said.push(format!("max depth {d}"));
+        }
+        if let Some(d) = hints.rr_depth {
+            a.rr_depth = d;
+            said.push(format!("roulette from {d}"));
+        }
+        if !said.is_empty() {
+            self.toast(format!("from the scene file: {}", said.join(", ")));
         }
     }
 

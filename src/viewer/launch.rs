@@ -104,8 +104,9 @@ pub(super) fn resolve_scene_path(path: &str) -> String {
     path.to_string()
 }
 
-/// The `.toml` files in `scenes/` (relative to the working directory, or to
-/// the source tree when run from elsewhere).
+/// The `.toml` files in `scenes/` and the imported scenes in its folders
+/// (`scenes/NAME/scene.xml`), relative to the working directory, or to the
+/// source tree when run from elsewhere.
 pub(super) fn list_scene_files() -> Vec<String> {
     let local = Path::new("scenes");
     let dir = if local.is_dir() {
@@ -118,7 +119,10 @@ pub(super) fn list_scene_files() -> Vec<String> {
         .flatten()
         .flatten()
         .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .filter_map(|p| match p.extension().is_some_and(|e| e == "toml") {
+            true => Some(p),
+            false => Some(p.join("scene.xml")).filter(|x| x.is_file()),
+        })
         .map(|p| p.to_string_lossy().into_owned())
         .collect();
     files.sort();

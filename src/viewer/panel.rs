@@ -68,7 +68,7 @@ fn scene_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
     ui.horizontal(|ui| {
         ui.add(
             egui::TextEdit::singleline(&mut app.scene_field)
-                .hint_text("path/to/scene.toml")
+                .hint_text("scene.toml, scene.xml, mesh.obj or .ply")
                 .desired_width(180.0),
         );
         if ui.button("Load").clicked() {
