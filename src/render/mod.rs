@@ -157,20 +157,25 @@ impl Session {
     /// do not yet handle light from infinity, spot lights or shading
     /// normals.
     pub fn unsupported(scene: &Scene, settings: &RenderSettings) -> Option<Error> {
-        let bidirectional = matches!(
-            settings.integrator.kind(),
-            crate::integrator::IntegratorKind::Bdpt | crate::integrator::IntegratorKind::Vcm
-        );
-        (bidirectional
-            && (scene.lights.has_lights_bidirectional_lacks() || scene.features.shading_normals))
-            .then(|| {
-                Error::new(format!(
-                    "{} does not handle environment, directional or spot lights or shading \
-                     normals yet (its MIS needs their densities and the adjoint's correction): \
-                     use path, light, mcrt or photon mapping",
-                    settings.integrator.name()
-                ))
-            })
+        use crate::integrator::IntegratorKind;
+        let kind = settings.integrator.kind();
+        let bidirectional = matches!(kind, IntegratorKind::Bdpt | IntegratorKind::Vcm);
+        let lacks = if bidirectional && scene.lights.has_lights_bidirectional_lacks() {
+            "environment, directional or spot lights (its MIS needs their densities)"
+        } else if kind == IntegratorKind::Vcm && scene.features.shading_normals {
+            "shading normals (its merging needs the adjoint's correction)"
+        } else {
+            return None;
+        };
+        Some(Error::new(format!(
+            "{} does not handle {lacks} yet: use path, light, mcrt or photon mapping{}",
+            settings.integrator.name(),
+            if kind == IntegratorKind::Vcm && !scene.lights.has_lights_bidirectional_lacks() {
+                ", or bdpt"
+            } else {
+                ""
+            }
+        )))
     }
 
     /// Starts a session on an existing pool (sessions that take turns share one).

@@ -8,7 +8,6 @@
 
 use super::{Bdpt, Connection, Kind, Vertex};
 use crate::integrator::MisHeuristic;
-use crate::math::Frame;
 use crate::scene::Scene;
 
 impl Bdpt {
@@ -135,7 +134,7 @@ pub(super) fn pdf(scene: &Scene, v: &Vertex, previous: Option<&Vertex>, next: &V
         Kind::Light => return light_direction_pdf(scene, v, next),
         Kind::Surface => {
             let wo = previous.map_or(v.wo, |p| (p.point - v.point).normalize_or_zero());
-            let frame = Frame::from_normal(v.normal);
+            let frame = v.frame();
             v.bsdf.pdf(frame.to_local(wo), frame.to_local(w))
         }
     };

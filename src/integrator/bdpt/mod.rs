@@ -29,7 +29,7 @@
 //! splatting pass, which divides by N: a camera strategy's estimate for its
 //! own pixel is multiplied by W H.
 
-use super::light::{importance_weight, sample_particle, sees_lens};
+use super::light::{importance_weight, sample_particle, sees_lens, shading_correction};
 use super::{IntegratorOptions, MisHeuristic, RayCounts, Splat, SplattingEstimator, Technique};
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, ray_between};
@@ -125,6 +125,9 @@ struct Vertex {
     /// Geometric normal; zero for a pinhole or a point light, which have
     /// no surface to project densities on.
     normal: Vec3A,
+    /// Shading normal of a surface (interpolated vertex normals), which
+    /// frames its BSDF; zero where it is the geometric one.
+    shading: Vec3A,
     /// Unit direction towards the previous vertex of its subpath.
     wo: Vec3A,
     bsdf: Bsdf,
@@ -163,6 +166,7 @@ impl Vertex {
         point: Vec3A::ZERO,
         error: Vec3A::ZERO,
         normal: Vec3A::ZERO,
+        shading: Vec3A::ZERO,
         wo: Vec3A::ZERO,
         bsdf: Bsdf::Diffuse { albedo: Rgb::ZERO },
         beta: Rgb::ZERO,
@@ -185,9 +189,9 @@ impl Vertex {
     fn scatter(&self, w: Vec3A) -> Rgb {
         match self.kind {
             Kind::Surface => {
-                let frame = Frame::from_normal(self.normal);
+                let frame = self.frame();
                 let (wo, w) = (frame.to_local(self.wo), frame.to_local(w));
-                self.bsdf.eval(w, wo)
+                self.bsdf.eval(w, wo) * shading_correction(wo, w, self.normal_local(&frame))
             }
             Kind::Light => {
                 if self.normal == Vec3A::ZERO || self.two_sided || self.normal.dot(w) > 0.0 {
@@ -197,6 +201,38 @@ impl Vertex {
                 }
             }
             Kind::Camera => Rgb::ZERO,
+        }
+    }
+
+    /// The frame of the BSDF: the shading normal's where there is one.
+    #[inline]
+    fn frame(&self) -> Frame {
+        Frame::from_normal(if self.shading == Vec3A::ZERO {
+            self.normal
+        } else {
+            self.shading
+        })
+    }
+
+    /// The geometric normal in `frame` (exactly +z without a shading normal,
+    /// where the adjoint's correction is 1).
+    #[inline]
+    fn normal_local(&self, frame: &Frame) -> Vec3A {
+        if self.shading == Vec3A::ZERO {
+            Vec3A::Z
+        } else {
+            frame.to_local(self.normal)
+        }
+    }
+
+    /// |cos| between the shading normal and `w`: the cosine of the
+    /// scattering integral (Veach's thesis, 5.3; pbrt's G).
+    #[inline]
+    fn shading_cos(&self, w: Vec3A) -> f32 {
+        if self.shading == Vec3A::ZERO {
+            self.cos(w)
+        } else {
+            self.shading.dot(w).abs()
         }
     }
 
@@ -437,6 +473,12 @@ impl Bdpt {
             let previous = path[index - 1];
             let bsdf = scene.bsdf_at(&hit);
             let mut vertex = surface_vertex(&hit, bsdf, wo_world, beta);
+            if scene.features.shading_normals {
+                let n = scene.geometry.shading_normal(&hit);
+                if n != hit.normal {
+                    vertex.shading = n;
+                }
+            }
             if hit.light != NO_LIGHT {
                 vertex.light = hit.light;
                 vertex.emitted = material.emitted(hit.normal, wo_world);
@@ -449,7 +491,7 @@ impl Bdpt {
                 break;
             }
 
-            let frame = Frame::from_normal(hit.normal);
+            let frame = vertex.frame();
             let wo = frame.to_local(wo_world);
             let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
                 break;
@@ -459,9 +501,13 @@ impl Bdpt {
                     relative /= bsdf.refraction_scale(wo, sample.wi);
                     sample.weight
                 }
-                Transport::Importance => {
-                    importance_weight(bsdf, wo, sample.wi, Vec3A::Z, sample.weight)
-                }
+                Transport::Importance => importance_weight(
+                    bsdf,
+                    wo,
+                    sample.wi,
+                    vertex.normal_local(&frame),
+                    sample.weight,
+                ),
             };
             let (pdf_fwd, pdf_rev) = if sample.specular {
                 (0.0, 0.0)
@@ -533,7 +579,7 @@ impl Bdpt {
                 return None;
             }
             let c = scene.camera.connect(qs.point, qs.u_connect)?;
-            let value = qs.beta * qs.scatter(c.wi) * (qs.cos(c.wi) * c.weight);
+            let value = qs.beta * qs.scatter(c.wi) * (qs.shading_cos(c.wi) * c.weight);
             if !(value.max_element() > 0.0)
                 || !sees_lens(scene, qs.point, qs.error, qs.normal, &c, time, counts)
             {
@@ -561,13 +607,13 @@ impl Bdpt {
             return None;
         }
         let pm = &cam[t - 2];
-        let frame = Frame::from_normal(pt.normal);
+        let frame = pt.frame();
         let wo = frame.to_local(pt.wo);
         if s == 1 {
             // Next-event estimation from z_{t-1}.
             let ls = scene.lights.sample(pt.point, pt.u_select, pt.u_connect)?;
             let (f, _, pdf_reverse) = pt.bsdf.eval_with_pdfs(wo, frame.to_local(ls.wi));
-            let value = pt.beta * f * ls.radiance * (pt.cos(ls.wi) / ls.pdf);
+            let value = pt.beta * f * ls.radiance * (pt.shading_cos(ls.wi) / ls.pdf);
             if !(value.max_element() > 0.0) {
                 return None;
             }
@@ -615,11 +661,11 @@ impl Bdpt {
         }
         let w = d / dist2.sqrt();
         let (f_pt, pdf_pt, pdf_pt_reverse) = pt.bsdf.eval_with_pdfs(wo, frame.to_local(-w));
-        let qs_frame = Frame::from_normal(qs.normal);
-        let (f_qs, pdf_qs, pdf_qs_reverse) = qs
-            .bsdf
-            .eval_adjoint_with_pdfs(qs_frame.to_local(qs.wo), qs_frame.to_local(w));
-        let g = qs.cos(w) * pt.cos(w) / dist2;
+        let qs_frame = qs.frame();
+        let (qs_wo, qs_w) = (qs_frame.to_local(qs.wo), qs_frame.to_local(w));
+        let (f_qs, pdf_qs, pdf_qs_reverse) = qs.bsdf.eval_adjoint_with_pdfs(qs_wo, qs_w);
+        let f_qs = f_qs * shading_correction(qs_wo, qs_w, qs.normal_local(&qs_frame));
+        let g = qs.shading_cos(w) * pt.shading_cos(w) / dist2;
         let value = qs.beta * f_qs * f_pt * pt.beta * g;
         if !(value.max_element() > 0.0) {
             return None;
