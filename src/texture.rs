@@ -116,6 +116,16 @@ impl Bitmap {
             return read_pfm(&bytes).map_err(|e| format!("{}: {e}", path.display()));
         }
         let image = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        Self::from_image(image, raw).map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// Decodes an image held in memory (a glTF file's embedded images).
+    pub fn decode(bytes: &[u8], raw: bool) -> Result<Bitmap, String> {
+        let image = image::load_from_memory(bytes).map_err(|e| e.to_string())?;
+        Self::from_image(image, raw)
+    }
+
+    fn from_image(image: image::DynamicImage, raw: bool) -> Result<Bitmap, String> {
         let float = matches!(
             image.color(),
             image::ColorType::Rgb32F | image::ColorType::Rgba32F
@@ -123,7 +133,7 @@ impl Bitmap {
         let rgb = image.to_rgb32f();
         let (width, height) = (rgb.width() as usize, rgb.height() as usize);
         if width == 0 || height == 0 {
-            return Err(format!("{}: the image is empty", path.display()));
+            return Err("the image is empty".into());
         }
         let decode = |c: f32| {
             let c = if c.is_finite() { c.max(0.0) } else { 0.0 };

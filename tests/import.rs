@@ -320,3 +320,153 @@ fn what_is_not_rendered_is_a_warning_and_strict_makes_it_an_error() {
         .expect("strict refuses");
     assert!(e.to_string().contains("bump map ignored") && e.to_string().contains("--strict"));
 }
+
+/// A floor quad, an emissive quad, a camera and a point light under a
+/// parent node, as glTF JSON; `uri` names the buffer file (None: a GLB's).
+fn gltf_json(uri: Option<&str>) -> String {
+    let buffer = match uri {
+        Some(u) => format!(r#"{{"byteLength": 140, "uri": "{u}"}}"#),
+        None => r#"{"byteLength": 140}"#.to_string(),
+    };
+    format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength"],
+  "extensions": {{"KHR_lights_punctual": {{"lights": [{{"type": "point", "color": [1, 0.5, 0.25], "intensity": 10}}]}}}},
+  "scene": 0,
+  "scenes": [{{"nodes": [0, 1, 2, 3]}}],
+  "nodes": [
+    {{"mesh": 0, "rotation": [-0.70710678, 0, 0, 0.70710678], "scale": [5, 5, 5]}},
+    {{"mesh": 1, "rotation": [0.70710678, 0, 0, 0.70710678], "translation": [0, 3, 0]}},
+    {{"camera": 0, "translation": [0, 1, 5]}},
+    {{"translation": [1, 0, 0], "children": [4]}},
+    {{"translation": [0, 2, 0], "extensions": {{"KHR_lights_punctual": {{"light": 0}}}}}}
+  ],
+  "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.8, "aspectRatio": 1.5, "znear": 0.1}}}}],
+  "meshes": [
+    {{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}}, "indices": 3, "material": 0}}]}},
+    {{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 3, "material": 1}}]}}
+  ],
+  "materials": [
+    {{"name": "floor", "doubleSided": true, "pbrMetallicRoughness": {{"baseColorFactor": [0.8, 0.2, 0.2, 1], "metallicFactor": 0, "roughnessFactor": 0.5}}}},
+    {{"name": "lamp", "emissiveFactor": [1, 1, 1], "extensions": {{"KHR_materials_emissive_strength": {{"emissiveStrength": 5}}}},
+      "pbrMetallicRoughness": {{"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0}}}}
+  ],
+  "buffers": [{buffer}],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": 48}},
+    {{"buffer": 0, "byteOffset": 48, "byteLength": 48}},
+    {{"buffer": 0, "byteOffset": 96, "byteLength": 32}},
+    {{"buffer": 0, "byteOffset": 128, "byteLength": 12}}
+  ],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"}},
+    {{"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"}},
+    {{"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}}
+  ]
+}}"#
+    )
+}
+
+/// The buffer of [`gltf_json`]: a unit quad facing +z, normals, uvs, indices.
+fn gltf_buffer() -> Vec<u8> {
+    let mut b = Vec::new();
+    for p in [[-1f32, -1., 0.], [1., -1., 0.], [1., 1., 0.], [-1., 1., 0.]] {
+        p.iter().for_each(|x| b.extend(x.to_le_bytes()));
+    }
+    for _ in 0..4 {
+        [0f32, 0., 1.]
+            .iter()
+            .for_each(|x| b.extend(x.to_le_bytes()));
+    }
+    for uv in [[0f32, 1.], [1., 1.], [1., 0.], [0., 0.]] {
+        uv.iter().for_each(|x| b.extend(x.to_le_bytes()));
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        b.extend(i.to_le_bytes());
+    }
+    b
+}
+
+#[test]
+fn gltf_nodes_meshes_camera_materials_and_lights_land_where_the_file_puts_them() {
+    let dir = temp_dir("gltf");
+    std::fs::write(dir.join("quad.bin"), gltf_buffer()).unwrap();
+    std::fs::write(dir.join("scene.gltf"), gltf_json(Some("quad.bin"))).unwrap();
+    // The same scene as one binary file: JSON chunk, then BIN chunk.
+    let mut json = gltf_json(None).into_bytes();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let bin = gltf_buffer();
+    let mut glb = Vec::new();
+    glb.extend(b"glTF");
+    glb.extend(2u32.to_le_bytes());
+    glb.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(&json);
+    glb.extend((bin.len() as u32).to_le_bytes());
+    glb.extend(b"BIN\0");
+    glb.extend(&bin);
+    std::fs::write(dir.join("scene.glb"), glb).unwrap();
+
+    for file in ["scene.gltf", "scene.glb"] {
+        let scene = Scene::load(&dir.join(file)).unwrap_or_else(|e| panic!("{e}"));
+        assert!(scene.warnings.is_empty(), "{file}: {:?}", scene.warnings);
+        assert_eq!(scene.geometry.triangle_count(), 4, "{file}");
+        let c = &scene.camera;
+        assert_eq!((c.width, c.height), (640, 427));
+        assert!((c.eye - Vec3A::new(0.0, 1.0, 5.0)).length() < 1e-6);
+        assert!((c.forward - Vec3A::new(0.0, 0.0, -1.0)).length() < 1e-6);
+        assert!((c.tan_half_fov_y - 0.4f32.tan()).abs() < 1e-6);
+        use tracelab::scene::light::Light;
+        let lights = scene.lights.as_slice();
+        let lamp = lights
+            .iter()
+            .find_map(|l| match l {
+                Light::Parallelogram(p) => Some(p),
+                _ => None,
+            })
+            .expect("the emissive quad is a light");
+        // Rotated +90 degrees about x, up 3: facing down, radiance 5.
+        assert!(
+            (lamp.p0.y - 3.0).abs() < 1e-5 && lamp.normal.y < -0.999,
+            "{lamp:?}"
+        );
+        assert!((lamp.radiance - Vec3A::splat(5.0)).length() < 1e-5);
+        // The point light inherits its parent's translation.
+        let point = lights
+            .iter()
+            .find_map(|l| match l {
+                Light::Point {
+                    position,
+                    intensity,
+                } => Some((*position, *intensity)),
+                _ => None,
+            })
+            .expect("the punctual light");
+        assert!((point.0 - Vec3A::new(1.0, 2.0, 0.0)).length() < 1e-5);
+        assert!((point.1 - Vec3A::new(10.0, 5.0, 2.5)).length() < 1e-5);
+        let floor = scene.materials.iter().find(|m| m.name == "floor").unwrap();
+        assert!(
+            matches!(
+                floor.bsdf,
+                tracelab::bsdf::Bsdf::RoughPlastic {
+                    two_sided: true,
+                    ..
+                }
+            ),
+            "{:?}",
+            floor.bsdf
+        );
+    }
+    // A missing buffer file is an error naming the file.
+    std::fs::remove_file(dir.join("quad.bin")).unwrap();
+    let e = Scene::load(&dir.join("scene.gltf"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("scene.gltf") && e.contains("quad.bin"), "{e}");
+}

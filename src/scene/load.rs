@@ -18,7 +18,7 @@ use std::path::Path;
 use toml::Spanned;
 
 /// Reads a scene of any format the loader knows, by its extension: tracelab
-/// TOML, Mitsuba XML, or a bare OBJ or PLY mesh (framed by a default camera
+/// TOML, Mitsuba XML, glTF 2.0, or a bare OBJ or PLY mesh (framed by a default camera
 /// and lit by a constant environment).
 pub fn load_any(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
     let extension = path
@@ -41,11 +41,10 @@ pub fn load_any(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
             not_toml("meshes")?;
             super::framing::bare_mesh(path, &options.limits)
         }
-        Some("gltf" | "glb") => Err(Error::at(
-            path,
-            None,
-            "glTF import is not built yet (scenes: .toml, .xml; meshes: .obj, .ply)",
-        )),
+        Some("gltf" | "glb") => {
+            not_toml("glTF files")?;
+            super::gltf::load_gltf(path, options)
+        }
         _ => {
             not_toml("TOML scenes")?;
             load_scene_file(path, &options.limits)

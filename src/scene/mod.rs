@@ -6,6 +6,7 @@ pub mod description;
 pub mod emitters;
 pub mod environment;
 pub mod framing;
+pub mod gltf;
 pub mod light;
 pub mod lights;
 pub mod load;

@@ -1,0 +1,558 @@
+//! glTF 2.0 scenes (`.gltf` with its buffers, or `.glb`) into a [`SceneInput`]:
+//! the default scene's node tree with its transforms, triangle meshes with
+//! normals and texture coordinates, the first camera, metallic-roughness
+//! materials mapped onto tracelab's models, and KHR_lights_punctual.
+//!
+//! The mapping (say it where a user asks): transmission > 0 is a dielectric
+//! (rough where roughness > 0) of the KHR_materials_ior index, else
+//! metallic ≥ ½ a conductor whose reflectance is the base colour at every
+//! angle, else a plastic (a dielectric coat of IOR 1.5 over the base colour);
+//! GGX with α = roughness². glTF's single-sided materials are one-sided.
+//! Punctual lights' intensities are taken as radiometric (W/sr, W/m²).
+
+use super::appearance::build_material;
+use super::description::{IorDesc, MaterialDesc, MaterialKind};
+use super::environment::{Environment, Radiance};
+use super::material::{Material, MaterialTextures};
+use super::mesh::{MeshData, Orientation};
+use super::{LoadOptions, SceneInput, in_range};
+use crate::accel::TriangleInput;
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::filter::PixelFilter;
+use crate::math::Rgb;
+use crate::scene::light::{Light, LightSampling, SpotCone};
+use crate::texture::{Bitmap, Filter, Texture, UvTransform, Wrap};
+use glam::{Mat3A, Mat4, Vec2, Vec3, Vec3A};
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+/// Reads a glTF 2.0 file.
+pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
+    let err = |m: String| Error::at(path, None, m);
+    let gltf = gltf::Gltf::open(path).map_err(|e| err(format!("not a valid glTF file: {e}")))?;
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut buffers = Vec::new();
+    for buffer in gltf.document.buffers() {
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => gltf
+                .blob
+                .clone()
+                .ok_or_else(|| err("a buffer refers to a missing binary chunk".into()))?,
+            gltf::buffer::Source::Uri(uri) => read_uri(uri, &dir).map_err(err)?,
+        };
+        if data.len() < buffer.length() {
+            return Err(err(format!(
+                "buffer {} holds {} bytes, fewer than its declared {}",
+                buffer.index(),
+                data.len(),
+                buffer.length()
+            )));
+        }
+        buffers.push(data);
+    }
+    let mut importer = Importer {
+        path,
+        dir: &dir,
+        buffers: &buffers,
+        warnings: Vec::new(),
+        materials: Vec::new(),
+        material_ids: HashMap::new(),
+        textures: Vec::new(),
+        texture_ids: HashMap::new(),
+        triangles: Vec::new(),
+        lights: Vec::new(),
+        camera: None,
+        max_triangles: options.limits.max_triangles,
+    };
+    let scene = gltf
+        .document
+        .default_scene()
+        .or_else(|| gltf.document.scenes().next())
+        .ok_or_else(|| err("the file has no scene".into()))?;
+    for node in scene.nodes() {
+        importer.node(&node, Mat4::IDENTITY)?;
+    }
+    let camera = match importer.camera.take() {
+        Some(c) => c,
+        None => {
+            importer.warn("no camera: a default one frames the scene".into());
+            super::framing::default_camera(&importer.triangles, &[])
+        }
+    };
+    options
+        .limits
+        .check_resolution(camera.width, camera.height)
+        .map_err(err)?;
+    let emissive = importer.materials.iter().any(Material::is_emissive);
+    let environment = if importer.lights.is_empty() && !emissive {
+        importer.warn("no light: a constant white environment lights the scene".into());
+        Some(Environment::new(
+            Radiance::Constant(Rgb::ONE),
+            1.0,
+            Mat3A::IDENTITY,
+        ))
+    } else {
+        None
+    };
+    if options.strict && !importer.warnings.is_empty() {
+        return Err(Error::new(format!(
+            "{} (--strict: warnings are errors)",
+            importer.warnings[0]
+        )));
+    }
+    Ok(SceneInput {
+        camera,
+        materials: importer.materials,
+        textures: importer.textures,
+        environment,
+        triangles: importer.triangles,
+        spheres: Vec::new(),
+        point_lights: importer.lights,
+        moving: Vec::new(),
+        sphere_sampling: LightSampling::SolidAngle,
+        triangle_sampling: LightSampling::Area,
+        warnings: importer.warnings,
+        hints: Default::default(),
+    })
+}
+
+/// A buffer or image URI: a file relative to the scene, or base64 data.
+fn read_uri(uri: &str, dir: &Path) -> std::result::Result<Vec<u8>, String> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (_, data) = rest
+            .split_once(";base64,")
+            .ok_or_else(|| "a data URI that is not base64".to_string())?;
+        return base64_decode(data).ok_or_else(|| "bad base64 data in a data URI".to_string());
+    }
+    let file = dir.join(percent_decode(uri));
+    std::fs::read(&file).map_err(|e| format!("cannot read `{}`: {e}", file.display()))
+}
+
+fn percent_decode(s: &str) -> String {
+    let bytes = s.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%'
+            && i + 2 < bytes.len()
+            && let Ok(b) = u8::from_str_radix(&s[i + 1..i + 3], 16)
+        {
+            out.push(b);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+fn base64_decode(s: &str) -> Option<Vec<u8>> {
+    let value = |c: u8| -> Option<u32> {
+        Some(match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' | b'-' => 62,
+            b'/' | b'_' => 63,
+            _ => return None,
+        } as u32)
+    };
+    let data: Vec<u8> = s
+        .bytes()
+        .filter(|c| !c.is_ascii_whitespace() && *c != b'=')
+        .collect();
+    let mut out = Vec::with_capacity(data.len() * 3 / 4);
+    for chunk in data.chunks(4) {
+        let mut n = 0u32;
+        for (i, &c) in chunk.iter().enumerate() {
+            n |= value(c)? << (18 - 6 * i);
+        }
+        let bytes = [(n >> 16) as u8, (n >> 8) as u8, n as u8];
+        out.extend_from_slice(&bytes[..chunk.len().saturating_sub(1)]);
+    }
+    Some(out)
+}
+
+struct Importer<'a> {
+    path: &'a Path,
+    dir: &'a Path,
+    buffers: &'a [Vec<u8>],
+    warnings: Vec<String>,
+    materials: Vec<Material>,
+    material_ids: HashMap<Option<usize>, u32>,
+    textures: Vec<Texture>,
+    texture_ids: HashMap<(usize, bool), u32>,
+    triangles: Vec<TriangleInput>,
+    lights: Vec<Light>,
+    camera: Option<Camera>,
+    max_triangles: usize,
+}
+
+impl Importer<'_> {
+    fn warn(&mut self, what: String) {
+        self.warnings
+            .push(format!("{}: {what}", self.path.display()));
+    }
+
+    fn error(&self, what: String) -> Error {
+        Error::at(self.path, None, what)
+    }
+
+    fn node(&mut self, node: &gltf::Node, parent: Mat4) -> Result<()> {
+        let to_world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !to_world.is_finite() {
+            return Err(self.error(format!(
+                "node {}: its transform is not finite",
+                node.index()
+            )));
+        }
+        if let Some(mesh) = node.mesh() {
+            self.mesh(&mesh, to_world)?;
+        }
+        if let Some(camera) = node.camera() {
+            self.camera(&camera, to_world);
+        }
+        if let Some(light) = node.light() {
+            self.light(&light, to_world)?;
+        }
+        for child in node.children() {
+            self.node(&child, to_world)?;
+        }
+        Ok(())
+    }
+
+    fn mesh(&mut self, mesh: &gltf::Mesh, to_world: Mat4) -> Result<()> {
+        let name = mesh.name().unwrap_or("").to_string();
+        for primitive in mesh.primitives() {
+            if primitive.mode() != gltf::mesh::Mode::Triangles {
+                self.warn(format!(
+                    "mesh {} `{name}`: a primitive of mode {:?} skipped (triangles only)",
+                    mesh.index(),
+                    primitive.mode()
+                ));
+                continue;
+            }
+            let buffers = self.buffers;
+            let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d[..]));
+            let Some(positions) = reader.read_positions() else {
+                self.warn(format!(
+                    "mesh {} `{name}`: a primitive without positions skipped",
+                    mesh.index()
+                ));
+                continue;
+            };
+            let mut data = MeshData {
+                positions: positions.map(Vec3::from).collect(),
+                normals: reader.read_normals().map(|n| n.map(Vec3::from).collect()),
+                uvs: reader
+                    .read_tex_coords(0)
+                    .map(|t| t.into_f32().map(Vec2::from).collect()),
+                indices: Vec::new(),
+            };
+            let flat: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..data.positions.len() as u32).collect(),
+            };
+            data.indices = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            data.validate()
+                .map_err(|m| self.error(format!("mesh {} `{name}`: {m}", mesh.index())))?;
+            let material = self.material(&primitive.material())?;
+            let mut out = Vec::new();
+            data.triangles(
+                to_world,
+                Orientation::Winding,
+                false,
+                false,
+                material,
+                &mut out,
+            );
+            if self.triangles.len() + out.len() > self.max_triangles {
+                return Err(self.error(format!(
+                    "more than {} triangles (raise the limit with --max-triangles)",
+                    self.max_triangles
+                )));
+            }
+            if !out.iter().all(|t| t.vertices.iter().all(|&v| in_range(v))) {
+                return Err(self.error(format!(
+                    "mesh {} `{name}`: coordinates out of range",
+                    mesh.index()
+                )));
+            }
+            self.triangles.extend(out);
+        }
+        Ok(())
+    }
+
+    fn camera(&mut self, camera: &gltf::Camera, to_world: Mat4) {
+        if self.camera.is_some() {
+            return;
+        }
+        let gltf::camera::Projection::Perspective(p) = camera.projection() else {
+            self.warn(format!(
+                "camera {}: orthographic cameras are not supported: skipped",
+                camera.index()
+            ));
+            return;
+        };
+        let aspect = p.aspect_ratio().filter(|a| *a > 0.0).unwrap_or(4.0 / 3.0);
+        let (width, height) = if aspect >= 1.0 {
+            (640, (640.0 / aspect).round().max(1.0) as u32)
+        } else {
+            ((640.0 * aspect).round().max(1.0) as u32, 640)
+        };
+        // A glTF camera looks down its -z with +y up.
+        let eye = Vec3A::from(to_world.w_axis.truncate());
+        let forward = -Vec3A::from(to_world.z_axis.truncate()).normalize_or_zero();
+        let up = Vec3A::from(to_world.y_axis.truncate()).normalize_or_zero();
+        let fov_y = p.yfov().to_degrees();
+        if forward == Vec3A::ZERO || up == Vec3A::ZERO || !(fov_y > 0.0 && fov_y < 180.0) {
+            self.warn(format!(
+                "camera {}: a degenerate frame or field of view: skipped",
+                camera.index()
+            ));
+            return;
+        }
+        self.camera = Some(
+            Camera::look_at(eye, eye + forward, up, fov_y, width, height, 0.0, 1.0)
+                .with_filter(PixelFilter::Box),
+        );
+    }
+
+    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, to_world: Mat4) -> Result<()> {
+        let power = Rgb::from(light.color()) * light.intensity();
+        if !(power.is_finite() && power.min_element() >= 0.0) {
+            return Err(self.error(format!(
+                "light {}: colour and intensity must be >= 0",
+                light.index()
+            )));
+        }
+        let position = Vec3A::from(to_world.w_axis.truncate());
+        let axis = -Vec3A::from(to_world.z_axis.truncate()).normalize_or_zero();
+        if light.range().is_some() {
+            self.warn(format!(
+                "light {}: range ignored (light falls off with distance squared)",
+                light.index()
+            ));
+        }
+        use gltf::khr_lights_punctual::Kind;
+        self.lights.push(match light.kind() {
+            Kind::Point => Light::Point {
+                position,
+                intensity: power,
+            },
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => Light::Spot {
+                position,
+                intensity: power,
+                cone: SpotCone {
+                    axis,
+                    cutoff: outer_cone_angle.clamp(1e-4, std::f32::consts::FRAC_PI_2),
+                    beam_width: inner_cone_angle.clamp(0.0, outer_cone_angle),
+                },
+            },
+            Kind::Directional => Light::Directional {
+                direction: axis,
+                irradiance: power,
+                center: Vec3A::ZERO,
+                radius: 1.0,
+            },
+        });
+        Ok(())
+    }
+
+    /// A glTF material as one of tracelab's (module comment: the mapping).
+    fn material(&mut self, m: &gltf::Material) -> Result<u32> {
+        if let Some(&id) = self.material_ids.get(&m.index()) {
+            return Ok(id);
+        }
+        let name = m.name().unwrap_or("gltf material").to_string();
+        let label = format!("material {} `{name}`", m.index().map_or(-1, |i| i as i64));
+        let pbr = m.pbr_metallic_roughness();
+        let base = pbr.base_color_factor();
+        let base_rgb = [base[0], base[1], base[2]];
+        let roughness = pbr.roughness_factor().clamp(0.0, 1.0);
+        let metallic = pbr.metallic_factor().clamp(0.0, 1.0);
+        let alpha = roughness * roughness;
+        let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
+        let mut textures = MaterialTextures::default();
+        let base_texture = match pbr.base_color_texture() {
+            Some(info) => Some(self.texture(&info.texture(), info.tex_coord(), false, &label)?),
+            None => None,
+        };
+        if pbr.metallic_roughness_texture().is_some() {
+            self.warn(format!(
+                "{label}: metallic-roughness texture ignored (its factors are used)"
+            ));
+        }
+        if m.normal_texture().is_some() {
+            self.warn(format!("{label}: normal map ignored"));
+        }
+        if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
+            self.warn(format!(
+                "{label}: alpha mode {:?} read as opaque",
+                m.alpha_mode()
+            ));
+        }
+        if metallic > 0.0 && metallic < 1.0 && transmission == 0.0 {
+            self.warn(format!(
+                "{label}: metallic {metallic} read as {}",
+                if metallic >= 0.5 {
+                    "a metal"
+                } else {
+                    "a dielectric"
+                }
+            ));
+        }
+        let mut d = MaterialDesc {
+            twosided: Some(m.double_sided()),
+            ..Default::default()
+        };
+        if transmission > 0.0 {
+            if transmission < 1.0 {
+                self.warn(format!("{label}: transmission {transmission} read as 1"));
+            }
+            d.twosided = None;
+            let ior = m.ior().unwrap_or(1.5);
+            // glTF's transmissive volumes are refracting solids.
+            d.kind = match alpha > 1e-4 {
+                true => MaterialKind::RoughDielectric,
+                false => MaterialKind::Dielectric,
+            };
+            if d.kind == MaterialKind::Dielectric {
+                d.ior = Some(ior);
+                d.tint = Some(base_rgb);
+            } else {
+                d.int_ior = Some(IorDesc::Value(ior));
+                d.ext_ior = Some(IorDesc::Value(1.0));
+                d.specular_transmittance = Some(base_rgb);
+                d.distribution = Some(crate::bsdf::Distribution::Ggx);
+                d.alpha = Some(alpha);
+            }
+        } else if metallic >= 0.5 {
+            d.kind = match alpha > 1e-4 {
+                true => MaterialKind::RoughConductor,
+                false => MaterialKind::Conductor,
+            };
+            // η = 0, k = 1: Fresnel 1 at every angle, tinted by the base colour.
+            d.eta = Some([0.0; 3]);
+            d.k = Some([1.0; 3]);
+            d.specular_reflectance = Some(base_rgb);
+            textures.specular = base_texture;
+            if d.kind == MaterialKind::RoughConductor {
+                d.distribution = Some(crate::bsdf::Distribution::Ggx);
+                d.alpha = Some(alpha);
+            }
+        } else {
+            d.kind = match alpha > 1e-4 {
+                true => MaterialKind::RoughPlastic,
+                false => MaterialKind::Plastic,
+            };
+            d.int_ior = Some(IorDesc::Value(1.5));
+            d.ext_ior = Some(IorDesc::Value(1.0));
+            d.diffuse_reflectance = Some(base_rgb);
+            textures.diffuse = base_texture;
+            if d.kind == MaterialKind::RoughPlastic {
+                d.distribution = Some(crate::bsdf::Distribution::Ggx);
+                d.alpha = Some(alpha);
+            }
+        }
+        let strength = m.emissive_strength().unwrap_or(1.0);
+        let mut emission = Rgb::from(m.emissive_factor()) * strength;
+        if let Some(info) = m.emissive_texture() {
+            let id = self.texture(&info.texture(), info.tex_coord(), false, &label)?;
+            self.warn(format!("{label}: emissive texture: its mean is used"));
+            emission *= self.textures[id as usize].mean();
+        }
+        if emission.max_element() > 0.0 {
+            d.emission = Some(emission.to_array());
+            d.two_sided = Some(m.double_sided());
+        }
+        let mut material =
+            build_material(&name, &d).map_err(|e| self.error(format!("{label}: {e}")))?;
+        material.textures = textures;
+        let id = self.materials.len() as u32;
+        self.materials.push(material);
+        self.material_ids.insert(m.index(), id);
+        Ok(id)
+    }
+
+    fn texture(
+        &mut self,
+        t: &gltf::Texture,
+        tex_coord: u32,
+        raw: bool,
+        label: &str,
+    ) -> Result<u32> {
+        if tex_coord != 0 {
+            self.warn(format!(
+                "{label}: texture coordinate set {tex_coord} read as set 0"
+            ));
+        }
+        if let Some(&id) = self.texture_ids.get(&(t.index(), raw)) {
+            return Ok(id);
+        }
+        let image = t.source();
+        let bytes = match image.source() {
+            gltf::image::Source::View { view, .. } => {
+                let data = &self.buffers[view.buffer().index()];
+                let range = view.offset()..view.offset() + view.length();
+                data.get(range)
+                    .ok_or_else(|| {
+                        self.error(format!(
+                            "image {}: its buffer view is out of range",
+                            image.index()
+                        ))
+                    })?
+                    .to_vec()
+            }
+            gltf::image::Source::Uri { uri, .. } => {
+                read_uri(uri, self.dir).map_err(|m| self.error(m))?
+            }
+        };
+        let bitmap = Bitmap::decode(&bytes, raw)
+            .map_err(|m| self.error(format!("image {}: {m}", image.index())))?;
+        let sampler = t.sampler();
+        let wrap = |w: gltf::texture::WrappingMode| match w {
+            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+            gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
+            gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+        };
+        let (wrap_s, wrap_t) = (wrap(sampler.wrap_s()), wrap(sampler.wrap_t()));
+        if wrap_s != wrap_t {
+            self.warn(format!(
+                "{label}: different wrap modes for u and v: u's is used"
+            ));
+        }
+        let filter = match sampler.mag_filter() {
+            Some(gltf::texture::MagFilter::Nearest) => Filter::Nearest,
+            _ => Filter::Bilinear,
+        };
+        let id = self.textures.len() as u32;
+        self.textures.push(Texture::Bitmap {
+            image: Arc::new(bitmap),
+            wrap: wrap_s,
+            filter,
+            to_uv: UvTransform::default(),
+        });
+        self.texture_ids.insert((t.index(), raw), id);
+        Ok(id)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_and_percent_decoding() {
+        assert_eq!(base64_decode("aGVsbG8=").unwrap(), b"hello");
+        assert_eq!(base64_decode("aGVsbG8h").unwrap(), b"hello!");
+        assert!(base64_decode("a$==").is_none());
+        assert_eq!(percent_decode("my%20mesh.bin"), "my mesh.bin");
+    }
+}
