@@ -235,7 +235,8 @@ fn environment_importance_sampling_cuts_the_variance() {
     assert!(v_u > 10.0 * v_i, "variance only {:.1}x lower", v_u / v_i);
 }
 
-/// Light from infinity and delta lights in light tracing: particles from
+/// Light from infinity and delta lights in light tracing (and the spot in
+/// BDPT): particles from
 /// the environment's and the directional light's discs and from the spot's
 /// cone agree with path tracing's light samples (the floor fills the
 /// frame, so no pixel sees the environment itself, which light tracing
@@ -294,6 +295,21 @@ radiance = [0.3, 0.35, 0.4]
     );
     let light = render(scene, Integrator::from(LightTracer::default()), 256, 22);
     assert_agree("every light, light / path", &light, &path);
+    // BDPT handles the spot (a point light with a falloff) but not yet the
+    // lights at infinity: under the spot alone it agrees with light tracing.
+    // (Not with path tracing's standard errors: beyond the spot's cone the
+    // far floor gets 1e-5 by rare paths, whose spread path tracing's few
+    // non-zero samples understate: z 10.8 there, all means within 0.02%.)
+    let spot_only = &text[..text.find("[[directional_light]]").unwrap()];
+    let scene = load_scene_text("spot-light", spot_only);
+    let light = render(
+        scene.clone(),
+        Integrator::from(LightTracer::default()),
+        256,
+        23,
+    );
+    let bdpt = render(scene, Integrator::from(Bdpt::default()), 256, 24);
+    assert_agree("spot light, bdpt / light", &bdpt, &light);
 }
 
 /// An environment map with NaN and infinite texels (read as 0) and one

@@ -160,9 +160,12 @@ impl Session {
         use crate::integrator::IntegratorKind;
         let kind = settings.integrator.kind();
         let bidirectional = matches!(kind, IntegratorKind::Bdpt | IntegratorKind::Vcm);
+        let vcm = kind == IntegratorKind::Vcm;
         let lacks = if bidirectional && scene.lights.has_lights_bidirectional_lacks() {
-            "environment, directional or spot lights (its MIS needs their densities)"
-        } else if kind == IntegratorKind::Vcm && scene.features.shading_normals {
+            "environment or directional lights (its MIS needs the densities of lights at infinity)"
+        } else if vcm && scene.lights.has_spot_lights() {
+            "spot lights"
+        } else if vcm && scene.features.shading_normals {
             "shading normals (its merging needs the adjoint's correction)"
         } else {
             return None;
@@ -170,7 +173,7 @@ impl Session {
         Some(Error::new(format!(
             "{} does not handle {lacks} yet: use path, light, mcrt or photon mapping{}",
             settings.integrator.name(),
-            if kind == IntegratorKind::Vcm && !scene.lights.has_lights_bidirectional_lacks() {
+            if vcm && !scene.lights.has_lights_bidirectional_lacks() {
                 ", or bdpt"
             } else {
                 ""

@@ -42,14 +42,19 @@ impl Lights {
         }
     }
 
-    /// True when a light is at infinity or a spot: bidirectional
-    /// techniques do not handle these yet.
+    /// True when a light is at infinity: bidirectional techniques do not
+    /// handle these yet.
     pub fn has_lights_bidirectional_lacks(&self) -> bool {
         self.environment.is_some()
             || self
                 .lights
                 .iter()
-                .any(|l| matches!(l, Light::Spot { .. } | Light::Directional { .. }))
+                .any(|l| matches!(l, Light::Directional { .. }))
+    }
+
+    /// True for spot lights, which BDPT handles and VCM does not yet.
+    pub fn has_spot_lights(&self) -> bool {
+        self.lights.iter().any(|l| matches!(l, Light::Spot { .. }))
     }
 
     /// The environment, if the scene has one.

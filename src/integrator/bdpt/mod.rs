@@ -35,6 +35,7 @@ use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, ray_between};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
+use crate::scene::light::Light;
 use crate::scene::material::Bsdf;
 use glam::{Vec2, Vec3A};
 use std::cell::RefCell;
@@ -186,7 +187,7 @@ impl Vertex {
     /// light's side) to w; at a light vertex (whose beta is 1 /
     /// p_position), the emitted radiance towards `w`; `w` is a unit vector.
     #[inline]
-    fn scatter(&self, w: Vec3A) -> Rgb {
+    fn scatter(&self, scene: &Scene, w: Vec3A) -> Rgb {
         match self.kind {
             Kind::Surface => {
                 let frame = self.frame();
@@ -194,7 +195,13 @@ impl Vertex {
                 self.bsdf.eval(w, wo) * shading_correction(wo, w, self.normal_local(&frame))
             }
             Kind::Light => {
-                if self.normal == Vec3A::ZERO || self.two_sided || self.normal.dot(w) > 0.0 {
+                if self.normal == Vec3A::ZERO {
+                    // A point or spot light: a spot's falloff shapes it.
+                    match scene.lights.as_slice().get(self.light as usize) {
+                        Some(Light::Spot { cone, .. }) => self.emitted * cone.falloff(w),
+                        _ => self.emitted,
+                    }
+                } else if self.two_sided || self.normal.dot(w) > 0.0 {
                     self.emitted
                 } else {
                     Rgb::ZERO
@@ -579,7 +586,7 @@ impl Bdpt {
                 return None;
             }
             let c = scene.camera.connect(qs.point, qs.u_connect)?;
-            let value = qs.beta * qs.scatter(c.wi) * (qs.shading_cos(c.wi) * c.weight);
+            let value = qs.beta * qs.scatter(scene, c.wi) * (qs.shading_cos(c.wi) * c.weight);
             if !(value.max_element() > 0.0)
                 || !sees_lens(scene, qs.point, qs.error, qs.normal, &c, time, counts)
             {
@@ -705,7 +712,6 @@ struct Connection {
 
 /// A light's emitted radiance (or intensity) and sidedness.
 fn emission_of(scene: &Scene, light: u32) -> (Rgb, bool) {
-    use crate::scene::light::Light;
     match scene.lights.as_slice()[light as usize] {
         Light::Triangle(p) | Light::Parallelogram(p) => (p.radiance, p.two_sided),
         Light::Sphere {
@@ -713,9 +719,9 @@ fn emission_of(scene: &Scene, light: u32) -> (Rgb, bool) {
             two_sided,
             ..
         } => (radiance, two_sided),
-        Light::Point { intensity, .. } => (intensity, true),
+        Light::Point { intensity, .. } | Light::Spot { intensity, .. } => (intensity, true),
         // Never reached: sessions refuse BDPT on scenes with these.
-        Light::Spot { .. } | Light::Directional { .. } => (Rgb::ZERO, false),
+        Light::Directional { .. } => (Rgb::ZERO, false),
     }
 }
 
