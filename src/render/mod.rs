@@ -158,26 +158,20 @@ impl Session {
     /// normals.
     pub fn unsupported(scene: &Scene, settings: &RenderSettings) -> Option<Error> {
         use crate::integrator::IntegratorKind;
-        let kind = settings.integrator.kind();
-        let bidirectional = matches!(kind, IntegratorKind::Bdpt | IntegratorKind::Vcm);
-        let vcm = kind == IntegratorKind::Vcm;
-        let lacks = if bidirectional && scene.lights.has_lights_bidirectional_lacks() {
+        if settings.integrator.kind() != IntegratorKind::Vcm {
+            return None;
+        }
+        let lacks = if scene.lights.has_lights_bidirectional_lacks() {
             "environment or directional lights (its MIS needs the densities of lights at infinity)"
-        } else if vcm && scene.lights.has_spot_lights() {
+        } else if scene.lights.has_spot_lights() {
             "spot lights"
-        } else if vcm && scene.features.shading_normals {
+        } else if scene.features.shading_normals {
             "shading normals (its merging needs the adjoint's correction)"
         } else {
             return None;
         };
         Some(Error::new(format!(
-            "{} does not handle {lacks} yet: use path, light, mcrt or photon mapping{}",
-            settings.integrator.name(),
-            if vcm && !scene.lights.has_lights_bidirectional_lacks() {
-                ", or bdpt"
-            } else {
-                ""
-            }
+            "vcm does not handle {lacks} yet: use bdpt, path, light, mcrt or photon mapping"
         )))
     }
 

@@ -42,8 +42,7 @@ impl Lights {
         }
     }
 
-    /// True when a light is at infinity: bidirectional techniques do not
-    /// handle these yet.
+    /// True when a light is at infinity: VCM does not handle these yet.
     pub fn has_lights_bidirectional_lacks(&self) -> bool {
         self.environment.is_some()
             || self
@@ -52,7 +51,7 @@ impl Lights {
                 .any(|l| matches!(l, Light::Directional { .. }))
     }
 
-    /// True for spot lights, which BDPT handles and VCM does not yet.
+    /// True for spot lights, which VCM does not handle yet.
     pub fn has_spot_lights(&self) -> bool {
         self.lights.iter().any(|l| matches!(l, Light::Spot { .. }))
     }

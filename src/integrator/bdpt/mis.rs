@@ -145,6 +145,10 @@ pub(super) fn pdf(scene: &Scene, v: &Vertex, previous: Option<&Vertex>, next: &V
 /// point `v` heads for `next`.
 #[inline]
 pub(super) fn light_direction_pdf(scene: &Scene, v: &Vertex, next: &Vertex) -> f32 {
+    if v.infinite {
+        // A parallel beam along `v.normal`: the disc's density, projected.
+        return super::disc_density(scene, v.light) * next.cos(v.normal);
+    }
     let w = (next.point - v.point).normalize_or_zero();
     let (_, pdf_direction) = scene.lights.emission_pdf(v.light, v.normal, w);
     v.area_density_at(pdf_direction, next)

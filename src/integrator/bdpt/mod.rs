@@ -143,6 +143,10 @@ struct Vertex {
     delta: bool,
     /// A point light: no subpath can hit it.
     delta_light: bool,
+    /// A light at infinity (the environment, a directional light): `point`
+    /// stands far beyond the scene, `normal` is the direction its light
+    /// travels, and densities towards it stay per solid angle.
+    infinite: bool,
     /// The part of the MIS sum that depends on this subpath alone: the
     /// heuristic's ratios p_i / p_s of the strategies that would have made
     /// this vertex and the ones before it from the other side (see
@@ -175,6 +179,7 @@ impl Vertex {
         pdf_rev: 0.0,
         delta: false,
         delta_light: false,
+        infinite: false,
         mis_prefix: 0.0,
         light: NO_LIGHT,
         emitted: Rgb::ZERO,
@@ -194,6 +199,7 @@ impl Vertex {
                 let (wo, w) = (frame.to_local(self.wo), frame.to_local(w));
                 self.bsdf.eval(w, wo) * shading_correction(wo, w, self.normal_local(&frame))
             }
+            Kind::Light if self.infinite => Rgb::ZERO,
             Kind::Light => {
                 if self.normal == Vec3A::ZERO {
                     // A point or spot light: a spot's falloff shapes it.
@@ -257,6 +263,9 @@ impl Vertex {
     /// at `next`.
     #[inline]
     fn area_density_at(&self, pdf_direction: f32, next: &Vertex) -> f32 {
+        if next.infinite {
+            return pdf_direction;
+        }
         let d = next.point - self.point;
         let dist2 = d.length_squared();
         if !(dist2 > 0.0) {
@@ -377,14 +386,23 @@ impl Bdpt {
         let emission = sample_particle(scene, sampler);
         let u_lens = sampler.next_2d_for(Domain::Lens);
         if let Some(emission) = emission {
+            let infinite = is_infinite(scene, emission.light);
             light_path.push(Vertex {
                 kind: Kind::Light,
                 point: emission.point,
                 error: emission.error,
                 normal: emission.normal,
                 beta: Rgb::splat(1.0 / emission.pdf_position),
-                pdf_fwd: emission.pdf_position,
-                delta_light: emission.normal == Vec3A::ZERO,
+                // From infinity the particle's origin is its direction
+                // (per solid angle; 0 for a directional light's delta).
+                pdf_fwd: if infinite {
+                    origin_density(scene, emission.light, -emission.direction)
+                } else {
+                    emission.pdf_position
+                },
+                delta_light: emission.normal == Vec3A::ZERO
+                    || is_directional(scene, emission.light),
+                infinite,
                 light: emission.light,
                 emitted: emission.emitted,
                 two_sided: emission.two_sided,
@@ -472,6 +490,32 @@ impl Bdpt {
                 Transport::Importance => (0.0, sampler.next_2d_for(Domain::Lens)),
             };
             let Some(hit) = scene.geometry.intersect(&ray) else {
+                // A camera subpath that leaves the scene ends on the environment.
+                if transport == Transport::Radiance
+                    && let Some(env) = scene.lights.environment()
+                {
+                    let previous = path[path.len() - 1];
+                    let distance =
+                        crate::scene::light::beyond_bounds(ray.origin, env.center, env.radius);
+                    path.push(Vertex {
+                        kind: Kind::Light,
+                        point: ray.origin + ray.direction * distance,
+                        normal: -ray.direction,
+                        wo: -ray.direction,
+                        beta,
+                        pdf_fwd: previous.area_density_at(
+                            pdf_direction,
+                            &Vertex {
+                                infinite: true,
+                                ..Vertex::EMPTY
+                            },
+                        ),
+                        infinite: true,
+                        light: scene.lights.as_slice().len() as u32,
+                        emitted: env.le(ray.direction),
+                        ..Vertex::EMPTY
+                    });
+                }
                 break;
             };
             let material = &scene.materials[hit.material as usize];
@@ -492,7 +536,12 @@ impl Bdpt {
             }
             vertex.u_select = u_select;
             vertex.u_connect = u_connect;
-            vertex.pdf_fwd = previous.area_density_at(pdf_direction, &vertex);
+            vertex.pdf_fwd = if previous.infinite {
+                // A parallel beam: the disc's density, projected.
+                disc_density(scene, previous.light) * vertex.cos(ray.direction)
+            } else {
+                previous.area_density_at(pdf_direction, &vertex)
+            };
             path.push(vertex);
             if path.len() >= max_vertices || bsdf.is_black() {
                 break;
@@ -559,7 +608,7 @@ impl Bdpt {
         if s == 0 {
             // The camera subpath found a light by itself.
             let pt = &cam[t - 1];
-            if pt.light == NO_LIGHT || pt.kind != Kind::Surface {
+            if pt.light == NO_LIGHT || !(pt.kind == Kind::Surface || pt.infinite) {
                 return None;
             }
             let value = pt.beta * pt.emitted;
@@ -567,11 +616,16 @@ impl Bdpt {
                 return None;
             }
             let pm = &cam[t - 2];
+            let pt_rev = if pt.infinite {
+                origin_density(scene, pt.light, -pt.normal)
+            } else {
+                scene.lights.emission_pdf(pt.light, pt.normal, pt.wo).0
+            };
             return Some(Connection {
                 value,
                 film: None,
                 sampled: None,
-                pt_rev: scene.lights.emission_pdf(pt.light, pt.normal, pt.wo).0,
+                pt_rev,
                 pt_minus_rev: light_direction_pdf(scene, pt, pm),
                 qs_rev: 0.0,
                 qs_minus_rev: 0.0,
@@ -582,7 +636,7 @@ impl Bdpt {
             let qs = &light[s - 1];
             // A vertex connects if any of its lobes is not a delta, however
             // its own path went on (pbrt-v4's IsConnectible).
-            if qs.kind == Kind::Surface && qs.bsdf.is_specular() {
+            if (qs.kind == Kind::Surface && qs.bsdf.is_specular()) || qs.infinite {
                 return None;
             }
             let c = scene.camera.connect(qs.point, qs.u_connect)?;
@@ -633,22 +687,33 @@ impl Bdpt {
             let (pdf_position, pdf_emission) =
                 scene.lights.emission_pdf(ls.light, ls.normal, -ls.wi);
             let (emitted, two_sided) = emission_of(scene, ls.light);
+            let infinite = is_infinite(scene, ls.light);
             let sampled = Vertex {
                 kind: Kind::Light,
                 point: ls.point,
                 error: ls.error,
-                normal: ls.normal,
-                pdf_fwd: pdf_position,
+                normal: if infinite { -ls.wi } else { ls.normal },
+                pdf_fwd: if infinite {
+                    origin_density(scene, ls.light, ls.wi)
+                } else {
+                    pdf_position
+                },
                 delta_light: ls.delta,
+                infinite,
                 light: ls.light,
                 emitted,
                 two_sided,
                 ..Vertex::EMPTY
             };
+            let pt_rev = if infinite {
+                disc_density(scene, ls.light) * pt.cos(ls.wi)
+            } else {
+                sampled.area_density_at(pdf_emission, pt)
+            };
             return Some(Connection {
                 value,
                 film: None,
-                pt_rev: sampled.area_density_at(pdf_emission, pt),
+                pt_rev,
                 pt_minus_rev: pt.area_density_at(pdf_reverse, pm),
                 qs_rev: pdf(scene, pt, Some(pm), &sampled),
                 qs_minus_rev: 0.0,
@@ -712,7 +777,10 @@ struct Connection {
 
 /// A light's emitted radiance (or intensity) and sidedness.
 fn emission_of(scene: &Scene, light: u32) -> (Rgb, bool) {
-    match scene.lights.as_slice()[light as usize] {
+    let Some(&emitter) = scene.lights.as_slice().get(light as usize) else {
+        return (Rgb::ZERO, false); // the environment, whose radiance is per direction
+    };
+    match emitter {
         Light::Triangle(p) | Light::Parallelogram(p) => (p.radiance, p.two_sided),
         Light::Sphere {
             radiance,
@@ -720,7 +788,6 @@ fn emission_of(scene: &Scene, light: u32) -> (Rgb, bool) {
             ..
         } => (radiance, two_sided),
         Light::Point { intensity, .. } | Light::Spot { intensity, .. } => (intensity, true),
-        // Never reached: sessions refuse BDPT on scenes with these.
         Light::Directional { .. } => (Rgb::ZERO, false),
     }
 }
@@ -737,4 +804,43 @@ fn surface_vertex(hit: &SurfaceHit, bsdf: Bsdf, wo: Vec3A, beta: Rgb) -> Vertex 
         beta,
         ..Vertex::EMPTY
     }
+}
+
+/// True for the environment and directional lights.
+#[inline]
+fn is_infinite(scene: &Scene, light: u32) -> bool {
+    match scene.lights.as_slice().get(light as usize) {
+        None => true,
+        Some(l) => matches!(l, Light::Directional { .. }),
+    }
+}
+
+#[inline]
+fn is_directional(scene: &Scene, light: u32) -> bool {
+    matches!(
+        scene.lights.as_slice().get(light as usize),
+        Some(Light::Directional { .. })
+    )
+}
+
+/// Per area, the density of a particle's start on the disc facing the
+/// scene from a light at infinity (without the light's choice).
+#[inline]
+pub(super) fn disc_density(scene: &Scene, light: u32) -> f32 {
+    let radius = match scene.lights.as_slice().get(light as usize) {
+        Some(Light::Directional { radius, .. }) => *radius,
+        _ => scene.lights.environment().map_or(1.0, |e| e.radius),
+    };
+    1.0 / (std::f32::consts::PI * radius * radius)
+}
+
+/// The density of a light at infinity as a path's first vertex: its choice
+/// times the solid-angle density of the direction `to_light` (pointing from
+/// the scene to the light); 0 for a directional light (a delta).
+#[inline]
+pub(super) fn origin_density(scene: &Scene, light: u32, to_light: Vec3A) -> f32 {
+    if is_directional(scene, light) {
+        return 0.0;
+    }
+    scene.lights.environment_pdf(to_light)
 }
