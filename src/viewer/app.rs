@@ -207,9 +207,11 @@ impl ViewerApp {
     /// What an imported file asks for (Mitsuba's integrator block): the
     /// technique and depths of view A, said in a toast.
     fn apply_hints(&mut self, hints: &crate::scene::RenderHints) {
+        // A technique named on the command line wins over the file's.
+        let launched_with_technique = self.launch.integrator.is_some();
         let a = &mut self.settings.a.integrator;
         let mut said = Vec::new();
-        if let Some(kind) = hints.integrator.as_deref().and_then(|name| {
+        if let Some(kind) = hints.integrator.as_deref().filter(|_| !launched_with_technique).and_then(|name| {
             crate::integrator::IntegratorKind::ALL
                 .iter()
                 .copied()
