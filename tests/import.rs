@@ -470,3 +470,70 @@ fn gltf_nodes_meshes_camera_materials_and_lights_land_where_the_file_puts_them()
         .to_string();
     assert!(e.contains("scene.gltf") && e.contains("quad.bin"), "{e}");
 }
+
+/// `smooth_angle` on a mesh without `vn`: a faceted sphere gets smooth
+/// normals close to the true ones; `face_normals` with it is refused.
+#[test]
+fn smooth_angle_gives_a_faceted_sphere_smooth_normals() {
+    let dir = temp_dir("smooth-angle");
+    let (nu, nv) = (24usize, 12usize);
+    let mut obj = String::new();
+    for j in 0..=nv {
+        for i in 0..nu {
+            let (theta, phi) = (
+                std::f32::consts::PI * j as f32 / nv as f32,
+                std::f32::consts::TAU * i as f32 / nu as f32,
+            );
+            obj += &format!(
+                "v {} {} {}\n",
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos()
+            );
+        }
+    }
+    let index = |i: usize, j: usize| 1 + j * nu + i % nu;
+    for j in 0..nv {
+        for i in 0..nu {
+            let (a, b, c, d) = (
+                index(i, j),
+                index(i + 1, j),
+                index(i + 1, j + 1),
+                index(i, j + 1),
+            );
+            obj += &format!("f {a} {d} {c}\nf {a} {c} {b}\n");
+        }
+    }
+    std::fs::write(dir.join("ball.obj"), obj).unwrap();
+    let scene_text = |extra: &str| {
+        format!(
+            "[camera]\neye = [0, -4, 0]\nlook_at = [0, 0, 0]\nup = [0, 0, 1]\nfov_y = 40\nwidth = 8\nheight = 8\n\n\
+             [[mesh]]\nfile = \"ball.obj\"\nsmooth_angle = 40\n{extra}\n\n[[point_light]]\nposition = [0, -4, 4]\nintensity = [1, 1, 1]\n"
+        )
+    };
+    std::fs::write(dir.join("scene.toml"), scene_text("")).unwrap();
+    let scene = Scene::load(&dir.join("scene.toml")).unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.features.shading_normals);
+    // At a hit, the interpolated normal is within 2 degrees of the sphere's.
+    let ray = tracelab::math::Ray::new(Vec3A::new(0.3, -4.0, 0.2), Vec3A::Y);
+    let hit = scene
+        .geometry
+        .intersect(&ray)
+        .expect("the ray hits the ball");
+    let n = scene.geometry.shading_normal(&hit);
+    let true_normal = hit.point.normalize();
+    assert!(
+        n.dot(true_normal) > 2f32.to_radians().cos(),
+        "{n} vs {true_normal}"
+    );
+    assert!(
+        n.dot(hit.normal) < 0.99999,
+        "the normal is interpolated, not the face's"
+    );
+    std::fs::write(dir.join("bad.toml"), scene_text("face_normals = true")).unwrap();
+    let e = Scene::load(&dir.join("bad.toml"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("bad.toml:") && e.contains("smooth_angle"), "{e}");
+}

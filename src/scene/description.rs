@@ -20,6 +20,7 @@
 //! translate = [0, 0, 0]
 //! material = "glass"       # optional: override every face's material
 //! velocity = [0, 0, 0]     # motion per unit time (meshes, spheres, quads; not emitters)
+//! smooth_angle = 30        # no `vn` in the file: smooth normals across edges below 30 degrees
 //!
 //! [[sphere]]
 //! center = [0, 1, 0]
@@ -205,6 +206,9 @@ pub struct MeshDesc {
     /// Shade flat, ignoring the file's `vn` normals (Mitsuba's `face_normals`).
     #[serde(default)]
     pub face_normals: bool,
+    /// Where the file has no `vn` normals: smooth ones, across edges whose
+    /// faces meet within this many degrees (Blender's auto smooth).
+    pub smooth_angle: Option<f32>,
 }
 
 /// `[[sphere]]`.

@@ -190,6 +190,18 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
                 ));
             }
         }
+        if let Some(angle) = desc.smooth_angle {
+            if !(angle.is_finite() && (0.0..=180.0).contains(&angle)) || desc.face_normals {
+                return Err(at(
+                    mesh.span(),
+                    format!(
+                        "mesh `{}`: `smooth_angle` must be in [0, 180] degrees and not with `face_normals`, got {angle}",
+                        desc.file
+                    ),
+                ));
+            }
+            super::mesh::smooth_by_angle(&mut mesh_triangles, angle);
+        }
         if !mesh_triangles
             .iter()
             .all(|t| t.vertices.iter().all(|&v| in_range(v)))

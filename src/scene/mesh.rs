@@ -158,7 +158,8 @@ impl MeshData {
             ..Default::default()
         };
         for i in 0..=segments {
-            let phi = i as f32 * TAU / segments as f32;
+            // The seam's two columns at exactly the same points.
+            let phi = (i % segments) as f32 * TAU / segments as f32;
             let n = Vec3::new(phi.cos(), phi.sin(), 0.0);
             for z in [0.0, 1.0] {
                 m.positions.push(n + Vec3::Z * z);
@@ -193,9 +194,113 @@ impl MeshData {
     }
 }
 
+/// Vertex normals for triangles that have none, as Blender's auto smooth
+/// makes them: at each corner, the normals of the triangles that share its
+/// position and meet its own within `max_angle` degrees, each weighted by
+/// its angle at that corner (so that how a surface is cut into triangles
+/// does not tilt the result). Sharper edges stay sharp; triangles given
+/// normals keep them.
+pub fn smooth_by_angle(triangles: &mut [TriangleInput], max_angle: f32) {
+    use std::collections::HashMap;
+    let cos_max = max_angle.to_radians().cos();
+    let key = |v: Vec3A| v.to_array().map(f32::to_bits);
+    let face: Vec<Vec3A> = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.vertices;
+            (b - a).cross(c - a).normalize_or_zero()
+        })
+        .collect();
+    let corner_angle = |t: &TriangleInput, k: usize| {
+        let v = t.vertices;
+        let (e1, e2) = (v[(k + 1) % 3] - v[k], v[(k + 2) % 3] - v[k]);
+        e1.normalize_or_zero()
+            .dot(e2.normalize_or_zero())
+            .clamp(-1.0, 1.0)
+            .acos()
+    };
+    // Per position, the (triangle, weighted normal) pairs that touch it.
+    let mut sharing: HashMap<[u32; 3], Vec<(u32, Vec3A)>> = HashMap::new();
+    for (i, t) in triangles.iter().enumerate() {
+        if t.normals.is_none() {
+            for k in 0..3 {
+                let weighted = face[i] * corner_angle(t, k);
+                sharing
+                    .entry(key(t.vertices[k]))
+                    .or_default()
+                    .push((i as u32, weighted));
+            }
+        }
+    }
+    for i in 0..triangles.len() {
+        let own = face[i];
+        if triangles[i].normals.is_some() || own == Vec3A::ZERO {
+            continue;
+        }
+        let normals = triangles[i].vertices.map(|v| {
+            let mut n = Vec3A::ZERO;
+            for &(j, weighted) in &sharing[&key(v)] {
+                if face[j as usize].dot(own) >= cos_max {
+                    n += weighted;
+                }
+            }
+            n.normalize_or_zero()
+        });
+        if normals.iter().all(|n| *n != Vec3A::ZERO) {
+            triangles[i].normals = Some(normals);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn smoothing_by_angle_rounds_a_cylinder_and_keeps_a_cube_sharp() {
+        let mut cube = Vec::new();
+        MeshData::cube().triangles(
+            Mat4::IDENTITY,
+            Orientation::Normal,
+            false,
+            false,
+            0,
+            &mut cube,
+        );
+        smooth_by_angle(&mut cube, 30.0);
+        for t in &cube {
+            let [a, b, c] = t.vertices;
+            let face = (b - a).cross(c - a).normalize();
+            for n in t.normals.unwrap() {
+                assert!(
+                    (n - face).length() < 1e-6,
+                    "cube edges are 90 degrees: sharp"
+                );
+            }
+        }
+        // A 24-gon band: neighbours meet at 15 degrees, so corners average.
+        let ring = MeshData::cylinder(24);
+        let mut band = Vec::new();
+        let flat = MeshData {
+            normals: None,
+            ..ring
+        };
+        flat.triangles(
+            Mat4::IDENTITY,
+            Orientation::Normal,
+            false,
+            false,
+            0,
+            &mut band,
+        );
+        smooth_by_angle(&mut band, 30.0);
+        for t in &band {
+            for (v, n) in t.vertices.iter().zip(t.normals.unwrap()) {
+                let radial = Vec3A::new(v.x, v.y, 0.0).normalize();
+                assert!((n - radial).length() < 1e-5, "{n} vs {radial}");
+            }
+        }
+    }
 
     fn area(m: &MeshData) -> f32 {
         m.indices

@@ -211,12 +211,17 @@ impl ViewerApp {
         let launched_with_technique = self.launch.integrator.is_some();
         let a = &mut self.settings.a.integrator;
         let mut said = Vec::new();
-        if let Some(kind) = hints.integrator.as_deref().filter(|_| !launched_with_technique).and_then(|name| {
-            crate::integrator::IntegratorKind::ALL
-                .iter()
-                .copied()
-                .find(|k| k.name() == name)
-        }) {
+        if let Some(kind) = hints
+            .integrator
+            .as_deref()
+            .filter(|_| !launched_with_technique)
+            .and_then(|name| {
+                crate::integrator::IntegratorKind::ALL
+                    .iter()
+                    .copied()
+                    .find(|k| k.name() == name)
+            })
+        {
             a.kind = kind;
             said.push(kind.label().to_string());
         }

@@ -86,13 +86,34 @@ fn scene_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
             app.force_restart();
         }
     });
+    // What the file asked for and did not get, for as long as it is loaded.
+    let Some(scene) = app.scene().cloned() else {
+        return;
+    };
+    if !scene.warnings.is_empty() {
+        egui::CollapsingHeader::new(format!("Scene warnings ({})", scene.warnings.len()))
+            .id_salt("scene-warnings")
+            .show(ui, |ui| {
+                for w in &scene.warnings {
+                    ui.label(egui::RichText::new(w).small());
+                }
+            });
+    }
 }
 
+/// A scene file's name; an imported scene's folder too (veach-mis/scene.xml).
 fn short_name(path: &str) -> String {
-    std::path::Path::new(path)
+    let p = std::path::Path::new(path);
+    let name = p
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| path.to_string())
+        .unwrap_or_else(|| path.to_string());
+    match p.parent().and_then(|d| d.file_name()) {
+        Some(dir) if p.file_stem().is_some_and(|s| s == "scene") => {
+            format!("{}/{name}", dir.to_string_lossy())
+        }
+        _ => name,
+    }
 }
 
 fn compare_section(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing) {
