@@ -203,6 +203,40 @@ fn a_bad_scene_shows_an_error_and_keeps_the_last_good_one() {
     harness.get_by_label("Dismiss").click();
     harness.step();
     assert!(harness.state().app.errors.is_empty());
+
+    // A Mitsuba file that asks for something not rendered loads, with its
+    // warning listed in the panel (file, line and column) while it is open.
+    let xml = dir.join("warned.xml");
+    std::fs::write(
+        &xml,
+        "<scene version=\"3.0.0\">\n  <shape type=\"cube\"><float name=\"mystery\" value=\"1\"/>\n    <emitter type=\"area\"/></shape>\n</scene>\n",
+    )
+    .unwrap();
+    harness.state_mut().app.scene_field = xml.to_string_lossy().into_owned();
+    harness.step();
+    harness.get_by_label("Load").click();
+    harness.step();
+    harness.step();
+    assert!(
+        harness.state().app.errors.is_empty(),
+        "{:?}",
+        harness.state().app.errors
+    );
+    let warnings = harness.state().app.scene().unwrap().warnings.clone();
+    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    harness.get_by_label("Scene warnings (2)").click();
+    harness.step();
+    // In the panel's list, and in the toast that announced it.
+    let shown = harness
+        .get_all_by_label_contains("shape `cube`: property `mystery` ignored")
+        .count();
+    assert_eq!(shown, 2);
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("warned.xml:2:22: shape `cube`")),
+        "{warnings:?}"
+    );
     harness.state_mut().app.shutdown();
 }
 

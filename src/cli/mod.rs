@@ -119,6 +119,12 @@ struct ViewArgs {
     /// Radiosity's settings, used with --integrator radiosity.
     #[command(flatten)]
     radiosity: radiosity::RadiosityFlags,
+    /// Mitsuba XML: set a parameter `$name` (as Mitsuba's -D).
+    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = render::parse_define)]
+    define: Vec<(String, String)>,
+    /// Make every warning about the scene file an error.
+    #[arg(long)]
+    strict: bool,
 }
 
 /// Runs the parsed command line.
@@ -192,6 +198,8 @@ fn view(args: ViewArgs) -> Result<()> {
         export_dir: args.export_dir,
         radiosity: (launch_kind == Some(IntegratorKind::Radiosity))
             .then(|| args.radiosity.options()),
+        defines: args.define,
+        strict: args.strict,
     })
 }
 

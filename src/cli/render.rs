@@ -738,7 +738,7 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
 }
 
 /// `-D name=value`.
-fn parse_define(s: &str) -> std::result::Result<(String, String), String> {
+pub(crate) fn parse_define(s: &str) -> std::result::Result<(String, String), String> {
     match s.split_once('=') {
         Some((n, v)) if !n.is_empty() => Ok((n.to_string(), v.to_string())),
         _ => Err(format!("expected NAME=VALUE, got \"{s}\"")),

@@ -179,7 +179,12 @@ impl ViewerApp {
 
     /// Loads a scene file; on failure shows the error and keeps the last good scene.
     pub fn load_scene(&mut self, path: &str) {
-        match Scene::load_with_limits(Path::new(path), &Limits::default()) {
+        let options = crate::scene::LoadOptions {
+            limits: Limits::default(),
+            defines: self.launch.defines.clone(),
+            strict: self.launch.strict,
+        };
+        match Scene::load_with(Path::new(path), &options) {
             Ok(scene) => {
                 for w in &scene.warnings {
                     self.toast(format!("{path}: {w}"));

@@ -35,6 +35,10 @@ pub struct Launch {
     pub lab: Option<Experiment>,
     /// Radiosity's settings from the command line (with `--integrator radiosity`).
     pub radiosity: Option<IntegratorOptions>,
+    /// Mitsuba XML: values for the file's `$name`s (`-D name=value`).
+    pub defines: Vec<(String, String)>,
+    /// Warnings about a scene file are errors.
+    pub strict: bool,
 }
 
 impl Launch {
