@@ -352,8 +352,20 @@ radiance = [0.3, 0.35, 0.4]
         256,
         23,
     );
-    let bdpt = render(scene, Integrator::from(Bdpt::default()), 256, 24);
+    let bdpt = render(scene.clone(), Integrator::from(Bdpt::default()), 256, 24);
     assert_agree("spot light, bdpt / light", &bdpt, &light);
+    // VCM too (the spot's falloff is in the particles' weights, its cone's
+    // density in the MIS quantities); the 40 m floor makes the diagonal 57 m:
+    // merges at 0.03% of it, 1.7 cm.
+    let vcm = Integrator::MultiPass(MultiPassIntegrator::Vcm(Vcm {
+        radius: 0.0003,
+        ..Vcm::default()
+    }));
+    assert_agree(
+        "spot light, vcm / light",
+        &render(scene, vcm, 256, 28),
+        &light,
+    );
 }
 
 /// An environment map with NaN and infinite texels (read as 0) and one

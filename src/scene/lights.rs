@@ -51,11 +51,6 @@ impl Lights {
                 .any(|l| matches!(l, Light::Directional { .. }))
     }
 
-    /// True for spot lights, which VCM does not handle yet.
-    pub fn has_spot_lights(&self) -> bool {
-        self.lights.iter().any(|l| matches!(l, Light::Spot { .. }))
-    }
-
     /// The environment, if the scene has one.
     #[inline]
     pub fn environment(&self) -> Option<&Environment> {
