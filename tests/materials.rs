@@ -499,7 +499,7 @@ fn smooth_sphere_obj() -> String {
     text
 }
 
-/// Shading normals: light tracing and BDPT (with Veach's adjoint
+/// Shading normals: light tracing, BDPT and VCM (with Veach's adjoint
 /// correction) agree with path tracing on a faceted sphere shaded smooth, diffuse and rough
 /// plastic; without the correction it does not (the test sees it).
 #[test]
@@ -571,6 +571,17 @@ material = "ball"
     // there (z 5.3 in the block of its edge; BDPT and light tracing agree).
     let bdpt = render(scene.clone(), Integrator::from(Bdpt::default()), 512, 34);
     assert_agree("shading normals, bdpt / light", &bdpt, &light);
+    // VCM: connections as BDPT's, merges weighed by |wi·ns| / |wi·ng|;
+    // merges of 1.7 cm (0.03% of the 57 m diagonal).
+    let vcm = Integrator::MultiPass(MultiPassIntegrator::Vcm(Vcm {
+        radius: 0.0003,
+        ..Vcm::default()
+    }));
+    assert_agree(
+        "shading normals, vcm / light",
+        &render(scene.clone(), vcm, 512, 35),
+        &light,
+    );
     // Flat shading differs visibly from smooth (the normals matter here).
     let flat = load_scene_text(
         "flat-sphere",

@@ -163,8 +163,6 @@ impl Session {
         }
         let lacks = if scene.lights.has_lights_bidirectional_lacks() {
             "environment or directional lights (its MIS needs the densities of lights at infinity)"
-        } else if scene.features.shading_normals {
-            "shading normals (its merging needs the adjoint's correction)"
         } else {
             return None;
         };

@@ -124,6 +124,9 @@ pub struct LightVertex {
     point: Vec3A,
     error: Vec3A,
     normal: Vec3A,
+    /// The shading normal, which frames the BSDF (the geometric one where
+    /// the mesh has no vertex normals).
+    shading: Vec3A,
     /// Unit direction towards the previous vertex (where the light came from).
     wo: Vec3A,
     /// The subpath's weight up to here (flux of one of N subpaths).
@@ -257,6 +260,7 @@ impl Vcm {
         &self,
         bsdf: Bsdf,
         wo: Vec3A,
+        ng: Vec3A,
         importance: bool,
         bounces: u32,
         walk: &mut Walk,
@@ -267,7 +271,7 @@ impl Vcm {
         let u_roulette = sampler.next_1d_for(Domain::Other);
         let sample = bsdf.sample(wo, u_lobe, u_bsdf)?;
         let weight = if importance {
-            importance_weight(bsdf, wo, sample.wi, Vec3A::Z, sample.weight)
+            importance_weight(bsdf, wo, sample.wi, ng, sample.weight)
         } else {
             walk.relative /= bsdf.refraction_scale(wo, sample.wi);
             sample.weight
@@ -295,7 +299,8 @@ impl Vcm {
             pdf,
             pdf_reverse,
             specular: sample.specular,
-            cos: sample.wi.z.abs(),
+            // The densities' conversions to area take the geometric cosine.
+            cos: sample.wi.dot(ng).abs(),
         })
     }
 
@@ -347,11 +352,13 @@ impl Vcm {
             if bsdf.is_black() {
                 break;
             }
+            let shading = shading_normal(scene, &hit);
             if !bsdf.is_specular() {
                 let vertex = LightVertex {
                     point: hit.point,
                     error: hit.error,
                     normal: hit.normal,
+                    shading,
                     wo: wo_world,
                     beta: walk.beta,
                     material: hit.material,
@@ -367,10 +374,11 @@ impl Vcm {
             if segments == self.max_depth {
                 break;
             }
-            let frame = Frame::from_normal(hit.normal);
+            let frame = Frame::from_normal(shading);
             let Some(scatter) = self.scatter(
                 bsdf,
                 frame.to_local(wo_world),
+                normal_in(&frame, hit.normal, shading),
                 true,
                 segments,
                 &mut walk,
@@ -503,12 +511,14 @@ impl MultiPassEstimator for Vcm {
             if bsdf.is_black() || segments > self.max_depth {
                 break;
             }
-            let frame = Frame::from_normal(hit.normal);
+            let shading = shading_normal(scene, &hit);
+            let frame = Frame::from_normal(shading);
             let wo = frame.to_local(wo_world);
             let at = CameraVertex {
                 point: hit.point,
                 error: hit.error,
                 normal: hit.normal,
+                ng: normal_in(&frame, hit.normal, shading),
                 frame,
                 wo,
                 bsdf,
@@ -526,7 +536,8 @@ impl MultiPassEstimator for Vcm {
                 let merged = self.merge(iteration, &at, &walk);
                 radiance += walk.beta * merged * normalisation;
             }
-            let Some(scatter) = self.scatter(bsdf, wo, false, segments, &mut walk, sampler) else {
+            let Some(scatter) = self.scatter(bsdf, wo, at.ng, false, segments, &mut walk, sampler)
+            else {
                 break;
             };
             self.leave(&mut walk, &scatter, iteration);
@@ -534,5 +545,26 @@ impl MultiPassEstimator for Vcm {
             counts.bounce += 1;
         }
         radiance + splatted
+    }
+}
+
+/// The shading normal at `hit` (the geometric one without vertex normals).
+#[inline]
+fn shading_normal(scene: &Scene, hit: &SurfaceHit) -> Vec3A {
+    if scene.features.shading_normals {
+        scene.geometry.shading_normal(hit)
+    } else {
+        hit.normal
+    }
+}
+
+/// The geometric normal `ng` in `frame` (the shading normal `ns`'s): exactly
+/// +z where the two are one, so that the adjoint's correction is exactly 1.
+#[inline]
+fn normal_in(frame: &Frame, ng: Vec3A, ns: Vec3A) -> Vec3A {
+    if ng == ns {
+        Vec3A::Z
+    } else {
+        frame.to_local(ng)
     }
 }

@@ -4,7 +4,7 @@
 //! merges with the light vertices within the radius, each weighed by the
 //! recursive quantities of `mod.rs`.
 
-use super::super::light::sees_lens;
+use super::super::light::{photon_shading_factor, sees_lens, shading_correction};
 use super::{Iteration, LightVertex, Vcm, Walk};
 use crate::camera::CameraConnection;
 use crate::integrator::RayCounts;
@@ -20,7 +20,10 @@ use glam::Vec3A;
 pub(super) struct CameraVertex {
     pub(super) point: Vec3A,
     pub(super) error: Vec3A,
+    /// The geometric normal; `frame` is the shading normal's, and `ng` the
+    /// geometric normal in it.
     pub(super) normal: Vec3A,
+    pub(super) ng: Vec3A,
     pub(super) frame: Frame,
     pub(super) wo: Vec3A,
     pub(super) bsdf: Bsdf,
@@ -63,11 +66,14 @@ impl Vcm {
         let at = (v.point, v.error, v.normal);
         self.splat_through_lens(scene, iteration, at, sampler, counts, splats, |c| {
             let bsdf = scene.materials[v.material as usize].bsdf_at(&scene.textures, v.uv);
-            let frame = Frame::from_normal(v.normal);
-            let (f, _, pdf_reverse) =
-                bsdf.eval_adjoint_with_pdfs(frame.to_local(v.wo), frame.to_local(c.wi));
+            let frame = Frame::from_normal(v.shading);
+            let (wo, wi) = (frame.to_local(v.wo), frame.to_local(c.wi));
+            let (f, _, pdf_reverse) = bsdf.eval_adjoint_with_pdfs(wo, wi);
+            let f = f * shading_correction(wo, wi, super::normal_in(&frame, v.normal, v.shading));
+            // The scattering's cosine is the shading normal's, the
+            // density's conversion to area the geometric one's.
             let cos = v.normal.dot(c.wi).abs();
-            let value = v.beta * f * (cos * c.weight);
+            let value = v.beta * f * (wi.z.abs() * c.weight);
             let camera = self.camera_density(scene, iteration, c, v.point, cos);
             let w_light =
                 self.mis(camera) * (iteration.vm_factor + v.d_vcm + v.d_vc * self.mis(pdf_reverse));
@@ -136,9 +142,10 @@ impl Vcm {
         let Some(ls) = scene.lights.sample(at.point, u_select, u_light) else {
             return Rgb::ZERO;
         };
-        let (f, pdf, pdf_reverse) = at.bsdf.eval_with_pdfs(at.wo, at.frame.to_local(ls.wi));
+        let wi = at.frame.to_local(ls.wi);
+        let (f, pdf, pdf_reverse) = at.bsdf.eval_with_pdfs(at.wo, wi);
         let cos = at.normal.dot(ls.wi).abs();
-        let value = f * ls.radiance * (cos / ls.pdf);
+        let value = f * ls.radiance * (wi.z.abs() / ls.pdf);
         if !(value.max_element() > 0.0) {
             return Rgb::ZERO;
         }
@@ -178,15 +185,26 @@ impl Vcm {
             return Rgb::ZERO;
         }
         let w = d / dist2.sqrt();
+        let w_camera_local = at.frame.to_local(w);
         let (f_camera, pdf_camera, pdf_camera_reverse) =
-            at.bsdf.eval_with_pdfs(at.wo, at.frame.to_local(w));
+            at.bsdf.eval_with_pdfs(at.wo, w_camera_local);
         let light_bsdf =
             scene.materials[light.material as usize].bsdf_at(&scene.textures, light.uv);
-        let light_frame = Frame::from_normal(light.normal);
-        let (f_light, pdf_light, pdf_light_reverse) = light_bsdf
-            .eval_adjoint_with_pdfs(light_frame.to_local(light.wo), light_frame.to_local(-w));
+        let light_frame = Frame::from_normal(light.shading);
+        let (light_wo, light_wi) = (light_frame.to_local(light.wo), light_frame.to_local(-w));
+        let (f_light, pdf_light, pdf_light_reverse) =
+            light_bsdf.eval_adjoint_with_pdfs(light_wo, light_wi);
+        let f_light = f_light
+            * shading_correction(
+                light_wo,
+                light_wi,
+                super::normal_in(&light_frame, light.normal, light.shading),
+            );
+        // Shading cosines in the value (pbrt's G), geometric ones in the
+        // densities' conversions to area.
         let (cos_camera, cos_light) = (at.normal.dot(w).abs(), light.normal.dot(w).abs());
-        let value = f_camera * f_light * light.beta * (cos_camera * cos_light / dist2);
+        let value =
+            f_camera * f_light * light.beta * (w_camera_local.z.abs() * light_wi.z.abs() / dist2);
         if !(value.max_element() > 0.0) {
             return Rgb::ZERO;
         }
@@ -228,7 +246,10 @@ impl Vcm {
             if light.segments + at.segments > self.max_depth + 1 {
                 return;
             }
-            let (f, pdf, pdf_reverse) = at.bsdf.eval_with_pdfs(at.wo, at.frame.to_local(light.wo));
+            let wi = at.frame.to_local(light.wo);
+            let (f, pdf, pdf_reverse) = at.bsdf.eval_with_pdfs(at.wo, wi);
+            // Flux per geometric area turned into the shading integral.
+            let f = f * photon_shading_factor(wi, at.ng);
             if !(f.max_element() > 0.0) {
                 return;
             }
