@@ -9,7 +9,6 @@ use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::math::Rgb;
 use crate::scene::light::LightSampling;
-use crate::scene::material::{Bsdf, Material};
 use glam::{Mat3A, Mat4, Vec3A};
 use std::path::Path;
 
@@ -74,15 +73,7 @@ pub fn bare_mesh(path: &Path, limits: &Limits) -> Result<SceneInput> {
     let camera = default_camera(&triangles, &[]);
     Ok(SceneInput {
         camera,
-        materials: vec![Material {
-            name: "default".into(),
-            bsdf: Bsdf::Diffuse {
-                albedo: Rgb::splat(0.8),
-            },
-            emission: Rgb::ZERO,
-            two_sided_emission: false,
-            textures: Default::default(),
-        }],
+        materials: vec![super::load::default_material()],
         textures: Vec::new(),
         environment: Some(Environment::new(
             Radiance::Constant(Rgb::ONE),

@@ -96,12 +96,7 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
     } else {
         None
     };
-    if options.strict && !importer.warnings.is_empty() {
-        return Err(Error::new(format!(
-            "{} (--strict: warnings are errors)",
-            importer.warnings[0]
-        )));
-    }
+    options.check_strict(&importer.warnings)?;
     Ok(SceneInput {
         camera,
         materials: importer.materials,

@@ -501,7 +501,8 @@ fn mesh_transform(m: &MeshDesc) -> std::result::Result<Mat4, String> {
     ))
 }
 
-fn default_material() -> Material {
+/// Grey diffuse, for meshes that name no material.
+pub(super) fn default_material() -> Material {
     Material {
         name: "default".into(),
         bsdf: Bsdf::Diffuse {

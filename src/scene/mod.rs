@@ -78,6 +78,18 @@ pub struct LoadOptions {
     pub strict: bool,
 }
 
+impl LoadOptions {
+    /// With `strict`, the first warning of an import as an error.
+    pub fn check_strict(&self, warnings: &[String]) -> Result<()> {
+        match warnings.first() {
+            Some(w) if self.strict => {
+                Err(Error::new(format!("{w} (--strict: warnings are errors)")))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
 /// Bounces that stand for Mitsuba's unbounded `max_depth = -1` (Russian
 /// roulette ends paths long before).
 pub const UNBOUNDED_DEPTH: u32 = 100;

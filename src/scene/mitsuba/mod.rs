@@ -15,7 +15,7 @@ use super::material::Material;
 use super::{Limits, LoadOptions, RenderHints, SceneInput, in_range};
 use crate::accel::{Sphere, TriangleInput};
 use crate::camera::Camera;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::filter::PixelFilter;
 use crate::math::Rgb;
 use crate::scene::light::{Light, LightSampling, SpotCone};
@@ -47,12 +47,7 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         hints: RenderHints::default(),
     };
     let camera = importer.scene()?;
-    if options.strict && !importer.warnings.is_empty() {
-        return Err(Error::new(format!(
-            "{} (--strict: warnings are errors)",
-            importer.warnings[0]
-        )));
-    }
+    options.check_strict(&importer.warnings)?;
     Ok(SceneInput {
         camera,
         materials: importer.materials,
