@@ -31,18 +31,21 @@
 
 use super::light::{importance_weight, sample_particle, sees_lens, shading_correction};
 use super::{IntegratorOptions, MisHeuristic, RayCounts, Splat, SplattingEstimator, Technique};
-use crate::accel::{NO_LIGHT, SurfaceHit};
-use crate::math::{Frame, Ray, Rgb, ray_between};
+use crate::accel::NO_LIGHT;
+use crate::math::{Ray, Rgb, ray_between};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
-use crate::scene::light::Light;
-use crate::scene::material::Bsdf;
 use glam::{Vec2, Vec3A};
 use std::cell::RefCell;
 
 mod mis;
+mod vertex;
 
 use mis::{light_direction_pdf, pdf};
+use vertex::{
+    Kind, Vertex, disc_density, emission_of, is_directional, is_infinite, origin_density,
+    surface_vertex,
+};
 
 /// The deepest path bidirectional path tracing makes: subpaths live in
 /// per-thread buffers of this capacity, so that a sample allocates nothing.
@@ -102,176 +105,6 @@ impl Technique for Bdpt {
                 "off".into()
             }
         )
-    }
-}
-
-/// What kind of point a subpath vertex is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Kind {
-    /// The lens point z_0.
-    Camera,
-    /// A point on a light, y_0 (or the light point sampled for s = 1).
-    Light,
-    /// A surface the subpath hit.
-    Surface,
-}
-
-/// A subpath vertex: where it is, what the subpath carries to it, and the
-/// densities (area measure) of sampling it from either side.
-#[derive(Clone, Copy, Debug)]
-struct Vertex {
-    kind: Kind,
-    point: Vec3A,
-    error: Vec3A,
-    /// Geometric normal; zero for a pinhole or a point light, which have
-    /// no surface to project densities on.
-    normal: Vec3A,
-    /// Shading normal of a surface (interpolated vertex normals), which
-    /// frames its BSDF; zero where it is the geometric one.
-    shading: Vec3A,
-    /// Unit direction towards the previous vertex of its subpath.
-    wo: Vec3A,
-    bsdf: Bsdf,
-    /// The subpath's weight up to here: the product of f cos / p, with the
-    /// emission (light) or importance (camera) it started with.
-    beta: Rgb,
-    /// Density of this vertex when sampled from the previous one of its
-    /// own subpath, and when sampled from the next one (the other way).
-    pdf_fwd: f32,
-    pdf_rev: f32,
-    /// The vertex scattered specularly: no connection can reach it.
-    delta: bool,
-    /// A point light: no subpath can hit it.
-    delta_light: bool,
-    /// A light at infinity (the environment, a directional light): `point`
-    /// stands far beyond the scene, `normal` is the direction its light
-    /// travels, and densities towards it stay per solid angle.
-    infinite: bool,
-    /// The part of the MIS sum that depends on this subpath alone: the
-    /// heuristic's ratios p_i / p_s of the strategies that would have made
-    /// this vertex and the ones before it from the other side (see
-    /// [`Bdpt::prepare_mis`]).
-    mis_prefix: f32,
-    /// The light the point lies on (light vertices and emitting surfaces),
-    /// else [`NO_LIGHT`].
-    light: u32,
-    /// Radiance emitted towards `wo` (surfaces); Le (or a point light's
-    /// intensity) and its sidedness for light vertices.
-    emitted: Rgb,
-    two_sided: bool,
-    /// Random numbers reserved for this vertex's connection: a light
-    /// choice and point (camera subpath), a lens point (light subpath).
-    u_select: f32,
-    u_connect: Vec2,
-}
-
-impl Vertex {
-    const EMPTY: Vertex = Vertex {
-        kind: Kind::Surface,
-        point: Vec3A::ZERO,
-        error: Vec3A::ZERO,
-        normal: Vec3A::ZERO,
-        shading: Vec3A::ZERO,
-        wo: Vec3A::ZERO,
-        bsdf: Bsdf::Diffuse { albedo: Rgb::ZERO },
-        beta: Rgb::ZERO,
-        pdf_fwd: 0.0,
-        pdf_rev: 0.0,
-        delta: false,
-        delta_light: false,
-        infinite: false,
-        mis_prefix: 0.0,
-        light: NO_LIGHT,
-        emitted: Rgb::ZERO,
-        two_sided: false,
-        u_select: 0.0,
-        u_connect: Vec2::ZERO,
-    };
-
-    /// At a light subpath's surface vertex, the adjoint BSDF from wo (the
-    /// light's side) to w; at a light vertex (whose beta is 1 /
-    /// p_position), the emitted radiance towards `w`; `w` is a unit vector.
-    #[inline]
-    fn scatter(&self, scene: &Scene, w: Vec3A) -> Rgb {
-        match self.kind {
-            Kind::Surface => {
-                let frame = self.frame();
-                let (wo, w) = (frame.to_local(self.wo), frame.to_local(w));
-                self.bsdf.eval(w, wo) * shading_correction(wo, w, self.normal_local(&frame))
-            }
-            Kind::Light if self.infinite => Rgb::ZERO,
-            Kind::Light => {
-                if self.normal == Vec3A::ZERO {
-                    // A point or spot light: a spot's falloff shapes it.
-                    match scene.lights.as_slice().get(self.light as usize) {
-                        Some(Light::Spot { cone, .. }) => self.emitted * cone.falloff(w),
-                        _ => self.emitted,
-                    }
-                } else if self.two_sided || self.normal.dot(w) > 0.0 {
-                    self.emitted
-                } else {
-                    Rgb::ZERO
-                }
-            }
-            Kind::Camera => Rgb::ZERO,
-        }
-    }
-
-    /// The frame of the BSDF: the shading normal's where there is one.
-    #[inline]
-    fn frame(&self) -> Frame {
-        Frame::from_normal(if self.shading == Vec3A::ZERO {
-            self.normal
-        } else {
-            self.shading
-        })
-    }
-
-    /// The geometric normal in `frame` (exactly +z without a shading normal,
-    /// where the adjoint's correction is 1).
-    #[inline]
-    fn normal_local(&self, frame: &Frame) -> Vec3A {
-        if self.shading == Vec3A::ZERO {
-            Vec3A::Z
-        } else {
-            frame.to_local(self.normal)
-        }
-    }
-
-    /// |cos| between the shading normal and `w`: the cosine of the
-    /// scattering integral (Veach's thesis, 5.3; pbrt's G).
-    #[inline]
-    fn shading_cos(&self, w: Vec3A) -> f32 {
-        if self.shading == Vec3A::ZERO {
-            self.cos(w)
-        } else {
-            self.shading.dot(w).abs()
-        }
-    }
-
-    /// |cos| between the normal and the unit vector `w` (1 without a normal).
-    #[inline]
-    fn cos(&self, w: Vec3A) -> f32 {
-        if self.normal == Vec3A::ZERO {
-            1.0
-        } else {
-            self.normal.dot(w).abs()
-        }
-    }
-
-    /// A density wrt. solid angle at this vertex turned into one wrt. area
-    /// at `next`.
-    #[inline]
-    fn area_density_at(&self, pdf_direction: f32, next: &Vertex) -> f32 {
-        if next.infinite {
-            return pdf_direction;
-        }
-        let d = next.point - self.point;
-        let dist2 = d.length_squared();
-        if !(dist2 > 0.0) {
-            return 0.0;
-        }
-        pdf_direction * next.cos(d / dist2.sqrt()) / dist2
     }
 }
 
@@ -773,74 +606,4 @@ struct Connection {
     pt_minus_rev: f32,
     qs_rev: f32,
     qs_minus_rev: f32,
-}
-
-/// A light's emitted radiance (or intensity) and sidedness.
-fn emission_of(scene: &Scene, light: u32) -> (Rgb, bool) {
-    let Some(&emitter) = scene.lights.as_slice().get(light as usize) else {
-        return (Rgb::ZERO, false); // the environment, whose radiance is per direction
-    };
-    match emitter {
-        Light::Triangle(p) | Light::Parallelogram(p) => (p.radiance, p.two_sided),
-        Light::Sphere {
-            radiance,
-            two_sided,
-            ..
-        } => (radiance, two_sided),
-        Light::Point { intensity, .. } | Light::Spot { intensity, .. } => (intensity, true),
-        Light::Directional { .. } => (Rgb::ZERO, false),
-    }
-}
-
-#[inline]
-fn surface_vertex(hit: &SurfaceHit, bsdf: Bsdf, wo: Vec3A, beta: Rgb) -> Vertex {
-    Vertex {
-        kind: Kind::Surface,
-        point: hit.point,
-        error: hit.error,
-        normal: hit.normal,
-        wo,
-        bsdf,
-        beta,
-        ..Vertex::EMPTY
-    }
-}
-
-/// True for the environment and directional lights.
-#[inline]
-fn is_infinite(scene: &Scene, light: u32) -> bool {
-    match scene.lights.as_slice().get(light as usize) {
-        None => true,
-        Some(l) => matches!(l, Light::Directional { .. }),
-    }
-}
-
-#[inline]
-fn is_directional(scene: &Scene, light: u32) -> bool {
-    matches!(
-        scene.lights.as_slice().get(light as usize),
-        Some(Light::Directional { .. })
-    )
-}
-
-/// Per area, the density of a particle's start on the disc facing the
-/// scene from a light at infinity (without the light's choice).
-#[inline]
-pub(super) fn disc_density(scene: &Scene, light: u32) -> f32 {
-    let radius = match scene.lights.as_slice().get(light as usize) {
-        Some(Light::Directional { radius, .. }) => *radius,
-        _ => scene.lights.environment().map_or(1.0, |e| e.radius),
-    };
-    1.0 / (std::f32::consts::PI * radius * radius)
-}
-
-/// The density of a light at infinity as a path's first vertex: its choice
-/// times the solid-angle density of the direction `to_light` (pointing from
-/// the scene to the light); 0 for a directional light (a delta).
-#[inline]
-pub(super) fn origin_density(scene: &Scene, light: u32, to_light: Vec3A) -> f32 {
-    if is_directional(scene, light) {
-        return 0.0;
-    }
-    scene.lights.environment_pdf(to_light)
 }
