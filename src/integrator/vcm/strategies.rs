@@ -66,10 +66,11 @@ impl Vcm {
         let at = (v.point, v.error, v.normal);
         self.splat_through_lens(scene, iteration, at, sampler, counts, splats, |c| {
             let bsdf = scene.materials[v.material as usize].bsdf_at(&scene.textures, v.uv);
-            let frame = Frame::from_normal(v.shading);
+            let shading = v.shading();
+            let frame = Frame::from_normal(shading);
             let (wo, wi) = (frame.to_local(v.wo), frame.to_local(c.wi));
             let (f, _, pdf_reverse) = bsdf.eval_adjoint_with_pdfs(wo, wi);
-            let f = f * shading_correction(wo, wi, super::normal_in(&frame, v.normal, v.shading));
+            let f = f * shading_correction(wo, wi, super::normal_in(&frame, v.normal, shading));
             // The scattering's cosine is the shading normal's, the
             // density's conversion to area the geometric one's.
             let cos = v.normal.dot(c.wi).abs();
@@ -190,7 +191,8 @@ impl Vcm {
             at.bsdf.eval_with_pdfs(at.wo, w_camera_local);
         let light_bsdf =
             scene.materials[light.material as usize].bsdf_at(&scene.textures, light.uv);
-        let light_frame = Frame::from_normal(light.shading);
+        let light_shading = light.shading();
+        let light_frame = Frame::from_normal(light_shading);
         let (light_wo, light_wi) = (light_frame.to_local(light.wo), light_frame.to_local(-w));
         let (f_light, pdf_light, pdf_light_reverse) =
             light_bsdf.eval_adjoint_with_pdfs(light_wo, light_wi);
@@ -198,7 +200,7 @@ impl Vcm {
             * shading_correction(
                 light_wo,
                 light_wi,
-                super::normal_in(&light_frame, light.normal, light.shading),
+                super::normal_in(&light_frame, light.normal, light_shading),
             );
         // Shading cosines in the value (pbrt's G), geometric ones in the
         // densities' conversions to area.
