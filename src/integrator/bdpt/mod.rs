@@ -360,7 +360,7 @@ impl Bdpt {
             if scene.features.shading_normals {
                 let n = scene.geometry.shading_normal(&hit);
                 if n != hit.normal {
-                    vertex.shading = n;
+                    vertex.packed_shading = crate::math::octahedral_encode(n);
                 }
             }
             if hit.light != NO_LIGHT {

@@ -9,6 +9,9 @@ use crate::scene::light::Light;
 use crate::scene::material::Bsdf;
 use glam::{Vec2, Vec3A};
 
+/// [`Vertex::packed_shading`] where the shading normal is the geometric one.
+pub(super) const NO_SHADING_NORMAL: u32 = u32::MAX;
+
 /// What kind of point a subpath vertex is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Kind {
@@ -31,8 +34,10 @@ pub(super) struct Vertex {
     /// no surface to project densities on.
     pub(super) normal: Vec3A,
     /// Shading normal of a surface (interpolated vertex normals), which
-    /// frames its BSDF; zero where it is the geometric one.
-    pub(super) shading: Vec3A,
+    /// frames its BSDF, packed in 32 bits (`math::octahedral_encode`), so
+    /// that subpath copies stay small; [`NO_SHADING_NORMAL`] where it is
+    /// the geometric one.
+    pub(super) packed_shading: u32,
     /// Unit direction towards the previous vertex of its subpath.
     pub(super) wo: Vec3A,
     pub(super) bsdf: Bsdf,
@@ -75,7 +80,7 @@ impl Vertex {
         point: Vec3A::ZERO,
         error: Vec3A::ZERO,
         normal: Vec3A::ZERO,
-        shading: Vec3A::ZERO,
+        packed_shading: NO_SHADING_NORMAL,
         wo: Vec3A::ZERO,
         bsdf: Bsdf::Diffuse { albedo: Rgb::ZERO },
         beta: Rgb::ZERO,
@@ -124,10 +129,9 @@ impl Vertex {
     /// The frame of the BSDF: the shading normal's where there is one.
     #[inline]
     pub(super) fn frame(&self) -> Frame {
-        Frame::from_normal(if self.shading == Vec3A::ZERO {
-            self.normal
-        } else {
-            self.shading
+        Frame::from_normal(match self.packed_shading {
+            NO_SHADING_NORMAL => self.normal,
+            p => crate::math::octahedral_decode(p),
         })
     }
 
@@ -135,7 +139,7 @@ impl Vertex {
     /// where the adjoint's correction is 1).
     #[inline]
     pub(super) fn normal_local(&self, frame: &Frame) -> Vec3A {
-        if self.shading == Vec3A::ZERO {
+        if self.packed_shading == NO_SHADING_NORMAL {
             Vec3A::Z
         } else {
             frame.to_local(self.normal)
@@ -146,10 +150,9 @@ impl Vertex {
     /// scattering integral (Veach's thesis, 5.3; pbrt's G).
     #[inline]
     pub(super) fn shading_cos(&self, w: Vec3A) -> f32 {
-        if self.shading == Vec3A::ZERO {
-            self.cos(w)
-        } else {
-            self.shading.dot(w).abs()
+        match self.packed_shading {
+            NO_SHADING_NORMAL => self.cos(w),
+            p => crate::math::octahedral_decode(p).dot(w).abs(),
         }
     }
 
