@@ -2,7 +2,8 @@
 //! progress bar, prints its text, tables and checks, and writes CSV and
 //! plots. Exits non-zero when a check does not hold.
 
-use super::render::{SamplerArg, progress_bar};
+use super::choices::SamplerArg;
+use super::render::progress_bar;
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
 use std::time::Duration;

@@ -2,6 +2,7 @@
 //! (`view` and `compare` here; `render`, `bench` and `stress` in their own files).
 
 mod bench;
+mod choices;
 mod lab;
 mod radiosity;
 mod render;

@@ -1,6 +1,7 @@
 //! `tracelab render`: one image from the command line, with a progress bar
 //! and a summary of what it cost; `--debug-sample` replays one path.
 
+use super::choices::*;
 use super::radiosity::RadiosityFlags;
 use super::solver::{render_solver, render_until};
 use super::{IntegratorArg, integrator_kind};
@@ -23,67 +24,6 @@ use tracelab::sampling::{Domains, SamplerKind};
 use tracelab::scene::light::LightSampling;
 use tracelab::scene::{Limits, LoadOptions, RenderHints, Scene};
 use tracelab::{Error, Result};
-
-#[derive(ValueEnum, Clone, Copy, Debug)]
-enum StrategyArg {
-    /// BSDF sampling only.
-    Bsdf,
-    /// Light sampling only.
-    Light,
-    /// Both, combined by MIS.
-    Mis,
-}
-
-#[derive(ValueEnum, Clone, Copy, Debug)]
-enum LightSamplingArg {
-    /// Uniform by area: density d^2 / (cos A) in solid angle.
-    Area,
-    /// Uniform in solid angle: sphere cones, spherical triangles (Arvo).
-    SolidAngle,
-}
-
-#[derive(ValueEnum, Clone, Copy, Debug)]
-enum GlassShadowsArg {
-    Opaque,
-    Tinted,
-}
-
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-enum SeenEmittersArg {
-    Exact,
-    Sampled,
-}
-
-#[derive(ValueEnum, Clone, Copy, Debug)]
-pub(crate) enum SamplerArg {
-    /// Independent uniform numbers.
-    Independent,
-    /// Jittered strata in every dimension and pair, shuffled between dimensions.
-    Stratified,
-    /// Correlated multi-jittered: jittered and Latin hypercube in every pair.
-    Multijitter,
-    /// Owen-scrambled Sobol, shuffled per dimension pair (path tracing:
-    /// for the camera sample and the first two vertices, then independent).
-    Sobol,
-}
-
-impl SamplerArg {
-    pub(crate) fn kind(self) -> SamplerKind {
-        match self {
-            SamplerArg::Independent => SamplerKind::Independent,
-            SamplerArg::Stratified => SamplerKind::Stratified,
-            SamplerArg::Multijitter => SamplerKind::MultiJittered,
-            SamplerArg::Sobol => SamplerKind::Sobol,
-        }
-    }
-}
-
-#[derive(ValueEnum, Clone, Copy, Debug)]
-enum MisArg {
-    None,
-    Balance,
-    Power,
-}
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
