@@ -132,3 +132,39 @@ pub(super) fn list_scene_files() -> Vec<String> {
     files.sort();
     files
 }
+
+impl super::app::ViewerApp {
+    /// What an imported file asks for (Mitsuba's integrator block): the
+    /// technique and depths of view A, said in a toast.
+    pub(super) fn apply_hints(&mut self, hints: &crate::scene::RenderHints) {
+        // A technique named on the command line wins over the file's.
+        let launched_with_technique = self.launch.integrator.is_some();
+        let a = &mut self.settings.a.integrator;
+        let mut said = Vec::new();
+        if let Some(kind) = hints
+            .integrator
+            .as_deref()
+            .filter(|_| !launched_with_technique)
+            .and_then(|name| {
+                crate::integrator::IntegratorKind::ALL
+                    .iter()
+                    .copied()
+                    .find(|k| k.name() == name)
+            })
+        {
+            a.kind = kind;
+            said.push(kind.label().to_string());
+        }
+        if let Some(d) = hints.max_depth {
+            a.max_depth = d;
+            said.push(format!("max depth {d}"));
+        }
+        if let Some(d) = hints.rr_depth {
+            a.rr_depth = d;
+            said.push(format!("roulette from {d}"));
+        }
+        if !said.is_empty() {
+            self.toast(format!("from the scene file: {}", said.join(", ")));
+        }
+    }
+}
