@@ -113,3 +113,40 @@ pub fn mean_and_standard_error(snapshot: &FilmSnapshot) -> ([f64; 3], [f64; 3]) 
     }
     (mean, var.map(|v| v.sqrt() / n))
 }
+
+/// A unit UV sphere of `nu` x `nv` quads as OBJ text, faces counter-clockwise
+/// seen from outside; with `normals`, smooth `vn` normals (the true ones).
+pub fn uv_sphere_obj(nu: usize, nv: usize, normals: bool) -> String {
+    let mut text = String::new();
+    let index = |i: usize, j: usize| 1 + j * (nu + 1) + i;
+    for j in 0..=nv {
+        for i in 0..=nu {
+            let theta = std::f32::consts::PI * j as f32 / nv as f32;
+            let phi = std::f32::consts::TAU * i as f32 / nu as f32;
+            let n = glam::Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            );
+            text += &format!("v {} {} {}\n", n.x, n.y, n.z);
+            if normals {
+                text += &format!("vn {} {} {}\n", n.x, n.y, n.z);
+            }
+        }
+    }
+    for j in 0..nv {
+        for i in 0..nu {
+            let (a, b, c, d) = (
+                index(i, j),
+                index(i + 1, j),
+                index(i + 1, j + 1),
+                index(i, j + 1),
+            );
+            text += &match normals {
+                true => format!("f {a}//{a} {d}//{d} {c}//{c}\nf {a}//{a} {c}//{c} {b}//{b}\n"),
+                false => format!("f {a} {d} {c}\nf {a} {c} {b}\n"),
+            };
+        }
+    }
+    text
+}

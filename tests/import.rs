@@ -476,34 +476,7 @@ fn gltf_nodes_meshes_camera_materials_and_lights_land_where_the_file_puts_them()
 #[test]
 fn smooth_angle_gives_a_faceted_sphere_smooth_normals() {
     let dir = temp_dir("smooth-angle");
-    let (nu, nv) = (24usize, 12usize);
-    let mut obj = String::new();
-    for j in 0..=nv {
-        for i in 0..nu {
-            let (theta, phi) = (
-                std::f32::consts::PI * j as f32 / nv as f32,
-                std::f32::consts::TAU * i as f32 / nu as f32,
-            );
-            obj += &format!(
-                "v {} {} {}\n",
-                theta.sin() * phi.cos(),
-                theta.sin() * phi.sin(),
-                theta.cos()
-            );
-        }
-    }
-    let index = |i: usize, j: usize| 1 + j * nu + i % nu;
-    for j in 0..nv {
-        for i in 0..nu {
-            let (a, b, c, d) = (
-                index(i, j),
-                index(i + 1, j),
-                index(i + 1, j + 1),
-                index(i, j + 1),
-            );
-            obj += &format!("f {a} {d} {c}\nf {a} {c} {b}\n");
-        }
-    }
+    let obj = crate::common::uv_sphere_obj(24, 12, false);
     std::fs::write(dir.join("ball.obj"), obj).unwrap();
     let scene_text = |extra: &str| {
         format!(

@@ -466,46 +466,18 @@ file = "{sky}"
     }
 }
 
-/// A UV sphere of 12 x 6 quads with smooth `vn` normals (shading and
-/// geometric normals differ by up to 15 degrees), as OBJ text.
-fn smooth_sphere_obj() -> String {
-    let (nu, nv) = (12usize, 6usize);
-    let mut text = String::new();
-    let index = |i: usize, j: usize| 1 + j * (nu + 1) + i;
-    for j in 0..=nv {
-        for i in 0..=nu {
-            let theta = std::f32::consts::PI * j as f32 / nv as f32;
-            let phi = std::f32::consts::TAU * i as f32 / nu as f32;
-            let n = glam::Vec3::new(
-                theta.sin() * phi.cos(),
-                theta.sin() * phi.sin(),
-                theta.cos(),
-            );
-            text += &format!("v {} {} {}\nvn {} {} {}\n", n.x, n.y, n.z, n.x, n.y, n.z);
-        }
-    }
-    for j in 0..nv {
-        for i in 0..nu {
-            let (a, b, c, d) = (
-                index(i, j),
-                index(i + 1, j),
-                index(i + 1, j + 1),
-                index(i, j + 1),
-            );
-            // Counter-clockwise seen from outside.
-            text += &format!("f {a}//{a} {d}//{d} {c}//{c}\nf {a}//{a} {c}//{c} {b}//{b}\n");
-        }
-    }
-    text
-}
-
 /// Shading normals: light tracing, BDPT and VCM (with Veach's adjoint
 /// correction) agree with path tracing on a faceted sphere shaded smooth, diffuse and rough
 /// plastic; without the correction it does not (the test sees it).
 #[test]
 fn light_tracing_agrees_with_path_tracing_under_shading_normals() {
     let dir = crate::common::temp_dir("smooth-sphere");
-    std::fs::write(dir.join("ball.obj"), smooth_sphere_obj()).unwrap();
+    // 12 x 6 quads: shading and geometric normals differ by up to 15 degrees.
+    std::fs::write(
+        dir.join("ball.obj"),
+        crate::common::uv_sphere_obj(12, 6, true),
+    )
+    .unwrap();
     let text = format!(
         r#"
 [camera]
