@@ -134,9 +134,6 @@ impl Session {
     /// Refuses, before allocating, a render whose film would not fit in
     /// the memory available ([`Session::memory_estimate`]).
     pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Result<Session> {
-        if let Some(e) = Session::unsupported(&scene, &settings) {
-            return Err(e);
-        }
         let needed = Session::memory_estimate(&scene, &settings);
         if let Some(available) = available_memory()
             && needed > available
@@ -153,31 +150,12 @@ impl Session {
         Ok(Self::with_pool(scene, settings, pool))
     }
 
-    /// Why `settings` cannot render `scene`, if they cannot: BDPT and VCM
-    /// do not yet handle light from infinity, spot lights or shading
-    /// normals.
-    pub fn unsupported(scene: &Scene, settings: &RenderSettings) -> Option<Error> {
-        use crate::integrator::IntegratorKind;
-        if settings.integrator.kind() != IntegratorKind::Vcm {
-            return None;
-        }
-        let lacks = if scene.lights.has_lights_bidirectional_lacks() {
-            "environment or directional lights (its MIS needs the densities of lights at infinity)"
-        } else {
-            return None;
-        };
-        Some(Error::new(format!(
-            "vcm does not handle {lacks} yet: use bdpt, path, light, mcrt or photon mapping"
-        )))
-    }
-
     /// Starts a session on an existing pool (sessions that take turns share one).
     pub fn with_pool(
         scene: Arc<Scene>,
         settings: RenderSettings,
         pool: Arc<rayon::ThreadPool>,
     ) -> Session {
-        let unsupported = Session::unsupported(&scene, &settings);
         let settings = RenderSettings {
             integrator: settings.integrator.for_scene(&scene),
             ..settings
@@ -205,7 +183,7 @@ impl Session {
             solver_state: Mutex::new(None),
             solver_progress: Mutex::new(None),
             solver_notes: Mutex::new(Vec::new()),
-            failure: Mutex::new(unsupported),
+            failure: Mutex::new(None),
         }
     }
 

@@ -42,13 +42,34 @@ impl Lights {
         }
     }
 
-    /// True when a light is at infinity: VCM does not handle these yet.
-    pub fn has_lights_bidirectional_lacks(&self) -> bool {
-        self.environment.is_some()
-            || self
-                .lights
-                .iter()
-                .any(|l| matches!(l, Light::Directional { .. }))
+    /// True for the lights at infinity: the environment and directional
+    /// lights, whose particles start on a disc facing the scene.
+    #[inline]
+    pub fn is_infinite(&self, light: u32) -> bool {
+        match self.lights.get(light as usize) {
+            None => true,
+            Some(l) => matches!(l, Light::Directional { .. }),
+        }
+    }
+
+    /// True for a directional light (a delta in direction).
+    #[inline]
+    pub fn is_directional(&self, light: u32) -> bool {
+        matches!(
+            self.lights.get(light as usize),
+            Some(Light::Directional { .. })
+        )
+    }
+
+    /// Per area, the density of a particle's start on the disc facing the
+    /// scene from light `light` at infinity (without the light's choice).
+    #[inline]
+    pub fn disc_density(&self, light: u32) -> f32 {
+        let radius = match self.lights.get(light as usize) {
+            Some(Light::Directional { radius, .. }) => *radius,
+            _ => self.environment.as_ref().map_or(1.0, |e| e.radius),
+        };
+        1.0 / (PI * radius * radius)
     }
 
     /// The environment, if the scene has one.

@@ -147,7 +147,7 @@ pub(super) fn pdf(scene: &Scene, v: &Vertex, previous: Option<&Vertex>, next: &V
 pub(super) fn light_direction_pdf(scene: &Scene, v: &Vertex, next: &Vertex) -> f32 {
     if v.infinite {
         // A parallel beam along `v.normal`: the disc's density, projected.
-        return super::disc_density(scene, v.light) * next.cos(v.normal);
+        return scene.lights.disc_density(v.light) * next.cos(v.normal);
     }
     let w = (next.point - v.point).normalize_or_zero();
     let (_, pdf_direction) = scene.lights.emission_pdf(v.light, v.normal, w);

@@ -42,10 +42,7 @@ mod mis;
 mod vertex;
 
 use mis::{light_direction_pdf, pdf};
-use vertex::{
-    Kind, Vertex, disc_density, emission_of, is_directional, is_infinite, origin_density,
-    surface_vertex,
-};
+use vertex::{Kind, Vertex, emission_of, origin_density, surface_vertex};
 
 /// The deepest path bidirectional path tracing makes: subpaths live in
 /// per-thread buffers of this capacity, so that a sample allocates nothing.
@@ -219,7 +216,7 @@ impl Bdpt {
         let emission = sample_particle(scene, sampler);
         let u_lens = sampler.next_2d_for(Domain::Lens);
         if let Some(emission) = emission {
-            let infinite = is_infinite(scene, emission.light);
+            let infinite = scene.lights.is_infinite(emission.light);
             light_path.push(Vertex {
                 kind: Kind::Light,
                 point: emission.point,
@@ -234,7 +231,7 @@ impl Bdpt {
                     emission.pdf_position
                 },
                 delta_light: emission.normal == Vec3A::ZERO
-                    || is_directional(scene, emission.light),
+                    || scene.lights.is_directional(emission.light),
                 infinite,
                 light: emission.light,
                 emitted: emission.emitted,
@@ -371,7 +368,7 @@ impl Bdpt {
             vertex.u_connect = u_connect;
             vertex.pdf_fwd = if previous.infinite {
                 // A parallel beam: the disc's density, projected.
-                disc_density(scene, previous.light) * vertex.cos(ray.direction)
+                scene.lights.disc_density(previous.light) * vertex.cos(ray.direction)
             } else {
                 previous.area_density_at(pdf_direction, &vertex)
             };
@@ -520,7 +517,7 @@ impl Bdpt {
             let (pdf_position, pdf_emission) =
                 scene.lights.emission_pdf(ls.light, ls.normal, -ls.wi);
             let (emitted, two_sided) = emission_of(scene, ls.light);
-            let infinite = is_infinite(scene, ls.light);
+            let infinite = scene.lights.is_infinite(ls.light);
             let sampled = Vertex {
                 kind: Kind::Light,
                 point: ls.point,
@@ -539,7 +536,7 @@ impl Bdpt {
                 ..Vertex::EMPTY
             };
             let pt_rev = if infinite {
-                disc_density(scene, ls.light) * pt.cos(ls.wi)
+                scene.lights.disc_density(ls.light) * pt.cos(ls.wi)
             } else {
                 sampled.area_density_at(pdf_emission, pt)
             };

@@ -213,40 +213,12 @@ pub(super) fn surface_vertex(hit: &SurfaceHit, bsdf: Bsdf, wo: Vec3A, beta: Rgb)
     }
 }
 
-/// True for the environment and directional lights.
-#[inline]
-pub(super) fn is_infinite(scene: &Scene, light: u32) -> bool {
-    match scene.lights.as_slice().get(light as usize) {
-        None => true,
-        Some(l) => matches!(l, Light::Directional { .. }),
-    }
-}
-
-#[inline]
-pub(super) fn is_directional(scene: &Scene, light: u32) -> bool {
-    matches!(
-        scene.lights.as_slice().get(light as usize),
-        Some(Light::Directional { .. })
-    )
-}
-
-/// Per area, the density of a particle's start on the disc facing the
-/// scene from a light at infinity (without the light's choice).
-#[inline]
-pub(super) fn disc_density(scene: &Scene, light: u32) -> f32 {
-    let radius = match scene.lights.as_slice().get(light as usize) {
-        Some(Light::Directional { radius, .. }) => *radius,
-        _ => scene.lights.environment().map_or(1.0, |e| e.radius),
-    };
-    1.0 / (std::f32::consts::PI * radius * radius)
-}
-
 /// The density of a light at infinity as a path's first vertex: its choice
 /// times the solid-angle density of the direction `to_light` (pointing from
 /// the scene to the light); 0 for a directional light (a delta).
 #[inline]
 pub(super) fn origin_density(scene: &Scene, light: u32, to_light: Vec3A) -> f32 {
-    if is_directional(scene, light) {
+    if scene.lights.is_directional(light) {
         return 0.0;
     }
     scene.lights.environment_pdf(to_light)

@@ -249,12 +249,22 @@ impl Vcm {
 
     /// The next surface along `ray`, with the walk's quantities moved to it:
     /// from the previous vertex's solid angle into this one's area (the
-    /// distance squared over the |cos| of arrival).
+    /// distance squared over the |cos| of arrival; the cosine alone where
+    /// the ray left a light at infinity, `parallel`, by area already).
     #[inline]
-    fn advance(&self, scene: &Scene, ray: &Ray, walk: &mut Walk) -> Option<SurfaceHit> {
+    fn advance(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        parallel: bool,
+        walk: &mut Walk,
+    ) -> Option<SurfaceHit> {
         let hit = scene.geometry.intersect(ray)?;
         let c = self.mis(hit.normal.dot(ray.direction).abs());
-        walk.d_vcm *= self.mis((hit.point - ray.origin).length_squared()) / c;
+        if !parallel {
+            walk.d_vcm *= self.mis((hit.point - ray.origin).length_squared());
+        }
+        walk.d_vcm /= c;
         walk.d_vc /= c;
         walk.d_vm /= c;
         Some(hit)
@@ -343,7 +353,12 @@ impl Vcm {
         let Some(emission) = sample_particle(scene, sampler) else {
             return;
         };
-        let delta_light = emission.normal == Vec3A::ZERO;
+        // From infinity the particle starts on a disc facing the scene
+        // (normal = direction): light sampling picks its direction alone,
+        // with the density of the disc's point divided out (SmallVCM).
+        let infinite = scene.lights.is_infinite(emission.light);
+        let delta_light =
+            emission.normal == Vec3A::ZERO || scene.lights.is_directional(emission.light);
         let cos_light = if delta_light {
             1.0
         } else {
@@ -355,20 +370,27 @@ impl Vcm {
         } else {
             self.mis(cos_light / emission_pdf)
         };
+        let d_vcm = if infinite {
+            self.mis(1.0 / scene.lights.disc_density(emission.light))
+        } else {
+            self.mis(1.0 / emission.pdf_direction)
+        };
         let mut walk = Walk {
             beta: emission.throughput,
             relative: Rgb::ONE,
-            d_vcm: self.mis(1.0 / emission.pdf_direction),
+            d_vcm,
             d_vc,
             d_vm: d_vc * iteration.vc_factor,
         };
-        if !delta_light {
+        if !delta_light && !infinite {
             self.light_point_to_camera(scene, iteration, &emission, sampler, counts, splats);
         }
         let mut ray = emission.ray().at_time(iteration.time);
         counts.bounce += 1;
         for segments in 1..=self.max_depth {
-            let Some(hit) = self.advance(scene, &ray, &mut walk) else {
+            // The disc's density by area is the hit's up to the cosine.
+            let parallel = infinite && segments == 1;
+            let Some(hit) = self.advance(scene, &ray, parallel, &mut walk) else {
                 break;
             };
             let wo_world = -ray.direction;
@@ -513,7 +535,8 @@ impl MultiPassEstimator for Vcm {
             1.0 / (PI * iteration.radius * iteration.radius * iteration.paths as f32);
         let mut radiance = Rgb::ZERO;
         for segments in 1..=self.max_depth + 1 {
-            let Some(hit) = self.advance(scene, &ray, &mut walk) else {
+            let Some(hit) = self.advance(scene, &ray, false, &mut walk) else {
+                radiance += walk.beta * self.environment(scene, &ray, segments, &walk);
                 break;
             };
             let wo_world = -ray.direction;
@@ -569,6 +592,30 @@ impl MultiPassEstimator for Vcm {
             counts.bounce += 1;
         }
         radiance + splatted
+    }
+}
+
+impl Vcm {
+    /// s = 0 at infinity: the environment where the camera subpath leaves
+    /// the scene, weighed against light sampling and the light subpaths
+    /// that start on the disc facing it; seen directly, nothing else could
+    /// have made it.
+    fn environment(&self, scene: &Scene, ray: &Ray, segments: u32, walk: &Walk) -> Rgb {
+        let Some(env) = scene.lights.environment() else {
+            return Rgb::ZERO;
+        };
+        let le = env.le(ray.direction);
+        if segments == 1 {
+            return le;
+        }
+        let direct = scene.lights.environment_pdf(ray.direction);
+        let (pdf_position, pdf_direction) =
+            scene
+                .lights
+                .emission_pdf(scene.lights.environment_id(), Vec3A::ZERO, -ray.direction);
+        let w_camera =
+            self.mis(direct) * walk.d_vcm + self.mis(pdf_position * pdf_direction) * walk.d_vc;
+        le / (1.0 + w_camera)
     }
 }
 

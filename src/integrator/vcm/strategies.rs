@@ -152,13 +152,23 @@ impl Vcm {
         }
         let dist2 = ls.distance * ls.distance;
         let (pdf_position, pdf_emission) = scene.lights.emission_pdf(ls.light, ls.normal, -ls.wi);
+        // A light at infinity is sampled by direction; its light subpaths
+        // start on a disc, by area there.
+        let infinite = scene.lights.is_infinite(ls.light);
         let w_light = if ls.delta {
             0.0
+        } else if infinite {
+            self.mis(pdf / ls.pdf)
         } else {
             let cos_light = ls.normal.dot(ls.wi).abs();
             self.mis(pdf * cos_light / (dist2 * pdf_position))
         };
-        let w_camera = self.mis(pdf_emission * cos / dist2)
+        let emitted_here = if infinite {
+            pdf_position * pdf_emission * cos / ls.pdf
+        } else {
+            pdf_emission * cos / dist2
+        };
+        let w_camera = self.mis(emitted_here)
             * (iteration.vm_factor + walk.d_vcm + walk.d_vc * self.mis(pdf_reverse));
         counts.shadow += 1;
         let shadow = ray_between(at.point, at.error, at.normal, ls.point, ls.error, ls.normal)
