@@ -125,6 +125,35 @@ impl Bitmap {
         Self::from_image(image, raw)
     }
 
+    /// The alpha channel of an image held in memory, times `factor`, as a
+    /// grey bitmap; cut to 0 or 1 at `cutoff` where given (glTF's MASK).
+    /// An image without alpha is opaque.
+    pub fn decode_alpha(bytes: &[u8], factor: f32, cutoff: Option<f32>) -> Result<Bitmap, String> {
+        let image = image::load_from_memory(bytes).map_err(|e| e.to_string())?;
+        let rgba = image.to_rgba32f();
+        let (width, height) = (rgba.width() as usize, rgba.height() as usize);
+        if width == 0 || height == 0 {
+            return Err("the image is empty".into());
+        }
+        let texels = rgba
+            .pixels()
+            .map(|p| {
+                let a = p[3] * factor;
+                let a = match cutoff {
+                    Some(c) => f32::from(u8::from(a >= c)),
+                    None if a.is_finite() => a.clamp(0.0, 1.0),
+                    None => 0.0,
+                };
+                Rgb::splat(a)
+            })
+            .collect();
+        Ok(Bitmap {
+            width,
+            height,
+            texels,
+        })
+    }
+
     fn from_image(image: image::DynamicImage, raw: bool) -> Result<Bitmap, String> {
         let float = matches!(
             image.color(),

@@ -28,6 +28,7 @@ fn furnace_material() -> Material {
         emission: EMISSION,
         two_sided_emission: true,
         textures: Default::default(),
+        opacity: Default::default(),
     }
 }
 

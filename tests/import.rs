@@ -323,7 +323,7 @@ fn what_is_not_rendered_is_a_warning_and_strict_makes_it_an_error() {
 
 /// A floor quad, an emissive quad, a camera and a point light under a
 /// parent node, as glTF JSON; `uri` names the buffer file (None: a GLB's).
-fn gltf_json(uri: Option<&str>) -> String {
+pub(crate) fn gltf_json(uri: Option<&str>) -> String {
     let buffer = match uri {
         Some(u) => format!(r#"{{"byteLength": 140, "uri": "{u}"}}"#),
         None => r#"{"byteLength": 140}"#.to_string(),
@@ -370,7 +370,7 @@ fn gltf_json(uri: Option<&str>) -> String {
 }
 
 /// The buffer of [`gltf_json`]: a unit quad facing +z, normals, uvs, indices.
-fn gltf_buffer() -> Vec<u8> {
+pub(crate) fn gltf_buffer() -> Vec<u8> {
     let mut b = Vec::new();
     for p in [[-1f32, -1., 0.], [1., -1., 0.], [1., 1., 0.], [-1., 1., 0.]] {
         p.iter().for_each(|x| b.extend(x.to_le_bytes()));

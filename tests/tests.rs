@@ -33,6 +33,8 @@ mod strategies;
 mod bidirectional;
 // Microfacet, plastic, conductor and thin glass models in every technique.
 mod materials;
+// Opacity masks in every technique and importer.
+mod masks;
 // Same seed, same film, whatever the thread count or pass split.
 mod determinism;
 // Motion blur: a moving occluder against a case solved by hand.

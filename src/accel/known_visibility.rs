@@ -9,13 +9,15 @@ use crate::math::{OffsetMode, Ray};
 use glam::Vec3A;
 
 impl Geometry {
-    /// True when the geometry is a soup of triangles only, none moving:
+    /// True when the geometry is a soup of triangles only, none moving and
+    /// none masked:
     /// the soup tests every triangle one by one, so a query among some of
     /// them finds the same hits.
     pub fn is_static_soup(&self) -> bool {
         matches!(self.tri_index, TriangleIndex::Soup(_))
             && self.spheres.is_empty()
             && self.moving.is_empty()
+            && self.masks.is_none()
     }
 
     /// For a static soup ([`Geometry::is_static_soup`]): its box, and the

@@ -9,6 +9,7 @@
 
 mod block;
 mod known_visibility;
+pub mod mask;
 mod soup;
 mod sphere;
 pub(crate) mod triangle;
@@ -16,6 +17,7 @@ mod wide_bvh;
 
 use crate::math::{OffsetMode, Ray, gamma};
 use glam::{Vec2, Vec3A};
+use mask::Masks;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
@@ -25,6 +27,7 @@ use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
 use obvhs::ploc::PlocBuilder;
 use soup::TriangleSoup;
 use sphere::intersect_sphere;
+use std::sync::Arc;
 use wide_bvh::WideBvh;
 
 /// Marks a primitive that is not a light.
@@ -200,6 +203,9 @@ pub struct Geometry {
     keep_uvs: bool,
     /// Whether hits interpolate vertex normals.
     keep_normals: bool,
+    /// Opacity masks, where some material has one: queries then pass
+    /// through the hits a mask drops.
+    masks: Option<Arc<Masks>>,
 }
 
 /// Geometry translated by `velocity * time`: at time t it is hit where the
@@ -564,7 +570,10 @@ impl Geometry {
     /// instructions and gives most of that gain without a profile.
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
-        let mut hit = self.intersect_all(ray);
+        let mut hit = match &self.masks {
+            None => self.intersect_all(ray),
+            Some(masks) => self.intersect_masked(ray, masks),
+        };
         if let (OffsetMode::Fixed(_), Some(h)) = (self.offset, &mut hit) {
             h.error = self.offset.spawn_error(h.error, h.normal);
         }
@@ -595,6 +604,39 @@ impl Geometry {
             }
         }
         best
+    }
+
+    /// The closest hit that the masks keep: past each one they drop, the
+    /// ray goes on from it (out of line: only scenes with masks come here).
+    #[inline(never)]
+    fn intersect_masked(&self, ray: &Ray, masks: &Masks) -> Option<SurfaceHit> {
+        let mut r = *ray;
+        let mut travelled = 0.0;
+        for pass in 1..=mask::MAX_PASSES {
+            let hit = self.intersect_all(&r)?;
+            if pass == mask::MAX_PASSES
+                || masks.keeps(hit.material, &r, hit.point, || self.uv(&hit))
+            {
+                return Some(SurfaceHit {
+                    t: hit.t + travelled,
+                    ..hit
+                });
+            }
+            travelled += hit.t;
+            r = mask::continue_past(&r, hit.t, hit.point, hit.error, hit.normal);
+        }
+        None
+    }
+
+    /// Sets the materials' opacities: from now on every query passes
+    /// through the hits their masks drop. Scenes without a mask keep none.
+    pub fn set_masks(&mut self, masks: Masks) {
+        self.masks = Masks::any(&masks.by_material).then(|| Arc::new(masks));
+    }
+
+    /// True when some surface has an opacity mask.
+    pub fn has_masks(&self) -> bool {
+        self.masks.is_some()
     }
 
     /// Closest hit among the geometry at rest.
@@ -698,13 +740,18 @@ impl Geometry {
     /// (shadow rays).
     #[inline(always)]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.occluded_static(ray)
+        let blocked = self.occluded_static(ray)
             || self.moving.iter().any(|m| {
                 m.geometry.occluded_static(&Ray {
                     origin: ray.origin - ray.time * m.velocity,
                     ..*ray
                 })
-            })
+            });
+        // Masks only remove hits: a ray nothing blocks stays unblocked.
+        match &self.masks {
+            Some(masks) if blocked => self.intersect_masked(ray, masks).is_some(),
+            _ => blocked,
+        }
     }
 
     #[inline(always)]

@@ -10,6 +10,7 @@ use crate::bsdf::{
     RoughPlastic, ThinDielectric, presets,
 };
 use crate::math::Rgb;
+use crate::scene::material::Opacity;
 use crate::texture::{Bitmap, Filter as TextureFilter, Texture, UvTransform, Wrap};
 use glam::{EulerRot, Vec2};
 use std::collections::HashMap;
@@ -216,6 +217,32 @@ pub(super) fn material_textures(
         specular,
         alpha,
     })
+}
+
+/// The opacity of material `name`: its texture's (a name in `ids`), its
+/// constant, or opaque.
+pub(super) fn material_opacity(
+    name: &str,
+    d: &MaterialDesc,
+    ids: &HashMap<String, u32>,
+) -> std::result::Result<Opacity, String> {
+    match (&d.opacity_texture, d.opacity) {
+        (Some(_), Some(_)) => Err(format!(
+            "material `{name}`: give `opacity` or `opacity_texture`, not both"
+        )),
+        (Some(t), None) => ids.get(t).map(|&i| Opacity::Texture(i)).ok_or_else(|| {
+            format!("material `{name}`: unknown texture `{t}` for `opacity_texture`")
+        }),
+        (None, Some(a)) if (0.0..=1.0).contains(&a) => Ok(if a == 1.0 {
+            Opacity::Opaque
+        } else {
+            Opacity::Constant(a)
+        }),
+        (None, Some(a)) => Err(format!(
+            "material `{name}`: `opacity` must be in [0, 1], got {a}"
+        )),
+        (None, None) => Ok(Opacity::Opaque),
+    }
 }
 
 pub(super) fn build_material(
@@ -521,5 +548,6 @@ pub(super) fn build_material(
         emission: colour("emission", d.emission, Rgb::ZERO, f32::MAX)?,
         two_sided_emission: d.two_sided.unwrap_or(false),
         textures: Default::default(),
+        opacity: Default::default(),
     })
 }

@@ -319,6 +319,10 @@ pub struct MaterialDesc {
     pub diffuse_reflectance_texture: Option<String>,
     pub specular_reflectance_texture: Option<String>,
     pub alpha_texture: Option<String>,
+    /// Mitsuba's `mask`: the fraction of the surface that is there, in
+    /// [0, 1], or a texture's luminance (any type; not on emitters).
+    pub opacity: Option<f32>,
+    pub opacity_texture: Option<String>,
     /// Emitted radiance (any type).
     pub emission: Option<[f32; 3]>,
     /// Emit from both sides (any type).

@@ -13,7 +13,7 @@
 use super::appearance::build_material;
 use super::description::{IorDesc, MaterialDesc, MaterialKind};
 use super::environment::{Environment, Radiance};
-use super::material::{Material, MaterialTextures};
+use super::material::{Material, MaterialTextures, Opacity};
 use super::mesh::{MeshData, Orientation};
 use super::{LoadOptions, SceneInput, in_range};
 use crate::accel::TriangleInput;
@@ -387,12 +387,27 @@ impl Importer<'_> {
         if m.normal_texture().is_some() {
             self.warn(format!("{label}: normal map ignored"));
         }
-        if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
-            self.warn(format!(
-                "{label}: alpha mode {:?} read as opaque",
-                m.alpha_mode()
-            ));
-        }
+        // Alpha as an opacity mask: MASK keeps what reaches the cutoff,
+        // BLEND keeps the fraction alpha of the hits (coverage, not a
+        // transparency with colour).
+        use gltf::material::AlphaMode;
+        let cutoff = match m.alpha_mode() {
+            AlphaMode::Opaque => None,
+            AlphaMode::Mask => Some(m.alpha_cutoff().unwrap_or(0.5)),
+            AlphaMode::Blend => Some(f32::NAN),
+        };
+        let opacity = match (cutoff, pbr.base_color_texture()) {
+            (None, _) => Opacity::Opaque,
+            (Some(c), Some(info)) => Opacity::Texture(self.alpha_texture(
+                &info.texture(),
+                base[3],
+                (!c.is_nan()).then_some(c),
+                &label,
+            )?),
+            (Some(c), None) if c.is_nan() && base[3] < 1.0 => Opacity::Constant(base[3].max(0.0)),
+            (Some(c), None) if base[3] < c => Opacity::Constant(0.0),
+            (Some(_), None) => Opacity::Opaque,
+        };
         if metallic > 0.0 && metallic < 1.0 && transmission == 0.0 {
             self.warn(format!(
                 "{label}: metallic {metallic} read as {}",
@@ -470,6 +485,7 @@ impl Importer<'_> {
         let mut material =
             build_material(&name, &d).map_err(|e| self.error(format!("{label}: {e}")))?;
         material.textures = textures;
+        material.opacity = opacity;
         let id = self.materials.len() as u32;
         self.materials.push(material);
         self.material_ids.insert(m.index(), id);
@@ -492,7 +508,34 @@ impl Importer<'_> {
             return Ok(id);
         }
         let image = t.source();
-        let bytes = match image.source() {
+        let bytes = self.image_bytes(&image)?;
+        let bitmap = Bitmap::decode(&bytes, raw)
+            .map_err(|m| self.error(format!("image {}: {m}", image.index())))?;
+        let id = self.push_texture(t, bitmap, label);
+        self.texture_ids.insert((t.index(), raw), id);
+        Ok(id)
+    }
+
+    /// The opacity of a material whose base colour has texture `t`: the
+    /// image's alpha channel times `factor`, cut at `cutoff` where the
+    /// alpha mode is MASK (one texture per material: the cut differs).
+    fn alpha_texture(
+        &mut self,
+        t: &gltf::Texture,
+        factor: f32,
+        cutoff: Option<f32>,
+        label: &str,
+    ) -> Result<u32> {
+        let image = t.source();
+        let bytes = self.image_bytes(&image)?;
+        let bitmap = Bitmap::decode_alpha(&bytes, factor, cutoff)
+            .map_err(|m| self.error(format!("image {}: {m}", image.index())))?;
+        Ok(self.push_texture(t, bitmap, label))
+    }
+
+    /// The encoded bytes of `image`, from a buffer view or a URI.
+    fn image_bytes(&self, image: &gltf::Image) -> Result<Vec<u8>> {
+        Ok(match image.source() {
             gltf::image::Source::View { view, .. } => {
                 let data = &self.buffers[view.buffer().index()];
                 let range = view.offset()..view.offset() + view.length();
@@ -508,9 +551,11 @@ impl Importer<'_> {
             gltf::image::Source::Uri { uri, .. } => {
                 read_uri(uri, self.dir).map_err(|m| self.error(m))?
             }
-        };
-        let bitmap = Bitmap::decode(&bytes, raw)
-            .map_err(|m| self.error(format!("image {}: {m}", image.index())))?;
+        })
+    }
+
+    /// Adds `bitmap` sampled as texture `t` asks; returns its id.
+    fn push_texture(&mut self, t: &gltf::Texture, bitmap: Bitmap, label: &str) -> u32 {
         let sampler = t.sampler();
         let wrap = |w: gltf::texture::WrappingMode| match w {
             gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
@@ -534,8 +579,7 @@ impl Importer<'_> {
             filter,
             to_uv: UvTransform::default(),
         });
-        self.texture_ids.insert((t.index(), raw), id);
-        Ok(id)
+        id
     }
 }
 

@@ -1,7 +1,9 @@
 //! Scene files: TOML in, a validated [`SceneInput`] out. Every error names the
 //! scene file and the line of the entry at fault (or the OBJ/MTL file and line).
 
-use super::appearance::{build_environment, build_material, build_texture, material_textures};
+use super::appearance::{
+    build_environment, build_material, build_texture, material_opacity, material_textures,
+};
 use super::description::*;
 use super::material::{Bsdf, Material};
 use super::obj::load_obj;
@@ -87,6 +89,8 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         let mut m = build_material(name, desc.get_ref()).map_err(|m| at(desc.span(), m))?;
         m.textures = material_textures(name, desc.get_ref(), &texture_ids)
             .map_err(|m| at(desc.span(), m))?;
+        m.opacity =
+            material_opacity(name, desc.get_ref(), &texture_ids).map_err(|m| at(desc.span(), m))?;
         by_name.insert(name.clone(), materials.len() as u32);
         materials.push(m);
     }
@@ -511,5 +515,6 @@ pub(super) fn default_material() -> Material {
         emission: Rgb::ZERO,
         two_sided_emission: false,
         textures: Default::default(),
+        opacity: Default::default(),
     }
 }

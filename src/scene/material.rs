@@ -1,5 +1,6 @@
 //! Materials: a BSDF (see [`crate::bsdf`]) plus optional emission.
 
+pub use crate::accel::mask::Opacity;
 use crate::bsdf::Microfacet;
 pub use crate::bsdf::{Bsdf, BsdfSample, Fresnel, fresnel_dielectric};
 use crate::math::Rgb;
@@ -17,6 +18,9 @@ pub struct Material {
     pub two_sided_emission: bool,
     /// Parameters read from textures at each hit.
     pub textures: MaterialTextures,
+    /// How much of the surface is there (Mitsuba's `mask`); queries pass
+    /// through the rest ([`crate::accel::mask`]).
+    pub opacity: Opacity,
 }
 
 /// Which of a material's parameters come from textures (indices into

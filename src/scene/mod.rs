@@ -17,6 +17,7 @@ pub mod obj;
 pub mod ply;
 pub mod serialized;
 
+use crate::accel::mask::Masks;
 use crate::accel::{AccelChoice, Geometry, NO_LIGHT, Sphere, SurfaceHit, TriangleInput};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
@@ -26,7 +27,7 @@ use crate::texture::Texture;
 use emitters::EmitterShape;
 use glam::Vec3A;
 use light::{Light, LightSampling, Lights, PlanarEmitter};
-use material::{Bsdf, Material};
+use material::{Bsdf, Material, Opacity};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -339,7 +340,7 @@ impl Scene {
 
     /// Drops degenerate primitives (with a warning that counts them), builds
     /// the BVHs and turns every emissive primitive into a light.
-    pub fn build(input: SceneInput) -> Result<Scene> {
+    pub fn build(mut input: SceneInput) -> Result<Scene> {
         let mut warnings = input.warnings;
         let hints = input.hints;
         let mut dropped = Dropped::default();
@@ -393,8 +394,25 @@ impl Scene {
 
         // Texture coordinates cost memory and a lookup per hit: kept only
         // when some material reads a texture.
-        let textured = input.materials.iter().any(|m| !m.textures.is_empty());
+        let textured = input
+            .materials
+            .iter()
+            .any(|m| !m.textures.is_empty() || matches!(m.opacity, Opacity::Texture(_)));
         let mut geometry = Geometry::build_full(&triangles, spheres, AccelChoice::Auto, textured);
+        // An emitter is sampled where it is, mask or not: it stays whole.
+        for m in input.materials.iter_mut() {
+            if m.opacity != Opacity::Opaque && m.is_emissive() {
+                warnings.push(format!(
+                    "material `{}`: an emitter's opacity mask is ignored (it stays opaque)",
+                    m.name
+                ));
+                m.opacity = Opacity::Opaque;
+            }
+        }
+        geometry.set_masks(Masks {
+            by_material: input.materials.iter().map(|m| m.opacity).collect(),
+            textures: input.textures.clone(),
+        });
         for (triangles, spheres, velocity) in moving {
             if !(triangles.is_empty() && spheres.is_empty()) {
                 geometry.add_moving(Geometry::build(&triangles, spheres), velocity);

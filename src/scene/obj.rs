@@ -335,6 +335,7 @@ fn convert_material(mtl_path: &Path, m: &tobj::Material) -> Result<Material> {
         emission,
         two_sided_emission: false,
         textures: Default::default(),
+        opacity: Default::default(),
     })
 }
 

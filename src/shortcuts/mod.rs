@@ -54,6 +54,8 @@ pub enum NotApplied {
     Spheres,
     /// Something moves while the shutter is open.
     Motion,
+    /// Opacity masks: a ray may pass the triangle a list names.
+    Masks,
     /// More triangles than a soup holds: the BVH already tests few.
     ManyTriangles(usize),
     /// A thin lens: camera rays leave from anywhere on the lens.
@@ -80,6 +82,7 @@ impl fmt::Display for NotApplied {
         match self {
             NotApplied::Spheres => write!(f, "the scene has spheres"),
             NotApplied::Motion => write!(f, "something moves"),
+            NotApplied::Masks => write!(f, "the scene has opacity masks"),
             NotApplied::ManyTriangles(n) => write!(
                 f,
                 "{n} triangles, more than {SOUP_MAX_TRIANGLES}: the BVH decides"
@@ -190,6 +193,8 @@ fn static_soup(geometry: &Geometry) -> Result<(), NotApplied> {
         Err(NotApplied::Spheres)
     } else if geometry.has_motion() {
         Err(NotApplied::Motion)
+    } else if geometry.has_masks() {
+        Err(NotApplied::Masks)
     } else if !geometry.is_static_soup() {
         Err(NotApplied::ManyTriangles(geometry.triangle_count()))
     } else {

@@ -9,15 +9,14 @@ use crate::error::Result;
 use crate::math::Rgb;
 use crate::scene::appearance::build_material;
 use crate::scene::description::{IorDesc, MaterialDesc, MaterialKind};
-use crate::scene::material::{Material, MaterialTextures};
+use crate::scene::material::{Material, MaterialTextures, Opacity};
 use crate::texture::{Bitmap, Filter, Texture, UvTransform, Wrap};
 use glam::Vec2;
 use std::sync::Arc;
 
 /// Plugins whose parameters are read but whose effect is not rendered:
 /// each is replaced by the BSDF it wraps, with a warning.
-const WRAPPERS: [(&str, &str); 4] = [
-    ("mask", "opacity mask ignored (the surface is opaque)"),
+const WRAPPERS: [(&str, &str); 3] = [
     ("bumpmap", "bump map ignored"),
     ("normalmap", "normal map ignored"),
     ("blendbsdf", "blend of two BSDFs: the first one is used"),
@@ -103,6 +102,25 @@ impl<'a> Importer<'a> {
             }
             p.unused(&mut self.warnings);
             return self.bsdf(front, true);
+        }
+        if kind == "mask" {
+            let nested = p.objects("bsdf")?;
+            let Some(&inner) = nested.first() else {
+                return Err(e.loc.error("mask needs a nested <bsdf>"));
+            };
+            let opacity = match p.colour("opacity", false)? {
+                // Mitsuba's default.
+                None => Opacity::Constant(0.5),
+                Some(Colour::Value(c)) => match crate::math::luminance(c) {
+                    a if a >= 1.0 => Opacity::Opaque,
+                    a => Opacity::Constant(a.max(0.0)),
+                },
+                Some(Colour::Texture(t)) => Opacity::Texture(self.texture(t)?),
+            };
+            p.unused(&mut self.warnings);
+            let mut m = self.bsdf(inner, two_sided)?;
+            m.opacity = opacity;
+            return Ok(m);
         }
         if let Some((_, what)) = WRAPPERS.iter().find(|(k, _)| *k == kind) {
             let nested = p.objects("bsdf")?;
@@ -248,13 +266,14 @@ impl<'a> Importer<'a> {
                 }
             }
             "null" => {
-                self.warn(
-                    &e.loc,
-                    "null BSDF rendered as a black surface (light does not pass through it)",
-                );
+                // Nothing there: every ray passes (an opacity of 0).
                 d.kind = MaterialKind::Diffuse;
                 d.twosided = None;
                 d.albedo = Some([0.0; 3]);
+                p.unused(&mut self.warnings);
+                let mut m = self.built(&name, d, textures, Some(e))?;
+                m.opacity = Opacity::Constant(0.0);
+                return Ok(m);
             }
             other => {
                 self.warn(

@@ -1,0 +1,100 @@
+//! Opacity masks (Mitsuba's `mask`, a null BSDF): a surface that keeps a
+//! fraction of the hits on it and lets the rest pass, for camera, light and
+//! shadow rays alike. The choice is stochastic, by a hash of the ray and
+//! the hit (pbrt-v4's alpha test), so it is the same every time a ray is
+//! asked the same question, and a segment's expected transmission is
+//! 1 − opacity without any estimator knowing about masks.
+//!
+//! Scenes without masks never reach this code: [`super::Geometry`] tests
+//! for a mask table once per query.
+
+use crate::math::{Ray, Rgb, luminance, offset_ray_origin};
+use crate::sampling::hash::hash_combine;
+use crate::texture::Texture;
+use glam::Vec3A;
+
+/// How much of a surface is there.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Opacity {
+    /// Every hit counts (every surface but a mask's).
+    #[default]
+    Opaque,
+    /// A fraction of hits in [0, 1] counts (0: Mitsuba's `null`).
+    Constant(f32),
+    /// The luminance of a texture (an index into the scene's textures),
+    /// clamped to [0, 1], as Mitsuba reads a float from a colour bitmap.
+    Texture(u32),
+}
+
+/// The opacity of every material and the textures they read, held by the
+/// geometry so that traversal can cut holes without the scene.
+#[derive(Clone, Debug)]
+pub struct Masks {
+    pub by_material: Vec<Opacity>,
+    pub textures: Vec<Texture>,
+}
+
+/// Hits passed through on one query at most: past it the ray stops at the
+/// next one (a stack of thousands of leaves is not a scene, and the loop
+/// must end).
+pub const MAX_PASSES: u32 = 256;
+
+impl Masks {
+    /// True when some material is not opaque.
+    pub fn any(by_material: &[Opacity]) -> bool {
+        by_material.iter().any(|o| *o != Opacity::Opaque)
+    }
+
+    /// True when the hit of `ray` at `point` on `material`, with texture
+    /// coordinates from `uv`, is kept.
+    #[inline]
+    pub fn keeps(
+        &self,
+        material: u32,
+        ray: &Ray,
+        point: Vec3A,
+        uv: impl FnOnce() -> glam::Vec2,
+    ) -> bool {
+        let opacity = match self.by_material.get(material as usize) {
+            None | Some(Opacity::Opaque) => return true,
+            Some(Opacity::Constant(a)) => *a,
+            Some(Opacity::Texture(t)) => opacity_of(self.textures[*t as usize].eval(uv())),
+        };
+        if opacity >= 1.0 {
+            return true;
+        }
+        if !(opacity > 0.0) {
+            return false;
+        }
+        hash_unit(ray.direction, point) < opacity
+    }
+}
+
+/// A texel's opacity: its luminance in [0, 1]; NaN is transparent.
+#[inline]
+fn opacity_of(c: Rgb) -> f32 {
+    let a = luminance(c);
+    if a.is_nan() { 0.0 } else { a.clamp(0.0, 1.0) }
+}
+
+/// A number in [0, 1) from a ray's direction and a point on it.
+#[inline]
+fn hash_unit(d: Vec3A, p: Vec3A) -> f32 {
+    let mut h = 0x6d61_736b_u64;
+    for v in [d.x, d.y, d.z, p.x, p.y, p.z] {
+        h = hash_combine(h, u64::from(v.to_bits()));
+    }
+    (h >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+}
+
+/// The ray going on past a hit at `point` (error bound `error`, normal
+/// `normal`) that a mask let through, with what is left of its extent.
+#[inline]
+pub fn continue_past(ray: &Ray, t: f32, point: Vec3A, error: Vec3A, normal: Vec3A) -> Ray {
+    let origin = offset_ray_origin(point, error, normal, ray.direction);
+    Ray {
+        origin,
+        t_max: ray.t_max - t,
+        ..*ray
+    }
+}

@@ -1,0 +1,179 @@
+//! Opacity masks (Mitsuba's `mask` and `null`, glTF's alpha modes): a
+//! masked surface lets through the fraction 1 − opacity of camera, shadow
+//! and light rays alike, so every technique sees the same holes.
+
+use crate::bidirectional::render;
+use crate::common::temp_dir;
+use crate::strategies::assert_agree;
+use tracelab::integrator::vcm::Vcm;
+use tracelab::integrator::{Bdpt, Integrator, LightTracer, MultiPassIntegrator, PathTracer};
+use tracelab::scene::Scene;
+use tracelab::scene::material::Opacity;
+
+fn load_xml(name: &str, xml: &str) -> Scene {
+    let dir = temp_dir(name);
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, xml).unwrap();
+    Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+const SENSOR: &str = r##"
+  <sensor type="perspective">
+    <float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0, -4, 2.5" target="0, 0, 0.4" up="0, 0, 1"/></transform>
+    <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="64"/>
+      <rfilter type="box"/></film>
+  </sensor>"##;
+
+/// A black card of opacity 0.3 filling the view before a white sky: each
+/// camera sample sees the sky with probability 0.7, so the image's mean is
+/// 0.7 within its binomial noise, sqrt(0.21 / samples).
+#[test]
+fn a_mask_lets_through_one_minus_its_opacity() {
+    let xml = format!(
+        r##"<scene version="3.0.0">
+  {SENSOR}
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <shape type="rectangle">
+    <transform name="to_world"><scale value="100"/><rotate x="1" angle="90"/><translate y="-2"/></transform>
+    <bsdf type="mask"><float name="opacity" value="0.3"/>
+      <bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf></bsdf>
+  </shape>
+</scene>"##
+    );
+    let scene = load_xml("mask-card", &xml);
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert!(scene.geometry.has_masks());
+    let spp = 16;
+    let film = render(scene, Integrator::from(PathTracer::default()), spp, 3);
+    let samples = f64::from(64 * 64 * spp);
+    let se = (0.21 / samples).sqrt();
+    for (c, mean) in film.image.mean().into_iter().enumerate() {
+        assert!(
+            (mean - 0.7).abs() < 4.0 * se,
+            "channel {c}: {mean} against 0.7 (se {se:.2e})"
+        );
+    }
+}
+
+/// A card with checkerboard holes (opacity 1 and 0.25) between a lamp and
+/// a floor, seen with its shadow: path tracing, light tracing, BDPT and VCM
+/// agree (block z-test of `strategies.rs`), so camera, shadow and light
+/// rays all pass the same holes; `null` surfaces let everything through.
+#[test]
+fn every_technique_sees_the_same_holes() {
+    let xml = format!(
+        r##"<scene version="3.0.0">
+  {SENSOR}
+  <texture type="checkerboard" id="holes">
+    <rgb name="color0" value="1"/><rgb name="color1" value="0.25"/>
+    <transform name="to_uv"><scale x="4" y="4"/></transform>
+  </texture>
+  <shape type="rectangle">
+    <transform name="to_world"><scale value="3"/></transform>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf>
+  </shape>
+  <shape type="rectangle">
+    <transform name="to_world"><scale x="0.8" y="0.8"/><rotate x="1" angle="20"/><translate z="0.9"/></transform>
+    <bsdf type="twosided"><bsdf type="mask"><ref name="opacity" id="holes"/>
+      <bsdf type="roughplastic"><float name="alpha" value="0.3"/>
+        <rgb name="diffuse_reflectance" value="0.2, 0.5, 0.3"/></bsdf></bsdf></bsdf>
+  </shape>
+  <shape type="sphere"><point name="center" x="0" y="0" z="1.5"/><float name="radius" value="2"/>
+    <bsdf type="null"/></shape>
+  <shape type="rectangle">
+    <transform name="to_world"><scale value="0.4"/><rotate x="1" angle="180"/><translate x="0.3" z="2.5"/></transform>
+    <emitter type="area"><rgb name="radiance" value="12"/></emitter>
+  </shape>
+</scene>"##
+    );
+    let scene = load_xml("mask-holes", &xml);
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let path = render(
+        scene.clone(),
+        Integrator::from(PathTracer::default()),
+        256,
+        41,
+    );
+    // The holes matter: the card's shadow is lighter than an opaque card's.
+    let opaque = load_xml(
+        "mask-opaque",
+        &xml.replace(r#"value="0.25""#, r#"value="1""#),
+    );
+    let solid = render(opaque, Integrator::from(PathTracer::default()), 256, 42);
+    let worst = crate::strategies::largest_block_z(&solid, &path);
+    assert!(worst > 4.5, "holes or not, the same image (z {worst:.2})");
+    let light = render(
+        scene.clone(),
+        Integrator::from(LightTracer::default()),
+        256,
+        43,
+    );
+    assert_agree("masks, light / path", &light, &path);
+    let bdpt = render(scene.clone(), Integrator::from(Bdpt::default()), 256, 44);
+    assert_agree("masks, bdpt / path", &bdpt, &path);
+    let vcm = Integrator::MultiPass(MultiPassIntegrator::Vcm(Vcm {
+        radius: 0.002,
+        ..Vcm::default()
+    }));
+    assert_agree("masks, vcm / path", &render(scene, vcm, 256, 45), &path);
+}
+
+/// What each file format says about opacity lands in the material.
+#[test]
+fn masks_import_from_mitsuba_and_gltf() {
+    let xml = format!(
+        r##"<scene version="3.0.0">
+  {SENSOR}
+  <bsdf type="mask" id="half"><bsdf type="diffuse"/></bsdf>
+  <bsdf type="null" id="nothing"/>
+  <bsdf type="mask" id="whole"><float name="opacity" value="1"/><bsdf type="diffuse"/></bsdf>
+  <shape type="cube"><ref id="half"/></shape>
+  <shape type="sphere"><ref id="nothing"/></shape>
+  <shape type="disk"><ref id="whole"/></shape>
+  <emitter type="constant"/>
+</scene>"##
+    );
+    let scene = load_xml("mask-import", &xml);
+    let opacity = |name: &str| {
+        scene
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap_or_else(|| panic!("no material {name}"))
+            .opacity
+    };
+    // Mitsuba's default opacity is 0.5; null is nothing at all.
+    assert_eq!(opacity("half"), Opacity::Constant(0.5));
+    assert_eq!(opacity("nothing"), Opacity::Constant(0.0));
+    assert_eq!(opacity("whole"), Opacity::Opaque);
+    // glTF: BLEND keeps alpha of the hits; MASK cuts at alphaCutoff.
+    let dir = temp_dir("gltf-alpha");
+    std::fs::write(dir.join("quad.bin"), crate::import::gltf_buffer()).unwrap();
+    let json = crate::import::gltf_json(Some("quad.bin"));
+    let (name, floor) = (
+        r#""name": "floor","#,
+        r#""baseColorFactor": [0.8, 0.2, 0.2, 1]"#,
+    );
+    assert!(json.contains(name) && json.contains(floor));
+    for (mode, expected) in [
+        (r#""alphaMode": "BLEND""#, Opacity::Constant(0.3)),
+        (r#""alphaMode": "MASK""#, Opacity::Constant(0.0)),
+        (
+            r#""alphaMode": "MASK", "alphaCutoff": 0.25"#,
+            Opacity::Opaque,
+        ),
+    ] {
+        let text = json
+            .replace(floor, r#""baseColorFactor": [0.8, 0.2, 0.2, 0.3]"#)
+            .replace(name, &format!("{name} {mode},"));
+        std::fs::write(dir.join("scene.gltf"), text).unwrap();
+        let scene = Scene::load(&dir.join("scene.gltf")).unwrap_or_else(|e| panic!("{e}"));
+        let m = scene.materials.iter().find(|m| m.name == "floor").unwrap();
+        let got = match m.opacity {
+            Opacity::Constant(a) => Opacity::Constant((a * 1e4).round() / 1e4),
+            o => o,
+        };
+        assert_eq!(got, expected, "{mode}");
+    }
+}
