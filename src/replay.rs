@@ -5,10 +5,11 @@
 
 use crate::accel::SurfaceHit;
 use crate::error::{Error, Result};
+use crate::integrator::camera_ray;
 use crate::integrator::path::PathObserver;
 use crate::integrator::{CameraIntegrator, Integrator, RayCounts};
 use crate::math::Rgb;
-use crate::render::{RenderSettings, camera_ray};
+use crate::render::RenderSettings;
 use crate::sampling::Sampler;
 use crate::scene::Scene;
 use crate::scene::light::LightSample;

@@ -91,6 +91,26 @@ fn importance_variances_and_the_biased_density() {
     assert!(z.abs() > 10.0, "{z}");
 }
 
+/// Cow against cow (issue 39): oriented clusters within 1% of the sum over
+/// all pairs at the default ε with a fraction of the links (the report's
+/// checks), and closer as ε falls to 1e-5.
+#[test]
+fn cluster_form_factors_approach_the_sum_over_all_pairs() {
+    let mut settings = Experiment::Clusters.default_settings();
+    settings.n = 1024;
+    let report = run_with(settings);
+    assert_eq!(report.checks.len(), 3);
+    let rows = &report.tables[0].rows;
+    let error = |kind: &str, eps: &str| {
+        rows.iter()
+            .find(|r| r[0].text == kind && r[1].text == eps)
+            .and_then(|r| r[5].value)
+            .unwrap()
+    };
+    assert!(error("oriented", "1.000e-5") < error("oriented", "1.000e-1"));
+    assert!(error("oriented", "1.000e-5") < 0.002);
+}
+
 #[test]
 fn warps_pass_and_the_wrong_pdf_fails() {
     let report = run(Experiment::Warps);

@@ -38,8 +38,8 @@ enum Command {
     /// their references; exits non-zero when a case fails.
     Stress(stress::StressArgs),
     /// The Monte Carlo lab: pi by darts, coin flips, stratified sampling,
-    /// importance sampling, point sets and warps; prints a table and checks,
-    /// writes CSV and plots.
+    /// importance sampling, point sets, warps, and radiosity's cluster form
+    /// factors; prints a table and checks, writes CSV and plots.
     Lab(lab::LabArgs),
     /// Radiosity step by step against a reference: elements, links, rays,
     /// seconds, residual and RMSE per row; CSV and a plot.

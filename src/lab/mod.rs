@@ -9,6 +9,7 @@
 //! writes it (`tracelab lab`), the viewer draws it live (its "MC lab" tab)
 //! from the partial reports an experiment publishes as its N grows.
 
+pub mod clusters;
 pub mod coins;
 pub mod importance;
 pub mod pi;
@@ -43,16 +44,19 @@ pub enum Experiment {
     PointSets,
     /// Every warp of the renderer against its pdf (χ²).
     Warps,
+    /// The form factor between two meshes by cluster links (radiosity).
+    Clusters,
 }
 
 impl Experiment {
-    pub const ALL: [Experiment; 6] = [
+    pub const ALL: [Experiment; 7] = [
         Experiment::Pi,
         Experiment::Coins,
         Experiment::Stratified,
         Experiment::Importance,
         Experiment::PointSets,
         Experiment::Warps,
+        Experiment::Clusters,
     ];
 
     /// Name on the command line.
@@ -64,6 +68,7 @@ impl Experiment {
             Experiment::Importance => "importance",
             Experiment::PointSets => "point-sets",
             Experiment::Warps => "warps",
+            Experiment::Clusters => "clusters",
         }
     }
 
@@ -76,6 +81,7 @@ impl Experiment {
             Experiment::Importance => "Importance sampling",
             Experiment::PointSets => "Point sets",
             Experiment::Warps => "Warps and their pdfs",
+            Experiment::Clusters => "Clusters: the form factor of two meshes",
         }
     }
 
@@ -88,6 +94,7 @@ impl Experiment {
             Experiment::Importance => importance::TEXT,
             Experiment::PointSets => point_sets::TEXT,
             Experiment::Warps => warps::TEXT,
+            Experiment::Clusters => clusters::TEXT,
         }
     }
 
@@ -105,6 +112,7 @@ impl Experiment {
             Experiment::Importance => (1_000_000, 1),
             Experiment::PointSets => (4096, 256),
             Experiment::Warps => (1_000_000, 1),
+            Experiment::Clusters => (4096, 1),
         };
         LabSettings {
             experiment: self,
@@ -128,6 +136,12 @@ impl Experiment {
                 settings.n
             ));
         }
+        if self == Experiment::Clusters && settings.n > MAX_CLUSTER_TRIANGLES {
+            return Err(format!(
+                "clusters sums every pair of triangles for its reference, O(N^2): N is at most {MAX_CLUSTER_TRIANGLES}, got {}",
+                settings.n
+            ));
+        }
         Ok(())
     }
 
@@ -140,6 +154,7 @@ impl Experiment {
             Experiment::Importance => importance::run(settings, progress),
             Experiment::PointSets => point_sets::run(settings, progress),
             Experiment::Warps => warps::run(settings, progress),
+            Experiment::Clusters => clusters::run(settings, progress),
         }?;
         progress.publish(&report);
         Ok(report)
@@ -162,6 +177,9 @@ pub struct LabSettings {
     /// curves grow (the viewer); zero on the command line.
     pub pace: std::time::Duration,
 }
+
+/// The largest mesh `clusters` accepts (its reference is O(N²)).
+pub const MAX_CLUSTER_TRIANGLES: u32 = 16_384;
 
 /// The largest point set `point-sets` accepts.
 pub const MAX_POINT_SET: u32 = 1 << 16;

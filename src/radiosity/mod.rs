@@ -2,6 +2,7 @@
 //! form factors between elements, and the solvers of the linear system.
 //! The technique that renders with them is `crate::integrator::radiosity`.
 
+pub mod cluster;
 pub mod form_factor;
 pub mod hierarchy;
 pub mod mesh;

@@ -13,19 +13,17 @@
 //! the thread count or tile schedule.
 
 use crate::error::{Error, Result};
+use crate::film::splats::{PendingSplats, SplatBuffer};
 use crate::film::{Film, FilmSnapshot, Tile, classify, non_finite_of, note_flagged};
-use crate::filter::PixelFilter;
 use crate::integrator::{
-    ErrorEstimate, Integrator, RayCounts, SolverProgress, SplattingIntegrator, sample_time,
+    ErrorEstimate, Integrator, RayCounts, SolverProgress, SplattingIntegrator, camera_ray,
 };
 use crate::math::{Ray, Rgb};
 use crate::sampling::hash::hash_combine;
-use crate::sampling::{Domain, Domains, Sampler, SamplerKind};
+use crate::sampling::{Domains, Sampler, SamplerKind};
 use crate::scene::Scene;
 use crate::shortcuts::PrimaryPixel;
-use glam::Vec2;
 use rayon::prelude::*;
-use splats::{PendingSplats, SplatBuffer};
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -598,40 +596,6 @@ fn lock<T: ?Sized>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// The camera ray of the sample the sampler was started at, for pixel
-/// (`x`, `y`): film position, lens point and time in this order, so that a
-/// replay draws the same numbers. `deterministic` estimators shoot through
-/// the pixel and lens centres at mid-exposure.
-#[inline(always)]
-pub fn camera_ray(
-    scene: &Scene,
-    sampler: &mut Sampler,
-    x: u32,
-    y: u32,
-    deterministic: bool,
-    general: bool,
-) -> Ray {
-    let u_pixel = sampler.next_2d_for(Domain::Pixel);
-    // Filter importance sampling; the box keeps its exact arithmetic.
-    let mut film_point = match scene.camera.filter {
-        PixelFilter::Box => Vec2::new(x as f32, y as f32) + u_pixel,
-        filter => Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + filter.sample(u_pixel),
-    };
-    let lens_dim = sampler.skip();
-    let mut lens = if scene.camera.aperture_radius > 0.0 {
-        sampler.get_2d_for(lens_dim, Domain::Lens)
-    } else {
-        Vec2::splat(0.5)
-    };
-    let mut time = sample_time(scene, sampler, general);
-    if deterministic {
-        film_point = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-        lens = Vec2::splat(0.5);
-        time = scene.camera.time(0.5);
-    }
-    scene.camera.generate_ray(film_point, lens).at_time(time)
-}
-
 /// Scales `value` down so that its largest component is at most `limit`;
 /// returns true when it did.
 #[inline]
@@ -655,7 +619,6 @@ pub fn thread_pool(threads: usize) -> Result<Arc<rayon::ThreadPool>> {
         .map_err(|e| Error::new(format!("cannot start render threads: {e}")))
 }
 
-pub(crate) mod splats;
 mod technique_passes;
 
 #[cfg(test)]

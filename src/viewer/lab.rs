@@ -230,6 +230,7 @@ pub fn lab_panel(ui: &mut egui::Ui, lab: &mut LabState) {
             let max_n = match current {
                 Experiment::Coins => 1 << 14,
                 Experiment::PointSets => crate::lab::MAX_POINT_SET,
+                Experiment::Clusters => crate::lab::MAX_CLUSTER_TRIANGLES,
                 _ => 10_000_000,
             };
             ui.label("Largest N");
@@ -239,7 +240,10 @@ pub fn lab_panel(ui: &mut egui::Ui, lab: &mut LabState) {
                     .speed(100.0),
             );
             ui.end_row();
-            if !matches!(current, Experiment::Importance | Experiment::Warps) {
+            if !matches!(
+                current,
+                Experiment::Importance | Experiment::Warps | Experiment::Clusters
+            ) {
                 ui.label("Runs");
                 ui.add(
                     egui::DragValue::new(&mut lab.settings.runs)

@@ -180,7 +180,7 @@ impl Bdpt {
         mut contribute: impl FnMut(Contribution),
     ) {
         let camera = &scene.camera;
-        let ray = crate::render::camera_ray(scene, sampler, x, y, false, false);
+        let ray = super::camera_ray(scene, sampler, x, y, false, false);
         let time = ray.time;
         counts.camera += 1;
         let film = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);

@@ -7,9 +7,9 @@
 use super::super::light::{photon_shading_factor, sees_lens, shading_correction};
 use super::{Iteration, LightVertex, Vcm, Walk};
 use crate::camera::CameraConnection;
+use crate::film::splats::PendingSplats;
 use crate::integrator::RayCounts;
 use crate::math::{Frame, Rgb, ray_between};
-use crate::render::splats::PendingSplats;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::scene::light::EmissionSample;

@@ -6,6 +6,8 @@
 //! at most for one tile. The reconstruction filter is a box of one pixel:
 //! a pixel is the plain mean of the samples taken inside it (Mitsuba's `box`).
 
+pub mod splats;
+
 use crate::allocation::PixelNoise;
 use crate::image::Image;
 use crate::math::Rgb;
