@@ -8,6 +8,7 @@
 //! are contiguous in memory and a hit's index addresses them directly.
 
 mod block;
+mod build;
 mod known_visibility;
 pub mod mask;
 mod soup;
@@ -18,13 +19,8 @@ mod wide_bvh;
 use crate::math::{OffsetMode, Ray, gamma};
 use glam::{Vec2, Vec3A};
 use mask::Masks;
-use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
-use obvhs::bvh2::Bvh2;
-use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
-use obvhs::ploc::PlocBuilder;
 use soup::TriangleSoup;
 use sphere::intersect_sphere;
 use std::sync::Arc;
@@ -228,164 +224,7 @@ fn bvh_ray(ray: &Ray, t_max: f32) -> obvhs::ray::Ray {
     obvhs::ray::Ray::new(ray.origin, ray.direction + Vec3A::ZERO, 0.0, t_max)
 }
 
-fn build_params() -> BvhBuildParams {
-    BvhBuildParams::medium_build()
-}
-
-/// obvhs traverses a CWBVH with a stack of this many entries; a deeper tree
-/// would silently lose nodes (its push saturates).
-const CWBVH_STACK_DEPTH: u32 = 32;
-
-/// Levels of the CWBVH below `node` (1 for a node with only leaves).
-fn cwbvh_depth(bvh: &CwBvh, node: usize) -> u32 {
-    let n = &bvh.nodes[node];
-    let deepest_child = (0..8)
-        .filter(|&c| !n.is_child_empty(c) && !n.is_leaf(c))
-        .map(|c| cwbvh_depth(bvh, n.child_node_index(c) as usize))
-        .max()
-        .unwrap_or(0);
-    1 + deepest_child
-}
-
-/// obvhs's binary BVH over `aabbs`: PLOC, then reinsertion.
-fn build_bvh2(aabbs: &[Aabb]) -> Bvh2 {
-    let params = build_params();
-    let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
-        params.ploc_search_distance,
-        aabbs,
-        (0..aabbs.len() as u32).collect::<Vec<_>>(),
-        params.sort_precision,
-        params.search_depth_threshold,
-    );
-    ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-    bvh2
-}
-
-/// The triangles' 8-wide BVH and the order to store them in, or None when
-/// the tree would be deeper than its traversal stack (many nearly coincident
-/// triangles, found by fuzzing, make PLOC produce chains).
-fn build_wide_bvh(triangles: &[[Vec3A; 3]]) -> Option<(WideBvh, Vec<usize>)> {
-    let aabbs: Vec<Aabb> = triangles.iter().map(|t| Aabb::from_points(t)).collect();
-    WideBvh::from_bvh2(&build_bvh2(&aabbs), triangles)
-}
-
-/// A CWBVH over `aabbs` (spheres), or None when it would be too deep to
-/// traverse. The steps of obvhs's `build_cwbvh`, without its debug-build
-/// validation, which panics on such a tree where this returns None.
-fn build_shallow_cwbvh(aabbs: &[Aabb]) -> Option<CwBvh> {
-    let params = build_params();
-    let bvh2 = build_bvh2(aabbs);
-    let bvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
-    (bvh.nodes.is_empty() || cwbvh_depth(&bvh, 0) < CWBVH_STACK_DEPTH).then_some(bvh)
-}
-
 impl Geometry {
-    /// Builds the BVHs and stores the triangles in leaf order.
-    pub fn build(triangles: &[TriangleInput], spheres: Vec<Sphere>) -> Self {
-        Self::build_with(triangles, spheres, AccelChoice::Auto)
-    }
-
-    /// Builds with a chosen triangle index (for tests and benchmarks).
-    pub fn build_with(
-        triangles: &[TriangleInput],
-        spheres: Vec<Sphere>,
-        choice: AccelChoice,
-    ) -> Self {
-        Self::build_full(triangles, spheres, choice, false)
-    }
-
-    /// Builds, keeping texture coordinates for hits when `keep_uvs` (a
-    /// material reads a texture): only then do they cost memory and time.
-    pub fn build_full(
-        triangles: &[TriangleInput],
-        spheres: Vec<Sphere>,
-        choice: AccelChoice,
-        keep_uvs: bool,
-    ) -> Self {
-        let mut geometry = Geometry {
-            keep_uvs,
-            keep_normals: triangles.iter().any(|t| t.normals.is_some()),
-            ..Geometry::default()
-        };
-        let use_soup = match choice {
-            AccelChoice::Auto => triangles.len() <= SOUP_MAX_TRIANGLES,
-            AccelChoice::Bvh => false,
-            AccelChoice::Soup => true,
-        };
-        if !triangles.is_empty() && use_soup {
-            geometry.store_soup(triangles);
-        } else if !triangles.is_empty() {
-            let vertices: Vec<[Vec3A; 3]> = triangles.iter().map(|t| t.vertices).collect();
-            match build_wide_bvh(&vertices) {
-                Some((bvh, order)) => {
-                    geometry.store_in_order(triangles, order);
-                    geometry.tri_index = TriangleIndex::Bvh(bvh);
-                }
-                None => {
-                    // Correct at any depth, if slow: better than missed hits.
-                    geometry.store_soup(triangles);
-                    geometry.bvh_too_deep = true;
-                }
-            }
-        }
-        if spheres.len() <= SPHERE_LIST_MAX {
-            geometry.spheres = spheres;
-        } else {
-            let aabbs: Vec<Aabb> = spheres
-                .iter()
-                .map(|s| {
-                    Aabb::new(
-                        s.center - Vec3A::splat(s.radius),
-                        s.center + Vec3A::splat(s.radius),
-                    )
-                })
-                .collect();
-            match build_shallow_cwbvh(&aabbs) {
-                Some(bvh) => {
-                    geometry.spheres = bvh
-                        .primitive_indices
-                        .iter()
-                        .map(|&i| spheres[i as usize])
-                        .collect();
-                    geometry.sphere_bvh = Some(bvh);
-                }
-                None => {
-                    geometry.spheres = spheres;
-                    geometry.bvh_too_deep = true;
-                }
-            }
-        }
-        geometry
-    }
-
-    /// Stores `triangles[i]` for each i of `order`: the order hit indices refer to.
-    fn store_in_order(
-        &mut self,
-        triangles: &[TriangleInput],
-        order: impl IntoIterator<Item = usize>,
-    ) {
-        for i in order {
-            self.tri_vertices.push(triangles[i].vertices);
-            self.tri_shading.push(TriangleShading::new(&triangles[i]));
-            if self.keep_uvs {
-                let barycentric = [Vec2::ZERO, Vec2::X, Vec2::Y];
-                self.tri_uvs.push(triangles[i].uvs.unwrap_or(barycentric));
-            }
-            if self.keep_normals {
-                let flat = [TriangleShading::new(&triangles[i]).normal; 3];
-                self.tri_normals.push(triangles[i].normals.unwrap_or(flat));
-            }
-        }
-    }
-
-    /// Stores the triangles for a soup (those in a face of their bounding
-    /// box last) and tests them all.
-    fn store_soup(&mut self, triangles: &[TriangleInput]) {
-        let vertices: Vec<[Vec3A; 3]> = triangles.iter().map(|t| t.vertices).collect();
-        self.store_in_order(triangles, TriangleSoup::order(&vertices));
-        self.tri_index = TriangleIndex::Soup(TriangleSoup::new(&self.tri_vertices));
-    }
-
     /// Adds an object that moves by `velocity` per unit of time; `geometry`
     /// is its position at time 0. Lights never move (their sampling assumes
     /// fixed positions), so `geometry` must hold no light.

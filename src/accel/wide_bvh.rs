@@ -356,7 +356,7 @@ fn subtree_counts(bvh2: &Bvh2) -> Vec<u32> {
 mod tests {
     use super::*;
     use crate::accel::triangle::ShearedRay;
-    use crate::accel::{build_bvh2, build_wide_bvh};
+    use crate::accel::build::{build_bvh2, build_wide_bvh};
     use crate::sampling::hash::{hash_combine, to_unit_float};
     use obvhs::aabb::Aabb;
 
