@@ -355,8 +355,8 @@ fn subtree_counts(bvh2: &Bvh2) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::triangle::ShearedRay;
     use crate::accel::build::{build_bvh2, build_wide_bvh};
+    use crate::accel::triangle::ShearedRay;
     use crate::sampling::hash::{hash_combine, to_unit_float};
     use obvhs::aabb::Aabb;
 
