@@ -15,6 +15,8 @@ mod import;
 mod furnace;
 // Chi-square goodness of fit of every sampling routine against its pdf.
 mod chi2;
+// The same for the rough models, the thin dielectric and the environment map.
+mod chi2_rough;
 // The Monte Carlo lab's experiments meet their closed-form statements.
 mod lab;
 // Form factors between squares and discs against closed forms; reciprocity.
