@@ -29,6 +29,7 @@ fn furnace_material() -> Material {
         two_sided_emission: true,
         textures: Default::default(),
         opacity: Default::default(),
+        normal_map: None,
     }
 }
 

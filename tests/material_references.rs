@@ -306,3 +306,44 @@ fn spot_and_directional_lights_match_mitsuba() {
     let ratio = check_scene("light_directional", &sun);
     assert!(ratio <= 1.10, "light_directional: RMSE ratio {ratio:.3}");
 }
+
+/// A tangent-space normal map (tests/data/materials/bumps.exr, 4 x 4 bumps
+/// in the sphere's (φ / 2π, θ / π) coordinates) on a rough copper sphere,
+/// as Mitsuba's `normalmap`: the frame of dp/du and the map's convention.
+#[test]
+fn normal_map_matches_mitsuba() {
+    let bumps = crate::common::repo_path("tests/data/materials/bumps.exr");
+    let text = material_scene(
+        "type = \"roughconductor\"\nconductor = \"Cu\"\ndistribution = \"ggx\"\nalpha = 0.2\nnormal_map_texture = \"bumps\"",
+        SPHERE,
+    ) + &format!(
+        "\n[textures.bumps]\ntype = \"bitmap\"\nfile = {:?}\nraw = true\n",
+        bumps.display().to_string()
+    );
+    let ratio = check_scene("normalmap", &text);
+    assert!(ratio <= 1.10, "normalmap: RMSE ratio {ratio:.3}");
+    // Without the map the sphere is smooth and far from Mitsuba's render
+    // (measured: RMSE 0.033 against 0.0037).
+    let rmse_of = |text: &str, name: &str| {
+        let (snapshot, _) = render(
+            load_scene_text(name, text),
+            Integrator::from(PathTracer::default()),
+            SamplerKind::Independent,
+            256,
+            1,
+        );
+        snapshot
+            .image
+            .compare(&reference("materials/normalmap.exr"))
+            .unwrap()
+            .rmse
+    };
+    let plain = text.replace("normal_map_texture = \"bumps\"\n", "");
+    assert_ne!(plain, text);
+    let (mapped, smooth) = (rmse_of(&text, "mapped"), rmse_of(&plain, "smooth"));
+    eprintln!("normal map: RMSE {mapped:.4} mapped, {smooth:.4} smooth");
+    assert!(
+        smooth > 2.0 * mapped,
+        "the map changes little: {smooth} vs {mapped}"
+    );
+}

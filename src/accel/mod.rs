@@ -383,6 +383,27 @@ impl Geometry {
         hit.barycentric
     }
 
+    /// The direction of dp/du at `hit` (not normalised), where the surface
+    /// has texture coordinates that vary over it: a triangle's kept uvs, or
+    /// a sphere's (φ / 2π, θ / π). `None` where uv is degenerate.
+    #[inline]
+    pub fn uv_tangent(&self, hit: &SurfaceHit) -> Option<Vec3A> {
+        let i = hit.primitive as usize;
+        if let Some([t0, t1, t2]) = self.tri_uvs.get(i) {
+            let [p0, p1, p2] = self.tri_vertices[i];
+            let (d1, d2) = (*t1 - *t0, *t2 - *t0);
+            let det = d1.x * d2.y - d1.y * d2.x;
+            let dpdu = (d2.y * (p1 - p0) - d1.y * (p2 - p0)) / det;
+            return (det.abs() > 1e-20 && dpdu.is_finite() && dpdu != Vec3A::ZERO).then_some(dpdu);
+        }
+        if hit.primitive & MOVING_PRIMITIVE == 0 && i >= self.tri_vertices.len() {
+            // dp/dφ on a sphere is along (−n_y, n_x, 0).
+            let t = Vec3A::new(-hit.normal.y, hit.normal.x, 0.0);
+            return (t.length_squared() > 1e-12).then_some(t);
+        }
+        None
+    }
+
     /// True when some triangle shades with interpolated vertex normals.
     pub fn has_shading_normals(&self) -> bool {
         !self.tri_normals.is_empty() || self.moving.iter().any(|m| m.geometry.has_shading_normals())

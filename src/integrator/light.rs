@@ -132,7 +132,7 @@ impl SplattingEstimator for LightTracer {
             if bsdf.is_black() {
                 break;
             }
-            let frame = Frame::from_normal(scene.geometry.shading_normal(&hit));
+            let frame = Frame::from_normal(scene.shading_normal(&hit));
             let ng = frame.to_local(hit.normal);
             // Direction back towards where the particle came from.
             let w_prev = frame.to_local(-ray.direction);

@@ -159,7 +159,7 @@ impl McRayTracer {
         if level >= self.max_depth || bsdf.is_black() {
             return Rgb::ZERO;
         }
-        let frame = Frame::from_normal(scene.geometry.shading_normal(&hit));
+        let frame = Frame::from_normal(scene.shading_normal(&hit));
         let wo = frame.to_local(wo_world);
         let n_light = if bsdf.is_specular() {
             0

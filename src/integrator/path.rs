@@ -325,12 +325,7 @@ impl PathTracer {
                 break;
             }
 
-            // The vertex normals' lookup only where a mesh has them.
-            let frame = Frame::from_normal(if scene.features.shading_normals {
-                scene.geometry.shading_normal(&hit)
-            } else {
-                hit.normal
-            });
+            let frame = Frame::from_normal(scene.shading_normal(&hit));
             let wo = frame.to_local(wo_world);
             // The lobe and roulette numbers are computed only when used.
             let u_lobe = if matches!(bsdf, Bsdf::Diffuse { .. }) {

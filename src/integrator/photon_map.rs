@@ -326,7 +326,7 @@ fn trace_photon(
         if bsdf.is_black() {
             break;
         }
-        let frame = Frame::from_normal(scene.geometry.shading_normal(&hit));
+        let frame = Frame::from_normal(scene.shading_normal(&hit));
         let ng = frame.to_local(hit.normal);
         let wo = frame.to_local(-ray.direction);
         let u_lobe = sampler.next_1d_for(Domain::Bsdf);
@@ -416,7 +416,7 @@ pub fn camera_to_diffuse(
         if bsdf.is_black() {
             break;
         }
-        let frame = Frame::from_normal(scene.geometry.shading_normal(&hit));
+        let frame = Frame::from_normal(scene.shading_normal(&hit));
         let wo = frame.to_local(wo_world);
         let u_lobe = sampler.next_1d_for(Domain::Bsdf);
         let u_bsdf = sampler.next_2d_for(Domain::Bsdf);

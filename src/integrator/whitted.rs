@@ -122,7 +122,7 @@ impl WhittedTracer {
         } else {
             Rgb::ZERO
         };
-        let frame = Frame::from_normal(scene.geometry.shading_normal(&hit));
+        let frame = Frame::from_normal(scene.shading_normal(&hit));
         let wo = frame.to_local(wo_world);
         // Diffuse lobes: direct light from each light as a point, plus the
         // ambient term; ideal lobes (a rough one read as its smooth limit)

@@ -549,5 +549,6 @@ pub(super) fn build_material(
         two_sided_emission: d.two_sided.unwrap_or(false),
         textures: Default::default(),
         opacity: Default::default(),
+        normal_map: None,
     })
 }

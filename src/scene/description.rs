@@ -323,6 +323,8 @@ pub struct MaterialDesc {
     /// [0, 1], or a texture's luminance (any type; not on emitters).
     pub opacity: Option<f32>,
     pub opacity_texture: Option<String>,
+    /// A tangent-space normal map (a texture name; declare it `raw`).
+    pub normal_map_texture: Option<String>,
     /// Emitted radiance (any type).
     pub emission: Option<[f32; 3]>,
     /// Emit from both sides (any type).

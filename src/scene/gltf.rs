@@ -13,7 +13,7 @@
 use super::appearance::build_material;
 use super::description::{IorDesc, MaterialDesc, MaterialKind};
 use super::environment::{Environment, Radiance};
-use super::material::{Material, MaterialTextures, Opacity};
+use super::material::{Material, MaterialTextures, NormalMap, Opacity};
 use super::mesh::{MeshData, Orientation};
 use super::{LoadOptions, SceneInput, in_range};
 use crate::accel::TriangleInput;
@@ -384,9 +384,13 @@ impl Importer<'_> {
                 "{label}: metallic-roughness texture ignored (its factors are used)"
             ));
         }
-        if m.normal_texture().is_some() {
-            self.warn(format!("{label}: normal map ignored"));
-        }
+        let normal_map = match m.normal_texture() {
+            Some(info) => Some(NormalMap {
+                texture: self.texture(&info.texture(), info.tex_coord(), true, &label)?,
+                scale: info.scale(),
+            }),
+            None => None,
+        };
         // Alpha as an opacity mask: MASK keeps what reaches the cutoff,
         // BLEND keeps the fraction alpha of the hits (coverage, not a
         // transparency with colour).
@@ -486,6 +490,7 @@ impl Importer<'_> {
             build_material(&name, &d).map_err(|e| self.error(format!("{label}: {e}")))?;
         material.textures = textures;
         material.opacity = opacity;
+        material.normal_map = normal_map;
         let id = self.materials.len() as u32;
         self.materials.push(material);
         self.material_ids.insert(m.index(), id);

@@ -91,6 +91,18 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
             .map_err(|m| at(desc.span(), m))?;
         m.opacity =
             material_opacity(name, desc.get_ref(), &texture_ids).map_err(|m| at(desc.span(), m))?;
+        if let Some(t) = &desc.get_ref().normal_map_texture {
+            let texture = *texture_ids.get(t).ok_or_else(|| {
+                at(
+                    desc.span(),
+                    format!("material `{name}`: unknown texture `{t}` for `normal_map_texture`"),
+                )
+            })?;
+            m.normal_map = Some(super::material::NormalMap {
+                texture,
+                scale: 1.0,
+            });
+        }
         by_name.insert(name.clone(), materials.len() as u32);
         materials.push(m);
     }
@@ -516,5 +528,6 @@ pub(super) fn default_material() -> Material {
         two_sided_emission: false,
         textures: Default::default(),
         opacity: Default::default(),
+        normal_map: None,
     }
 }

@@ -21,6 +21,20 @@ pub struct Material {
     /// How much of the surface is there (Mitsuba's `mask`); queries pass
     /// through the rest ([`crate::accel::mask`]).
     pub opacity: Opacity,
+    /// A tangent-space normal map that tilts the shading normal
+    /// ([`crate::scene::Scene::shading_normal`]).
+    pub normal_map: Option<NormalMap>,
+}
+
+/// A tangent-space normal map (Mitsuba's `normalmap`, glTF's
+/// `normalTexture`): texel c is the normal 2c − 1 in the frame (dp/du made
+/// orthogonal to the shading normal, their cross product, the shading
+/// normal), its x and y scaled by `scale` (glTF's; 1 in Mitsuba).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NormalMap {
+    /// Index into the scene's textures (read raw: no sRGB decoding).
+    pub texture: u32,
+    pub scale: f32,
 }
 
 /// Which of a material's parameters come from textures (indices into

@@ -27,7 +27,7 @@ use crate::texture::Texture;
 use emitters::EmitterShape;
 use glam::Vec3A;
 use light::{Light, LightSampling, Lights, PlanarEmitter};
-use material::{Bsdf, Material, Opacity};
+use material::{Bsdf, Material, NormalMap, Opacity};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -154,8 +154,10 @@ pub struct Features {
     pub area_lights: usize,
     /// Something moves while the shutter is open: camera rays need a time.
     pub motion: bool,
-    /// Some triangle has vertex normals.
+    /// Some triangle has vertex normals, or some material a normal map.
     pub shading_normals: bool,
+    /// Some material has a normal map.
+    pub normal_maps: bool,
 }
 
 impl Features {
@@ -197,7 +199,9 @@ impl Features {
                 })
                 .count(),
             motion: geometry.has_motion() && camera.has_shutter_interval(),
-            shading_normals: geometry.has_shading_normals(),
+            shading_normals: geometry.has_shading_normals()
+                || materials.iter().any(|m| m.normal_map.is_some()),
+            normal_maps: materials.iter().any(|m| m.normal_map.is_some()),
         }
     }
 
@@ -394,10 +398,11 @@ impl Scene {
 
         // Texture coordinates cost memory and a lookup per hit: kept only
         // when some material reads a texture.
-        let textured = input
-            .materials
-            .iter()
-            .any(|m| !m.textures.is_empty() || matches!(m.opacity, Opacity::Texture(_)));
+        let textured = input.materials.iter().any(|m| {
+            !m.textures.is_empty()
+                || matches!(m.opacity, Opacity::Texture(_))
+                || m.normal_map.is_some()
+        });
         let mut geometry = Geometry::build_full(&triangles, spheres, AccelChoice::Auto, textured);
         // An emitter is sampled where it is, mask or not: it stays whole.
         for m in input.materials.iter_mut() {
@@ -524,6 +529,48 @@ impl Scene {
         match material.textures.diffuse {
             Some(t) => Some((self.textures[t as usize].mean(), true)),
             None => Some((albedo, approximated)),
+        }
+    }
+
+    /// The shading normal at `hit`: the interpolated vertex normal (the
+    /// geometric one without), tilted by the material's normal map. BSDFs
+    /// act in its frame; offsets, emission and densities keep the geometric
+    /// normal.
+    #[inline(always)]
+    pub fn shading_normal(&self, hit: &SurfaceHit) -> Vec3A {
+        if !self.features.shading_normals {
+            return hit.normal;
+        }
+        let n = self.geometry.shading_normal(hit);
+        if !self.features.normal_maps {
+            return n;
+        }
+        match self.materials[hit.material as usize].normal_map {
+            Some(map) => self.normal_mapped(hit, n, map),
+            None => n,
+        }
+    }
+
+    /// `n` tilted by `map` at `hit` (Mitsuba's `normalmap`); `n` where the
+    /// surface has no tangent or the texel no direction.
+    #[inline(never)]
+    fn normal_mapped(&self, hit: &SurfaceHit, n: Vec3A, map: NormalMap) -> Vec3A {
+        let Some(dpdu) = self.geometry.uv_tangent(hit) else {
+            return n;
+        };
+        let s = (dpdu - n * n.dot(dpdu)).normalize_or_zero();
+        if s == Vec3A::ZERO {
+            return n;
+        }
+        let t = n.cross(s);
+        let c = self.textures[map.texture as usize].eval(self.geometry.uv(hit));
+        let local = c * 2.0 - Vec3A::ONE;
+        let m = (s * (local.x * map.scale) + t * (local.y * map.scale) + n * local.z)
+            .normalize_or_zero();
+        if m.is_finite() && m != Vec3A::ZERO {
+            m
+        } else {
+            n
         }
     }
 

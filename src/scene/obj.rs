@@ -336,6 +336,7 @@ fn convert_material(mtl_path: &Path, m: &tobj::Material) -> Result<Material> {
         two_sided_emission: false,
         textures: Default::default(),
         opacity: Default::default(),
+        normal_map: None,
     })
 }
 

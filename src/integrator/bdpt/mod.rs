@@ -355,7 +355,7 @@ impl Bdpt {
             let bsdf = scene.bsdf_at(&hit);
             let mut vertex = surface_vertex(&hit, bsdf, wo_world, beta);
             if scene.features.shading_normals {
-                let n = scene.geometry.shading_normal(&hit);
+                let n = scene.shading_normal(&hit);
                 if n != hit.normal {
                     vertex.packed_shading = crate::math::octahedral_encode(n);
                 }

@@ -398,7 +398,7 @@ impl Vcm {
             if bsdf.is_black() {
                 break;
             }
-            let shading = shading_normal(scene, &hit);
+            let shading = scene.shading_normal(&hit);
             if !bsdf.is_specular() {
                 let vertex = LightVertex {
                     point: hit.point,
@@ -558,7 +558,7 @@ impl MultiPassEstimator for Vcm {
             if bsdf.is_black() || segments > self.max_depth {
                 break;
             }
-            let shading = shading_normal(scene, &hit);
+            let shading = scene.shading_normal(&hit);
             let frame = Frame::from_normal(shading);
             let wo = frame.to_local(wo_world);
             let at = CameraVertex {
@@ -616,16 +616,6 @@ impl Vcm {
         let w_camera =
             self.mis(direct) * walk.d_vcm + self.mis(pdf_position * pdf_direction) * walk.d_vc;
         le / (1.0 + w_camera)
-    }
-}
-
-/// The shading normal at `hit` (the geometric one without vertex normals).
-#[inline]
-fn shading_normal(scene: &Scene, hit: &SurfaceHit) -> Vec3A {
-    if scene.features.shading_normals {
-        scene.geometry.shading_normal(hit)
-    } else {
-        hit.normal
     }
 }
 

@@ -9,16 +9,15 @@ use crate::error::Result;
 use crate::math::Rgb;
 use crate::scene::appearance::build_material;
 use crate::scene::description::{IorDesc, MaterialDesc, MaterialKind};
-use crate::scene::material::{Material, MaterialTextures, Opacity};
+use crate::scene::material::{Material, MaterialTextures, NormalMap, Opacity};
 use crate::texture::{Bitmap, Filter, Texture, UvTransform, Wrap};
 use glam::Vec2;
 use std::sync::Arc;
 
 /// Plugins whose parameters are read but whose effect is not rendered:
 /// each is replaced by the BSDF it wraps, with a warning.
-const WRAPPERS: [(&str, &str); 3] = [
+const WRAPPERS: [(&str, &str); 2] = [
     ("bumpmap", "bump map ignored"),
-    ("normalmap", "normal map ignored"),
     ("blendbsdf", "blend of two BSDFs: the first one is used"),
 ];
 
@@ -120,6 +119,23 @@ impl<'a> Importer<'a> {
             p.unused(&mut self.warnings);
             let mut m = self.bsdf(inner, two_sided)?;
             m.opacity = opacity;
+            return Ok(m);
+        }
+        if kind == "normalmap" {
+            let nested = p.objects("bsdf")?;
+            let Some(&inner) = nested.first() else {
+                return Err(e.loc.error("normalmap needs a nested <bsdf>"));
+            };
+            let texture = match p.colour("normalmap", false)? {
+                Some(Colour::Texture(t)) => self.texture(t)?,
+                _ => return Err(e.loc.error("normalmap needs a `normalmap` texture")),
+            };
+            p.unused(&mut self.warnings);
+            let mut m = self.bsdf(inner, two_sided)?;
+            m.normal_map = Some(NormalMap {
+                texture,
+                scale: 1.0,
+            });
             return Ok(m);
         }
         if let Some((_, what)) = WRAPPERS.iter().find(|(k, _)| *k == kind) {
