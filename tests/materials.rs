@@ -585,3 +585,80 @@ material = "ball"
     let worst = crate::strategies::largest_block_z(&faceted, &path);
     assert!(worst > 4.5, "flat and smooth shading agree (z {worst:.2})");
 }
+
+/// A normal map (tests/data/materials/bumps.exr) on a rough plastic sphere
+/// and on the floor, under a spot and an area light: light tracing, BDPT
+/// and VCM agree with path tracing (block z-test), so the tilted normal is
+/// the same for every technique and the adjoint's correction covers it.
+#[test]
+fn every_technique_agrees_under_a_normal_map() {
+    let bumps = repo_path("tests/data/materials/bumps.exr");
+    let text = format!(
+        r#"
+[camera]
+eye = [0.0, -4.0, 2.5]
+look_at = [0.0, 0.0, 0.5]
+up = [0.0, 0.0, 1.0]
+fov_y = 35.0
+width = 64
+height = 64
+
+[textures.bumps]
+type = "bitmap"
+file = {:?}
+raw = true
+
+[materials.floor]
+type = "diffuse"
+albedo = [0.4, 0.4, 0.4]
+normal_map_texture = "bumps"
+
+[materials.ball]
+type = "roughplastic"
+distribution = "ggx"
+alpha = 0.3
+diffuse_reflectance = [0.6, 0.3, 0.2]
+normal_map_texture = "bumps"
+
+[materials.lamp]
+type = "diffuse"
+albedo = [0.0, 0.0, 0.0]
+emission = [3.0, 3.0, 3.0]
+
+[[quad]]
+corner = [-20.0, -20.0, 0.0]
+u = [40.0, 0.0, 0.0]
+v = [0.0, 40.0, 0.0]
+material = "floor"
+
+[[quad]]
+corner = [0.2, -2.2, 3.0]
+u = [0.0, 2.0, 0.0]
+v = [2.0, 0.0, 0.0]
+material = "lamp"
+
+[[sphere]]
+center = [0.0, 0.0, 0.6]
+radius = 0.6
+material = "ball"
+
+[[spot_light]]
+position = [-2.0, -2.0, 2.0]
+target = [0.0, 0.0, 0.3]
+intensity = [20.0, 18.0, 15.0]
+"#,
+        bumps.display().to_string()
+    );
+    let scene = load_scene_text("normal-map", &text);
+    assert!(scene.features.normal_maps && scene.features.shading_normals);
+    let path = render(scene.clone(), Integrator::from(PathTracer::default()), 256, 51);
+    let light = render(scene.clone(), Integrator::from(LightTracer::default()), 256, 52);
+    assert_agree("normal map, light / path", &light, &path);
+    let bdpt = render(scene.clone(), Integrator::from(Bdpt::default()), 256, 53);
+    assert_agree("normal map, bdpt / path", &bdpt, &path);
+    let vcm = Integrator::MultiPass(MultiPassIntegrator::Vcm(Vcm {
+        radius: 0.0003,
+        ..Vcm::default()
+    }));
+    assert_agree("normal map, vcm / path", &render(scene, vcm, 256, 54), &path);
+}
