@@ -651,8 +651,18 @@ intensity = [20.0, 18.0, 15.0]
     );
     let scene = load_scene_text("normal-map", &text);
     assert!(scene.features.normal_maps && scene.features.shading_normals);
-    let path = render(scene.clone(), Integrator::from(PathTracer::default()), 256, 51);
-    let light = render(scene.clone(), Integrator::from(LightTracer::default()), 256, 52);
+    let path = render(
+        scene.clone(),
+        Integrator::from(PathTracer::default()),
+        256,
+        51,
+    );
+    let light = render(
+        scene.clone(),
+        Integrator::from(LightTracer::default()),
+        256,
+        52,
+    );
     assert_agree("normal map, light / path", &light, &path);
     let bdpt = render(scene.clone(), Integrator::from(Bdpt::default()), 256, 53);
     assert_agree("normal map, bdpt / path", &bdpt, &path);
@@ -660,5 +670,9 @@ intensity = [20.0, 18.0, 15.0]
         radius: 0.0003,
         ..Vcm::default()
     }));
-    assert_agree("normal map, vcm / path", &render(scene, vcm, 256, 54), &path);
+    assert_agree(
+        "normal map, vcm / path",
+        &render(scene, vcm, 256, 54),
+        &path,
+    );
 }

@@ -35,6 +35,8 @@ mod strategies;
 mod bidirectional;
 // Microfacet, plastic, conductor and thin glass models in every technique.
 mod materials;
+// A textured, normal-mapped glTF asset: path tracing and BDPT agree.
+mod gltf_assets;
 // Opacity masks in every technique and importer.
 mod masks;
 // Same seed, same film, whatever the thread count or pass split.

@@ -96,7 +96,13 @@ impl SplattingEstimator for LightTracer {
         let camera = &scene.camera;
 
         // The light point seen directly: Le |cos| / p_position * We / p_cam.
-        if let Some(c) = camera.connect(emission.point, u_lens) {
+        // Point and spot lights are not seen, as no camera ray can hit them
+        // (path tracing's and Mitsuba's image).
+        let delta_position = emission.normal == Vec3A::ZERO;
+        if let Some(c) = camera
+            .connect(emission.point, u_lens)
+            .filter(|_| !delta_position)
+        {
             let le = emission.emitted_towards(c.wi);
             if le.max_element() > 0.0
                 && sees_lens(

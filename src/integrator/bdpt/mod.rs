@@ -466,7 +466,11 @@ impl Bdpt {
             let qs = &light[s - 1];
             // A vertex connects if any of its lobes is not a delta, however
             // its own path went on (pbrt-v4's IsConnectible).
-            if (qs.kind == Kind::Surface && qs.bsdf.is_specular()) || qs.infinite {
+            // Nor is a point or spot light seen (no camera ray hits one).
+            if (qs.kind == Kind::Surface && qs.bsdf.is_specular())
+                || qs.infinite
+                || (qs.kind == Kind::Light && qs.normal == Vec3A::ZERO)
+            {
                 return None;
             }
             let c = scene.camera.connect(qs.point, qs.u_connect)?;
