@@ -92,6 +92,38 @@ impl Texture {
         }
     }
 
+    /// The texture's luminance at `uv` and its gradient in uv (Mitsuba's
+    /// `eval_1_grad`: the bilinear interpolant's derivatives; zero for
+    /// nearest filtering and the checkerboard, which are flat between
+    /// their steps).
+    #[inline]
+    pub fn eval_gradient(&self, uv: Vec2) -> Vec2 {
+        let Texture::Bitmap {
+            image,
+            wrap,
+            filter: Filter::Bilinear,
+            to_uv,
+        } = self
+        else {
+            return Vec2::ZERO;
+        };
+        let uv = uv * to_uv.scale + to_uv.offset;
+        if !uv.is_finite() {
+            return Vec2::ZERO;
+        }
+        let (w, h) = (image.width as f32, image.height as f32);
+        let (x, y) = (uv.x * w - 0.5, uv.y * h - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let f = |dx: i64, dy: i64| crate::math::luminance(image.texel(x0 + dx, y0 + dy, *wrap));
+        let (f00, f10, f01, f11) = (f(0, 0), f(1, 0), f(0, 1), f(1, 1));
+        let d_dx = (1.0 - fy) * (f10 - f00) + fy * (f11 - f01);
+        let d_dy = (1.0 - fx) * (f01 - f00) + fx * (f11 - f10);
+        let g = Vec2::new(d_dx * w * to_uv.scale.x, d_dy * h * to_uv.scale.y);
+        if g.is_finite() { g } else { Vec2::ZERO }
+    }
+
     /// The mean over the texture (for lobe choices that want one value).
     pub fn mean(&self) -> Rgb {
         match self {

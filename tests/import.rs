@@ -297,8 +297,8 @@ fn what_is_not_rendered_is_a_warning_and_strict_makes_it_an_error() {
   <default name="res" value="8"/><default name="spp" value="1"/><default name="power" value="1"/>
   {SENSOR}
   <shape type="cube">
-    <bsdf type="bumpmap"><texture type="bitmap" name="arbitrary"><string name="filename" value="x.png"/></texture>
-      <bsdf type="diffuse"/></bsdf>
+    <bsdf type="blendbsdf"><float name="weight" value="0.3"/>
+      <bsdf type="diffuse"/><bsdf type="conductor"/></bsdf>
     <float name="mystery" value="1"/>
   </shape>
   <shape type="hair"/>
@@ -308,7 +308,7 @@ fn what_is_not_rendered_is_a_warning_and_strict_makes_it_an_error() {
     let scene = load("warnings", &xml, &[], false).unwrap_or_else(|e| panic!("{e}"));
     let w = scene.warnings.join("\n");
     for expected in [
-        "scene.xml:11:5: bump map ignored",
+        "scene.xml:11:5: blend of two BSDFs: the first one is used",
         "scene.xml:13:5: shape `cube`: property `mystery` ignored",
         "scene.xml:15:3: shape \"hair\" is not supported: skipped",
         "scene.xml:16:3: emitter \"sunsky\" is not supported: skipped",
@@ -318,7 +318,7 @@ fn what_is_not_rendered_is_a_warning_and_strict_makes_it_an_error() {
     let e = load("strict", &xml, &[], true)
         .err()
         .expect("strict refuses");
-    assert!(e.to_string().contains("bump map ignored") && e.to_string().contains("--strict"));
+    assert!(e.to_string().contains("blend of two BSDFs") && e.to_string().contains("--strict"));
 }
 
 /// A floor quad, an emissive quad, a camera and a point light under a

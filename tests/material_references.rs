@@ -324,26 +324,60 @@ fn normal_map_matches_mitsuba() {
     assert!(ratio <= 1.10, "normalmap: RMSE ratio {ratio:.3}");
     // Without the map the sphere is smooth and far from Mitsuba's render
     // (measured: RMSE 0.033 against 0.0037).
-    let rmse_of = |text: &str, name: &str| {
-        let (snapshot, _) = render(
-            load_scene_text(name, text),
-            Integrator::from(PathTracer::default()),
-            SamplerKind::Independent,
-            256,
-            1,
-        );
-        snapshot
-            .image
-            .compare(&reference("materials/normalmap.exr"))
-            .unwrap()
-            .rmse
-    };
     let plain = text.replace("normal_map_texture = \"bumps\"\n", "");
     assert_ne!(plain, text);
-    let (mapped, smooth) = (rmse_of(&text, "mapped"), rmse_of(&plain, "smooth"));
+    let (mapped, smooth) = (
+        rmse_against(&text, "normalmap"),
+        rmse_against(&plain, "normalmap"),
+    );
     eprintln!("normal map: RMSE {mapped:.4} mapped, {smooth:.4} smooth");
     assert!(
         smooth > 2.0 * mapped,
         "the map changes little: {smooth} vs {mapped}"
     );
+}
+
+/// A bump map (tests/data/materials/heights.exr, 4 x 4 bumps, scale 0.05)
+/// on the rough copper sphere, as Mitsuba's `bumpmap`: the bilinear
+/// gradient in uv and both of the sphere's uv derivatives.
+#[test]
+fn bump_map_matches_mitsuba() {
+    let heights = crate::common::repo_path("tests/data/materials/heights.exr");
+    let text = material_scene(
+        "type = \"roughconductor\"\nconductor = \"Cu\"\ndistribution = \"ggx\"\nalpha = 0.2\nbump_map_texture = \"heights\"\nbump_scale = 0.05",
+        SPHERE,
+    ) + &format!(
+        "\n[textures.heights]\ntype = \"bitmap\"\nfile = {:?}\nraw = true\n",
+        heights.display().to_string()
+    );
+    let ratio = check_scene("bumpmap", &text);
+    assert!(ratio <= 1.10, "bumpmap: RMSE ratio {ratio:.3}");
+    let plain = text.replace("bump_map_texture = \"heights\"\nbump_scale = 0.05\n", "");
+    assert_ne!(plain, text);
+    let (bumped, smooth) = (
+        rmse_against(&text, "bumpmap"),
+        rmse_against(&plain, "bumpmap"),
+    );
+    eprintln!("bump map: RMSE {bumped:.4} bumped, {smooth:.4} smooth");
+    assert!(
+        smooth > 2.0 * bumped,
+        "the bumps change little: {smooth} vs {bumped}"
+    );
+}
+
+/// The RMSE of a 256-spp path-traced render of `text` against reference
+/// `name`.
+fn rmse_against(text: &str, name: &str) -> f64 {
+    let (snapshot, _) = render(
+        load_scene_text(name, text),
+        Integrator::from(PathTracer::default()),
+        SamplerKind::Independent,
+        256,
+        1,
+    );
+    snapshot
+        .image
+        .compare(&reference(&format!("materials/{name}.exr")))
+        .unwrap()
+        .rmse
 }

@@ -383,23 +383,38 @@ impl Geometry {
         hit.barycentric
     }
 
-    /// The direction of dp/du at `hit` (not normalised), where the surface
-    /// has texture coordinates that vary over it: a triangle's kept uvs, or
-    /// a sphere's (φ / 2π, θ / π). `None` where uv is degenerate.
+    /// dp/du and dp/dv at `hit`, where the surface has texture coordinates
+    /// that vary over it: a triangle's kept uvs, or a sphere's (φ / 2π,
+    /// θ / π). `None` where uv is degenerate.
     #[inline]
-    pub fn uv_tangent(&self, hit: &SurfaceHit) -> Option<Vec3A> {
+    pub fn uv_derivatives(&self, hit: &SurfaceHit) -> Option<(Vec3A, Vec3A)> {
         let i = hit.primitive as usize;
         if let Some([t0, t1, t2]) = self.tri_uvs.get(i) {
             let [p0, p1, p2] = self.tri_vertices[i];
             let (d1, d2) = (*t1 - *t0, *t2 - *t0);
             let det = d1.x * d2.y - d1.y * d2.x;
-            let dpdu = (d2.y * (p1 - p0) - d1.y * (p2 - p0)) / det;
-            return (det.abs() > 1e-20 && dpdu.is_finite() && dpdu != Vec3A::ZERO).then_some(dpdu);
+            let (e1, e2) = (p1 - p0, p2 - p0);
+            let dpdu = (d2.y * e1 - d1.y * e2) / det;
+            let dpdv = (d1.x * e2 - d2.x * e1) / det;
+            return (det.abs() > 1e-20
+                && dpdu.is_finite()
+                && dpdv.is_finite()
+                && dpdu != Vec3A::ZERO)
+                .then_some((dpdu, dpdv));
         }
         if hit.primitive & MOVING_PRIMITIVE == 0 && i >= self.tri_vertices.len() {
-            // dp/dφ on a sphere is along (−n_y, n_x, 0).
-            let t = Vec3A::new(-hit.normal.y, hit.normal.x, 0.0);
-            return (t.length_squared() > 1e-12).then_some(t);
+            let r = self.spheres[i - self.tri_vertices.len()].radius;
+            let n = hit.normal;
+            let sin_theta = (n.x * n.x + n.y * n.y).sqrt();
+            if sin_theta < 1e-6 {
+                return None;
+            }
+            // p = r (sin θ cos φ, sin θ sin φ, cos θ), u = φ / 2π, v = θ / π.
+            let dpdu = std::f32::consts::TAU * r * Vec3A::new(-n.y, n.x, 0.0);
+            let dpdv = std::f32::consts::PI
+                * r
+                * Vec3A::new(n.z * n.x / sin_theta, n.z * n.y / sin_theta, -sin_theta);
+            return Some((dpdu, dpdv));
         }
         None
     }

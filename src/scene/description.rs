@@ -325,6 +325,9 @@ pub struct MaterialDesc {
     pub opacity_texture: Option<String>,
     /// A tangent-space normal map (a texture name; declare it `raw`).
     pub normal_map_texture: Option<String>,
+    /// A bump map: a height texture's name and the height's scale (1).
+    pub bump_map_texture: Option<String>,
+    pub bump_scale: Option<f32>,
     /// Emitted radiance (any type).
     pub emission: Option<[f32; 3]>,
     /// Emit from both sides (any type).

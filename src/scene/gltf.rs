@@ -385,7 +385,7 @@ impl Importer<'_> {
             ));
         }
         let normal_map = match m.normal_texture() {
-            Some(info) => Some(NormalMap {
+            Some(info) => Some(NormalMap::Tangent {
                 texture: self.texture(&info.texture(), info.tex_coord(), true, &label)?,
                 scale: info.scale(),
             }),

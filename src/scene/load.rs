@@ -5,7 +5,7 @@ use super::appearance::{
     build_environment, build_material, build_texture, material_opacity, material_textures,
 };
 use super::description::*;
-use super::material::{Bsdf, Material};
+use super::material::{Bsdf, Material, NormalMap};
 use super::obj::load_obj;
 use super::{Limits, LoadOptions, MAX_COORDINATE, MovingInput, SceneInput, in_range};
 use crate::accel::{NO_LIGHT, Sphere, TriangleInput};
@@ -91,18 +91,8 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
             .map_err(|m| at(desc.span(), m))?;
         m.opacity =
             material_opacity(name, desc.get_ref(), &texture_ids).map_err(|m| at(desc.span(), m))?;
-        if let Some(t) = &desc.get_ref().normal_map_texture {
-            let texture = *texture_ids.get(t).ok_or_else(|| {
-                at(
-                    desc.span(),
-                    format!("material `{name}`: unknown texture `{t}` for `normal_map_texture`"),
-                )
-            })?;
-            m.normal_map = Some(super::material::NormalMap {
-                texture,
-                scale: 1.0,
-            });
-        }
+        m.normal_map =
+            normal_map(name, desc.get_ref(), &texture_ids).map_err(|m| at(desc.span(), m))?;
         by_name.insert(name.clone(), materials.len() as u32);
         materials.push(m);
     }
@@ -529,5 +519,40 @@ pub(super) fn default_material() -> Material {
         textures: Default::default(),
         opacity: Default::default(),
         normal_map: None,
+    }
+}
+
+/// The normal or bump map of material `name`, its textures named in `ids`.
+fn normal_map(
+    name: &str,
+    d: &MaterialDesc,
+    ids: &HashMap<String, u32>,
+) -> std::result::Result<Option<NormalMap>, String> {
+    let id = |field: &str, t: &String| {
+        ids.get(t)
+            .copied()
+            .ok_or_else(|| format!("material `{name}`: unknown texture `{t}` for `{field}`"))
+    };
+    match (&d.normal_map_texture, &d.bump_map_texture) {
+        (Some(_), Some(_)) => Err(format!(
+            "material `{name}`: give `normal_map_texture` or `bump_map_texture`, not both"
+        )),
+        (Some(t), None) => Ok(Some(NormalMap::Tangent {
+            texture: id("normal_map_texture", t)?,
+            scale: 1.0,
+        })),
+        (None, Some(t)) => match d.bump_scale.unwrap_or(1.0) {
+            scale if scale.is_finite() => Ok(Some(NormalMap::Bump {
+                texture: id("bump_map_texture", t)?,
+                scale,
+            })),
+            scale => Err(format!(
+                "material `{name}`: `bump_scale` must be finite, got {scale}"
+            )),
+        },
+        (None, None) if d.bump_scale.is_some() => Err(format!(
+            "material `{name}`: `bump_scale` without `bump_map_texture`"
+        )),
+        (None, None) => Ok(None),
     }
 }

@@ -26,15 +26,19 @@ pub struct Material {
     pub normal_map: Option<NormalMap>,
 }
 
-/// A tangent-space normal map (Mitsuba's `normalmap`, glTF's
-/// `normalTexture`): texel c is the normal 2c − 1 in the frame (dp/du made
-/// orthogonal to the shading normal, their cross product, the shading
-/// normal), its x and y scaled by `scale` (glTF's; 1 in Mitsuba).
+/// A texture that tilts the shading normal; `texture` indexes the scene's
+/// textures.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NormalMap {
-    /// Index into the scene's textures (read raw: no sRGB decoding).
-    pub texture: u32,
-    pub scale: f32,
+pub enum NormalMap {
+    /// Mitsuba's `normalmap`, glTF's `normalTexture`: texel c is the normal
+    /// 2c − 1 in the frame (dp/du made orthogonal to the shading normal,
+    /// their cross product, the shading normal), its x and y scaled by
+    /// `scale` (glTF's; 1 in Mitsuba). Read raw (no sRGB decoding).
+    Tangent { texture: u32, scale: f32 },
+    /// Mitsuba's `bumpmap`: the surface displaced along its normal by
+    /// `scale` times the texture (its luminance), whose gradient in uv
+    /// tilts dp/du and dp/dv.
+    Bump { texture: u32, scale: f32 },
 }
 
 /// Which of a material's parameters come from textures (indices into

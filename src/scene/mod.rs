@@ -551,22 +551,34 @@ impl Scene {
         }
     }
 
-    /// `n` tilted by `map` at `hit` (Mitsuba's `normalmap`); `n` where the
-    /// surface has no tangent or the texel no direction.
+    /// `n` tilted by `map` at `hit` (Mitsuba's `normalmap` and `bumpmap`);
+    /// `n` where the surface has no uv derivatives or the map no direction.
     #[inline(never)]
     fn normal_mapped(&self, hit: &SurfaceHit, n: Vec3A, map: NormalMap) -> Vec3A {
-        let Some(dpdu) = self.geometry.uv_tangent(hit) else {
+        let Some((dpdu, dpdv)) = self.geometry.uv_derivatives(hit) else {
             return n;
         };
-        let s = (dpdu - n * n.dot(dpdu)).normalize_or_zero();
-        if s == Vec3A::ZERO {
-            return n;
+        let uv = self.geometry.uv(hit);
+        let m = match map {
+            NormalMap::Tangent { texture, scale } => {
+                let s = (dpdu - n * n.dot(dpdu)).normalize_or_zero();
+                if s == Vec3A::ZERO {
+                    return n;
+                }
+                let t = n.cross(s);
+                let local = self.textures[texture as usize].eval(uv) * 2.0 - Vec3A::ONE;
+                s * (local.x * scale) + t * (local.y * scale) + n * local.z
+            }
+            NormalMap::Bump { texture, scale } => {
+                let g = scale * self.textures[texture as usize].eval_gradient(uv);
+                let du = dpdu + n * (g.x - n.dot(dpdu));
+                let dv = dpdv + n * (g.y - n.dot(dpdv));
+                let m = du.cross(dv);
+                // On the side of the geometric normal, as Mitsuba flips it.
+                if m.dot(hit.normal) < 0.0 { -m } else { m }
+            }
         }
-        let t = n.cross(s);
-        let c = self.textures[map.texture as usize].eval(self.geometry.uv(hit));
-        let local = c * 2.0 - Vec3A::ONE;
-        let m = (s * (local.x * map.scale) + t * (local.y * map.scale) + n * local.z)
-            .normalize_or_zero();
+        .normalize_or_zero();
         if m.is_finite() && m != Vec3A::ZERO {
             m
         } else {

@@ -16,10 +16,7 @@ use std::sync::Arc;
 
 /// Plugins whose parameters are read but whose effect is not rendered:
 /// each is replaced by the BSDF it wraps, with a warning.
-const WRAPPERS: [(&str, &str); 2] = [
-    ("bumpmap", "bump map ignored"),
-    ("blendbsdf", "blend of two BSDFs: the first one is used"),
-];
+const WRAPPERS: [(&str, &str); 1] = [("blendbsdf", "blend of two BSDFs: the first one is used")];
 
 impl<'a> Importer<'a> {
     /// The material of a shape: its BSDF plus an area emitter's radiance.
@@ -132,10 +129,25 @@ impl<'a> Importer<'a> {
             };
             p.unused(&mut self.warnings);
             let mut m = self.bsdf(inner, two_sided)?;
-            m.normal_map = Some(NormalMap {
+            m.normal_map = Some(NormalMap::Tangent {
                 texture,
                 scale: 1.0,
             });
+            return Ok(m);
+        }
+        if kind == "bumpmap" {
+            let nested = p.objects("bsdf")?;
+            let Some(&inner) = nested.first() else {
+                return Err(e.loc.error("bumpmap needs a nested <bsdf>"));
+            };
+            let Some(&height) = p.any_objects("texture")?.first() else {
+                return Err(e.loc.error("bumpmap needs a nested <texture>"));
+            };
+            let texture = self.texture(height)?;
+            let scale = p.float_or("scale", 1.0)?;
+            p.unused(&mut self.warnings);
+            let mut m = self.bsdf(inner, two_sided)?;
+            m.normal_map = Some(NormalMap::Bump { texture, scale });
             return Ok(m);
         }
         if let Some((_, what)) = WRAPPERS.iter().find(|(k, _)| *k == kind) {

@@ -161,6 +161,23 @@ impl<'a> Props<'a> {
 
     /// The unnamed child plugins with tag `tag` (nested or referenced),
     /// marked used.
+    /// Every nested `tag` element, named or not (a `bumpmap`'s texture
+    /// goes by any name).
+    pub fn any_objects(&self, tag: &str) -> Result<Vec<&'a Element>> {
+        let mut out = Vec::new();
+        for (i, c) in self.element.children.iter().enumerate() {
+            let target = match c.tag.as_str() {
+                "ref" => self.lookup(c)?,
+                _ => c,
+            };
+            if target.tag == tag {
+                self.used[i].set(true);
+                out.push(target);
+            }
+        }
+        Ok(out)
+    }
+
     pub fn objects(&self, tag: &str) -> Result<Vec<&'a Element>> {
         let mut out = Vec::new();
         for (i, c) in self.element.children.iter().enumerate() {

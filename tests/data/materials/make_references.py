@@ -126,8 +126,21 @@ def write_bumps(path="bumps.exr", size=64):
     mi.Bitmap(((n + 1) / 2).astype(np.float32)).write(path)
 
 
-# A normal map (bumps.exr, made by write_bumps) on a rough copper sphere.
+def write_heights(path="heights.exr", size=64):
+    """A height field of 4 x 4 bumps for Mitsuba's bumpmap:
+    h = 0.5 + 0.5 sin(8 pi u) sin(8 pi v), grey."""
+    u = (np.arange(size) + 0.5) / size
+    uu, vv = np.meshgrid(u, u)
+    h = 0.5 + 0.5 * np.sin(8 * np.pi * uu) * np.sin(8 * np.pi * vv)
+    mi.Bitmap(np.repeat(h[..., None], 3, -1).astype(np.float32)).write(path)
+
+
+# A normal map (bumps.exr, made by write_bumps) and a bump map (heights.exr,
+# scale 0.05: normals tilt by up to about 0.17) on a rough copper sphere.
 NORMALMAPS = {
+    "bumpmap": sphere({"type": "bumpmap", "scale": 0.05,
+                       "heights": {"type": "bitmap", "filename": "heights.exr", "raw": True},
+                       "bsdf": {"type": "roughconductor", "material": "Cu", "distribution": "ggx", "alpha": 0.2}}),
     "normalmap": sphere({"type": "normalmap",
                          "normalmap": {"type": "bitmap", "filename": "bumps.exr", "raw": True},
                          "bsdf": {"type": "roughconductor", "material": "Cu", "distribution": "ggx", "alpha": 0.2}}),
@@ -173,6 +186,7 @@ def main(names):
     jobs |= {name: (obj, None, None, light) for name, (obj, light) in LIGHTS.items()}
     jobs |= {name: (obj, None, None, None) for name, obj in NORMALMAPS.items()}
     write_bumps()
+    write_heights()
     for name, (obj, rfilter, floor, env) in jobs.items():
         if names and name not in names:
             continue
