@@ -195,14 +195,11 @@ fn plastic_matches_mitsuba() {
     );
 }
 
-/// Open: the rough plastic's diffuse term is brighter than Mitsuba 3.9.1's
-/// at grazing angles (its coating transmittance T(cos θ) falls less: the
-/// BSDF is 0.9% above Mitsuba's at normal incidence, 17% at cos θ 0.05;
-/// image means 0.2–1.3% high). Both integrate E[F G1] over visible
-/// normals as Mitsuba 3's published source does; 3.9.1 differs from it.
-/// Run with `cargo test -- --ignored` to see the gap.
+/// Rough plastic, linear and nonlinear: the coating's transmittance table
+/// is Mitsuba 3's `eval_transmittance`, E[(1 − F) G1] of the refracted
+/// direction over visible normals (1 − the reflectance, as older Mitsuba
+/// sources had it, was 17% high at cos θ 0.05 and the means 0.2–1.3%).
 #[test]
-#[ignore = "rough plastic differs from Mitsuba 3.9.1 at grazing angles (docs/validation.md)"]
 fn rough_plastics_match_mitsuba() {
     check(
         "roughplastic",

@@ -179,6 +179,37 @@ fn specular_albedo(microfacet: &Microfacet, cos: f32, eta: f32) -> f32 {
     (sum / (N * N) as f64) as f32
 }
 
+/// Directional transmittance of the coating at incident cosine `cos` into
+/// a medium of relative IOR `eta`: E[(1 − F(wo·m)) G1(wt, m)] over visible
+/// normals, wt the direction refracted through m (Mitsuba 3's
+/// `eval_transmittance`; the refracted ray's shadowing makes it fall
+/// faster towards grazing than 1 − the reflectance), by the midpoint rule
+/// of [`specular_albedo`].
+fn coating_transmittance(microfacet: &Microfacet, cos: f32, eta: f32) -> f32 {
+    const N: usize = 64;
+    let cos = cos.max(1e-6);
+    let wo = Vec3A::new((1.0 - cos * cos).max(0.0).sqrt(), 0.0, cos);
+    let mut sum = 0.0f64;
+    for i in 0..N {
+        for j in 0..N {
+            let u = Vec2::new((i as f32 + 0.5) / N as f32, (j as f32 + 0.5) / N as f32);
+            let m = microfacet.sample_visible(wo, u);
+            let dot = wo.dot(m);
+            let sin2_t = (1.0 - dot * dot).max(0.0) / (eta * eta);
+            if dot <= 0.0 || sin2_t >= 1.0 {
+                continue;
+            }
+            let cos_t = (1.0 - sin2_t).sqrt();
+            let wt = -wo / eta + m * (dot / eta - cos_t);
+            if wt.z < 0.0 {
+                let f = fresnel_dielectric(dot, eta).reflectance;
+                sum += ((1.0 - f) * microfacet.g1(wt, m)) as f64;
+            }
+        }
+    }
+    (sum / (N * N) as f64) as f32
+}
+
 /// The coating tables for (distribution, α, η), computed on first use.
 fn coating_tables(microfacet: Microfacet, eta: f32) -> &'static CoatingTables {
     type Key = (Distribution, u32, u32, u32);
@@ -197,7 +228,7 @@ fn coating_tables(microfacet: Microfacet, eta: f32) -> &'static CoatingTables {
     let mut internal = 0.0;
     for (k, t) in external_transmittance.iter_mut().enumerate() {
         let cos = k as f32 / (TABLE_SIZE - 1) as f32;
-        *t = 1.0 - specular_albedo(&microfacet, cos, eta);
+        *t = coating_transmittance(&microfacet, cos, eta);
         // Mitsuba's estimate of 2 ∫ R_int(μ) μ dμ: twice the mean over the
         // same 64 points, kept for agreement with its images.
         internal += specular_albedo(&microfacet, cos, 1.0 / eta) * cos;
