@@ -1,7 +1,8 @@
 //! `tracelab bench`: error against a reference at 1, 2, 4, ... spp for
 //! several configurations, as a table, CSV and log-log plots (SVG or PNG).
 
-use super::render::{override_resolution, render_spp};
+use super::render::render_spp;
+use super::shared::override_resolution;
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

@@ -3,7 +3,7 @@
 //! plots. Exits non-zero when a check does not hold.
 
 use super::choices::SamplerArg;
-use super::render::progress_bar;
+use super::shared::progress_bar;
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
 use std::time::Duration;

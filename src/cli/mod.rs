@@ -6,6 +6,7 @@ mod choices;
 mod lab;
 mod radiosity;
 mod render;
+mod shared;
 mod solver;
 mod strategies;
 mod stress;

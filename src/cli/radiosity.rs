@@ -4,7 +4,7 @@
 //! RMSE against the reference with and without the pixels that see lights)
 //! and writes them as CSV and a plot.
 
-use super::render::override_resolution;
+use super::shared::override_resolution;
 use super::solver::drive_solver;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;

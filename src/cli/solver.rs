@@ -2,7 +2,7 @@
 //! steps until it converges, then (with a time budget) more samples of the
 //! converged solution's image.
 
-use super::render::progress_bar;
+use super::shared::progress_bar;
 use std::time::Duration;
 use tracelab::Result;
 use tracelab::integrator::SolverProgress;

@@ -20,7 +20,7 @@
 //! reach surfaces by their error bounds, so nothing depends on the scene's
 //! units.
 
-use super::mesh::Element;
+use super::element::Element;
 use crate::accel::Geometry;
 use crate::math::{Rgb, gamma, ray_between};
 use crate::sampling::spherical_triangle;

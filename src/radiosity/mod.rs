@@ -3,6 +3,7 @@
 //! The technique that renders with them is `crate::integrator::radiosity`.
 
 pub mod cluster;
+pub mod element;
 pub mod form_factor;
 pub mod hierarchy;
 pub mod mesh;
@@ -10,8 +11,9 @@ pub mod reconstruct;
 pub mod solve;
 pub mod vertex_field;
 
+pub use element::Element;
 pub use form_factor::FormFactorMethod;
 pub use hierarchy::{Hierarchy, HierarchySettings};
-pub use mesh::{Element, Mesh};
+pub use mesh::Mesh;
 pub use solve::{FormFactors, RadiositySolver, Solution};
 pub use vertex_field::VertexField;

@@ -12,7 +12,7 @@
 //! coarser element through them). Hierarchies gather their vertices over
 //! their links instead ([`super::hierarchy::Hierarchy::smooth`]).
 
-use super::mesh::Element;
+use super::element::Element;
 use crate::math::Rgb;
 use glam::Vec3A;
 use std::collections::HashMap;

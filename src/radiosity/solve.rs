@@ -5,10 +5,11 @@
 //! elements shoot together, Cohen et al.'s substructuring), with the
 //! ambient term of Cohen et al. 1988 for display.
 
+use super::element::Element;
 use super::form_factor::{
     EXPOSURE_POINTS, FormFactorMethod, element_to_element, exposure, sent_radiance,
 };
-use super::mesh::{Element, Mesh};
+use super::mesh::Mesh;
 use crate::accel::Geometry;
 use crate::math::Rgb;
 use rayon::prelude::*;

@@ -5,7 +5,7 @@
 //! from the coarser side's line; the display showed it as a crack where a
 //! hierarchy's leaves of different levels meet.
 
-use super::mesh::Element;
+use super::element::Element;
 use super::reconstruct::{VertexKey, vertex_key};
 use crate::math::Rgb;
 use glam::Vec3A;

@@ -379,10 +379,10 @@ fn draw_figure(ui: &mut egui::Ui, figure: &Figure, index: usize, size: egui::Vec
         .y_axis_label(figure.y_label.as_str());
     if log {
         plot = plot
-            .x_axis_formatter(|mark, _| super::stats::format_power(mark.value))
-            .y_axis_formatter(|mark, _| super::stats::format_power(mark.value))
-            .x_grid_spacer(super::stats::log_grid)
-            .y_grid_spacer(super::stats::log_grid);
+            .x_axis_formatter(|mark, _| super::plot_scale::format_power(mark.value))
+            .y_axis_formatter(|mark, _| super::plot_scale::format_power(mark.value))
+            .x_grid_spacer(super::plot_scale::log_grid)
+            .y_grid_spacer(super::plot_scale::log_grid);
     } else if let Axes::Linear { x, y } = figure.axes {
         plot = plot.default_x_bounds(x.0, x.1).default_y_bounds(y.0, y.1);
         // Point sets and warped points are shapes: a square plot keeps circles round.

@@ -15,6 +15,7 @@ pub mod image_view;
 pub mod lab;
 pub mod launch;
 pub mod panel;
+pub mod plot_scale;
 pub mod settings;
 pub mod stats;
 pub mod strategies;
