@@ -10,7 +10,6 @@
 use crate::accel::{SurfaceHit, TriangleInput};
 use crate::error::{Error, Result};
 use crate::image::Image;
-use crate::integrator::path::shadow_ray;
 use crate::integrator::{CameraIntegrator, Integrator, PathTracer};
 use crate::math::{Frame, OffsetMode};
 use crate::render::{RenderSettings, Session};
@@ -340,7 +339,7 @@ pub fn count_self_intersections(scene: &Scene, seed: u64) -> (u64, u64) {
                 .sample(hit.point, sampler.next_1d(), sampler.next_2d())
                 && ls.wi.dot(hit.normal) * ray.direction.dot(hit.normal) < 0.0
             {
-                let shadow = shadow_ray(&hit, &ls);
+                let shadow = ls.shadow_ray_from(&hit);
                 spawned += 1;
                 if let Some(next) = scene.geometry.intersect(&shadow) {
                     self_hits += u64::from(is_self_hit(&hit, shadow.direction, &next));

@@ -21,8 +21,6 @@ use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::shortcuts::{PrimaryPixel, ShortcutsUsed};
 
-use super::path::shadow_ray;
-
 /// Settings of the branching ray tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct McRayTracer {
@@ -191,7 +189,7 @@ impl McRayTracer {
                 multi_sample_weight(self.mis, n_light, ls.pdf, n_bsdf, bsdf.pdf(wo, wi))
             };
             counts.shadow += 1;
-            if !scene.geometry.occluded(&shadow_ray(hit, &ls)) {
+            if !scene.geometry.occluded(&ls.shadow_ray_from(hit)) {
                 radiance += f * ls.radiance * (wi.z.abs() * weight / (ls.pdf * n_light as f32));
             }
         }

@@ -13,7 +13,7 @@ use super::{
     survives_roulette,
 };
 use crate::accel::{NO_LIGHT, SurfaceHit};
-use crate::math::{Frame, Ray, Rgb, ray_between};
+use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
@@ -350,7 +350,7 @@ impl PathTracer {
                             self.mis.weight(ls.pdf, pdf::<DIFFUSE_ONLY>(&bsdf, wo, wi))
                         };
                         let shadow = PendingShadow {
-                            ray: shadow_ray(&hit, &ls),
+                            ray: ls.shadow_ray_from(&hit),
                             added: beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf),
                             light: ls.light,
                         };
@@ -458,14 +458,4 @@ fn sample<const DIFFUSE_ONLY: bool>(
         });
     }
     bsdf.sample(wo, u_lobe, u)
-}
-
-/// Shadow ray from a surface hit to a sampled light point, both ends moved
-/// off their surfaces by their error bounds.
-#[inline]
-pub fn shadow_ray(hit: &SurfaceHit, ls: &LightSample) -> Ray {
-    ray_between(
-        hit.point, hit.error, hit.normal, ls.point, ls.error, ls.normal,
-    )
-    .at_time(hit.time)
 }

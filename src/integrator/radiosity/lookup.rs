@@ -158,10 +158,7 @@ pub(super) fn gather(
         let cos = normal.dot(ls.wi);
         if cos > 0.0 {
             counts.shadow += 1;
-            if !scene
-                .geometry
-                .occluded(&crate::integrator::path::shadow_ray(hit, &ls))
-            {
+            if !scene.geometry.occluded(&ls.shadow_ray_from(hit)) {
                 // f = ρ/π (Lambert).
                 direct = reflectance * ls.radiance * (cos / (std::f32::consts::PI * ls.pdf));
             }

@@ -217,6 +217,23 @@ pub struct LightSample {
     pub light: u32,
 }
 
+impl LightSample {
+    /// The shadow ray from surface hit `hit` to the sampled point, both ends
+    /// moved off their surfaces by their error bounds.
+    #[inline]
+    pub fn shadow_ray_from(&self, hit: &crate::accel::SurfaceHit) -> crate::math::Ray {
+        crate::math::ray_between(
+            hit.point,
+            hit.error,
+            hit.normal,
+            self.point,
+            self.error,
+            self.normal,
+        )
+        .at_time(hit.time)
+    }
+}
+
 impl Light {
     /// Emitted power in luminance units, used to choose lights.
     pub fn power(&self) -> f32 {
