@@ -16,6 +16,7 @@ pub mod mitsuba;
 pub mod obj;
 pub mod ply;
 pub mod serialized;
+mod shading;
 
 use crate::accel::mask::Masks;
 use crate::accel::{AccelChoice, Geometry, NO_LIGHT, Sphere, SurfaceHit, TriangleInput};
@@ -27,7 +28,7 @@ use crate::texture::Texture;
 use emitters::EmitterShape;
 use glam::Vec3A;
 use light::{Light, LightSampling, Lights, PlanarEmitter};
-use material::{Bsdf, Material, NormalMap, Opacity};
+use material::{Bsdf, Material, Opacity};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -529,60 +530,6 @@ impl Scene {
         match material.textures.diffuse {
             Some(t) => Some((self.textures[t as usize].mean(), true)),
             None => Some((albedo, approximated)),
-        }
-    }
-
-    /// The shading normal at `hit`: the interpolated vertex normal (the
-    /// geometric one without), tilted by the material's normal map. BSDFs
-    /// act in its frame; offsets, emission and densities keep the geometric
-    /// normal.
-    #[inline(always)]
-    pub fn shading_normal(&self, hit: &SurfaceHit) -> Vec3A {
-        if !self.features.shading_normals {
-            return hit.normal;
-        }
-        let n = self.geometry.shading_normal(hit);
-        if !self.features.normal_maps {
-            return n;
-        }
-        match self.materials[hit.material as usize].normal_map {
-            Some(map) => self.normal_mapped(hit, n, map),
-            None => n,
-        }
-    }
-
-    /// `n` tilted by `map` at `hit` (Mitsuba's `normalmap` and `bumpmap`);
-    /// `n` where the surface has no uv derivatives or the map no direction.
-    #[inline(never)]
-    fn normal_mapped(&self, hit: &SurfaceHit, n: Vec3A, map: NormalMap) -> Vec3A {
-        let Some((dpdu, dpdv)) = self.geometry.uv_derivatives(hit) else {
-            return n;
-        };
-        let uv = self.geometry.uv(hit);
-        let m = match map {
-            NormalMap::Tangent { texture, scale } => {
-                let s = (dpdu - n * n.dot(dpdu)).normalize_or_zero();
-                if s == Vec3A::ZERO {
-                    return n;
-                }
-                let t = n.cross(s);
-                let local = self.textures[texture as usize].eval(uv) * 2.0 - Vec3A::ONE;
-                s * (local.x * scale) + t * (local.y * scale) + n * local.z
-            }
-            NormalMap::Bump { texture, scale } => {
-                let g = scale * self.textures[texture as usize].eval_gradient(uv);
-                let du = dpdu + n * (g.x - n.dot(dpdu));
-                let dv = dpdv + n * (g.y - n.dot(dpdv));
-                let m = du.cross(dv);
-                // On the side of the geometric normal, as Mitsuba flips it.
-                if m.dot(hit.normal) < 0.0 { -m } else { m }
-            }
-        }
-        .normalize_or_zero();
-        if m.is_finite() && m != Vec3A::ZERO {
-            m
-        } else {
-            n
         }
     }
 
