@@ -235,14 +235,9 @@ fn environment_importance_sampling_cuts_the_variance() {
     assert!(v_u > 10.0 * v_i, "variance only {:.1}x lower", v_u / v_i);
 }
 
-/// Light from infinity and delta lights in light tracing and BDPT: particles from
-/// the environment's and the directional light's discs and from the spot's
-/// cone agree with path tracing's light samples (the floor fills the
-/// frame, so no pixel sees the environment itself, which light tracing
-/// cannot).
-#[test]
-fn light_tracing_agrees_with_path_tracing_under_every_light() {
-    let text = r#"
+/// A floor and a rough plastic ball under a spot, a directional light and
+/// a constant environment.
+const EVERY_LIGHT: &str = r#"
 [camera]
 eye = [0.0, -4.0, 2.5]
 look_at = [0.0, 0.0, 0.5]
@@ -285,6 +280,15 @@ irradiance = [1.5, 1.2, 0.9]
 type = "constant"
 radiance = [0.3, 0.35, 0.4]
 "#;
+
+/// Light from infinity and delta lights in light tracing and BDPT: particles from
+/// the environment's and the directional light's discs and from the spot's
+/// cone agree with path tracing's light samples (the floor fills the
+/// frame, so no pixel sees the environment itself, which light tracing
+/// cannot).
+#[test]
+fn light_tracing_agrees_with_path_tracing_under_every_light() {
+    let text = EVERY_LIGHT;
     let scene = load_scene_text("every-light", text);
     let path = render(
         scene.clone(),
@@ -593,32 +597,24 @@ material = "ball"
 #[test]
 fn every_technique_agrees_under_a_normal_map() {
     let bumps = repo_path("tests/data/materials/bumps.exr");
-    let text = format!(
-        r#"
-[camera]
-eye = [0.0, -4.0, 2.5]
-look_at = [0.0, 0.0, 0.5]
-up = [0.0, 0.0, 1.0]
-fov_y = 35.0
-width = 64
-height = 64
-
+    // The spot-lit room of EVERY_LIGHT with a lamp instead of the lights
+    // at infinity, and the map on the floor and the ball.
+    let spot_only = &EVERY_LIGHT[..EVERY_LIGHT.find("[[directional_light]]").unwrap()];
+    let text = spot_only
+        .replace(
+            "albedo = [0.4, 0.4, 0.4]\n",
+            "albedo = [0.4, 0.4, 0.4]\nnormal_map_texture = \"bumps\"\n",
+        )
+        .replace(
+            "diffuse_reflectance = [0.6, 0.3, 0.2]\n",
+            "diffuse_reflectance = [0.6, 0.3, 0.2]\nnormal_map_texture = \"bumps\"\n",
+        )
+        + &format!(
+            r#"
 [textures.bumps]
 type = "bitmap"
 file = {:?}
 raw = true
-
-[materials.floor]
-type = "diffuse"
-albedo = [0.4, 0.4, 0.4]
-normal_map_texture = "bumps"
-
-[materials.ball]
-type = "roughplastic"
-distribution = "ggx"
-alpha = 0.3
-diffuse_reflectance = [0.6, 0.3, 0.2]
-normal_map_texture = "bumps"
 
 [materials.lamp]
 type = "diffuse"
@@ -626,29 +622,14 @@ albedo = [0.0, 0.0, 0.0]
 emission = [3.0, 3.0, 3.0]
 
 [[quad]]
-corner = [-20.0, -20.0, 0.0]
-u = [40.0, 0.0, 0.0]
-v = [0.0, 40.0, 0.0]
-material = "floor"
-
-[[quad]]
 corner = [0.2, -2.2, 3.0]
 u = [0.0, 2.0, 0.0]
 v = [2.0, 0.0, 0.0]
 material = "lamp"
-
-[[sphere]]
-center = [0.0, 0.0, 0.6]
-radius = 0.6
-material = "ball"
-
-[[spot_light]]
-position = [-2.0, -2.0, 2.0]
-target = [0.0, 0.0, 0.3]
-intensity = [20.0, 18.0, 15.0]
 "#,
-        bumps.display().to_string()
-    );
+            bumps.display().to_string()
+        );
+    assert_eq!(text.matches("normal_map_texture").count(), 2);
     let scene = load_scene_text("normal-map", &text);
     assert!(scene.features.normal_maps && scene.features.shading_normals);
     let path = render(

@@ -155,59 +155,61 @@ impl RoughPlastic {
     }
 }
 
-/// Directional albedo of the coating's specular reflection (Fresnel at
-/// relative IOR `eta`) at incident cosine `cos`: E[F(wo·m) G1(wi)] over
-/// visible normals, by a 64 × 64 midpoint rule in the sampler's unit
-/// square, where the integrand is smooth at any roughness.
-fn specular_albedo(microfacet: &Microfacet, cos: f32, eta: f32) -> f32 {
+/// The mean of `term(wo, m)` over the normals visible from the direction
+/// at incident cosine `cos` (in the xz-plane), by a 64 × 64 midpoint rule
+/// in the sampler's unit square, where the integrand is smooth at any
+/// roughness.
+fn visible_normal_mean(
+    microfacet: &Microfacet,
+    cos: f32,
+    term: impl Fn(Vec3A, Vec3A) -> f32,
+) -> f32 {
     const N: usize = 64;
-    let cos = cos.max(1e-4);
     let wo = Vec3A::new((1.0 - cos * cos).max(0.0).sqrt(), 0.0, cos);
     let mut sum = 0.0f64;
     for i in 0..N {
         for j in 0..N {
             let u = Vec2::new((i as f32 + 0.5) / N as f32, (j as f32 + 0.5) / N as f32);
-            let m = microfacet.sample_visible(wo, u);
-            let dot = wo.dot(m);
-            let wi = 2.0 * dot * m - wo;
-            if wi.z > 0.0 && dot > 0.0 {
-                let f = fresnel_dielectric(dot, eta).reflectance;
-                sum += (f * microfacet.g1(wi, m)) as f64;
-            }
+            sum += f64::from(term(wo, microfacet.sample_visible(wo, u)));
         }
     }
     (sum / (N * N) as f64) as f32
+}
+
+/// Directional albedo of the coating's specular reflection (Fresnel at
+/// relative IOR `eta`) at incident cosine `cos`: E[F(wo·m) G1(wi)] over
+/// visible normals.
+fn specular_albedo(microfacet: &Microfacet, cos: f32, eta: f32) -> f32 {
+    visible_normal_mean(microfacet, cos.max(1e-4), |wo, m| {
+        let dot = wo.dot(m);
+        let wi = 2.0 * dot * m - wo;
+        if wi.z > 0.0 && dot > 0.0 {
+            fresnel_dielectric(dot, eta).reflectance * microfacet.g1(wi, m)
+        } else {
+            0.0
+        }
+    })
 }
 
 /// Directional transmittance of the coating at incident cosine `cos` into
 /// a medium of relative IOR `eta`: E[(1 − F(wo·m)) G1(wt, m)] over visible
 /// normals, wt the direction refracted through m (Mitsuba 3's
 /// `eval_transmittance`; the refracted ray's shadowing makes it fall
-/// faster towards grazing than 1 − the reflectance), by the midpoint rule
-/// of [`specular_albedo`].
+/// faster towards grazing than 1 − the reflectance).
 fn coating_transmittance(microfacet: &Microfacet, cos: f32, eta: f32) -> f32 {
-    const N: usize = 64;
-    let cos = cos.max(1e-6);
-    let wo = Vec3A::new((1.0 - cos * cos).max(0.0).sqrt(), 0.0, cos);
-    let mut sum = 0.0f64;
-    for i in 0..N {
-        for j in 0..N {
-            let u = Vec2::new((i as f32 + 0.5) / N as f32, (j as f32 + 0.5) / N as f32);
-            let m = microfacet.sample_visible(wo, u);
-            let dot = wo.dot(m);
-            let sin2_t = (1.0 - dot * dot).max(0.0) / (eta * eta);
-            if dot <= 0.0 || sin2_t >= 1.0 {
-                continue;
-            }
-            let cos_t = (1.0 - sin2_t).sqrt();
-            let wt = -wo / eta + m * (dot / eta - cos_t);
-            if wt.z < 0.0 {
-                let f = fresnel_dielectric(dot, eta).reflectance;
-                sum += ((1.0 - f) * microfacet.g1(wt, m)) as f64;
-            }
+    visible_normal_mean(microfacet, cos.max(1e-6), |wo, m| {
+        let dot = wo.dot(m);
+        let sin2_t = (1.0 - dot * dot).max(0.0) / (eta * eta);
+        if dot <= 0.0 || sin2_t >= 1.0 {
+            return 0.0;
         }
-    }
-    (sum / (N * N) as f64) as f32
+        let wt = -wo / eta + m * (dot / eta - (1.0 - sin2_t).sqrt());
+        if wt.z < 0.0 {
+            (1.0 - fresnel_dielectric(dot, eta).reflectance) * microfacet.g1(wt, m)
+        } else {
+            0.0
+        }
+    })
 }
 
 /// The coating tables for (distribution, α, η), computed on first use.
