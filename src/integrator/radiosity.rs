@@ -417,6 +417,7 @@ impl Radiosity {
                 method: self.form_factors,
                 samples: self.form_factor_samples,
                 max_nodes: MAX_NODES,
+                clusters: crate::radiosity::cluster::ClusterKind::Oriented,
             };
             let hierarchy = Hierarchy::build(scene, settings).map_err(crate::Error::new)?;
             return Ok(RadiosityState {

@@ -24,6 +24,7 @@
 //! reference, the sum over every pair of triangles, uses.
 
 use super::form_factor::point_to_polygon;
+pub use crate::scene::mesh::uv_sphere;
 use glam::Vec3A;
 use rayon::prelude::*;
 use std::f32::consts::PI;
@@ -63,6 +64,8 @@ pub struct ClusterTree {
     triangles: Vec<[Vec3A; 3]>,
     normals: Vec<Vec3A>,
     areas: Vec<f32>,
+    /// Per triangle in tree order, its index in the input.
+    order: Vec<u32>,
 }
 
 impl ClusterTree {
@@ -124,6 +127,7 @@ impl ClusterTree {
             areas: cross.iter().map(|c| 0.5 * c.length()).collect(),
             nodes,
             triangles,
+            order,
         };
         for node in &mut tree.nodes {
             let tris = &tree.triangles[node.first as usize..(node.first + node.count) as usize];
@@ -159,8 +163,32 @@ impl ClusterTree {
         self.nodes.len()
     }
 
+    /// Node `i`'s bounding sphere (centre, radius) and area.
+    pub(crate) fn sphere(&self, i: usize) -> (Vec3A, f32, f32) {
+        let n = &self.nodes[i];
+        (n.center, n.radius, n.area)
+    }
+
+    /// Node `i`'s triangles in tree order (`first..first + count`) and its
+    /// first child (the second follows), or None for a leaf.
+    pub(crate) fn range(&self, i: usize) -> (usize, usize, Option<usize>) {
+        let n = &self.nodes[i];
+        let children = (n.children != LEAF).then_some(n.children as usize);
+        (n.first as usize, n.count as usize, children)
+    }
+
+    /// The input index of the triangle at tree position `t`.
+    pub(crate) fn input_index(&self, t: usize) -> u32 {
+        self.order[t]
+    }
+
+    /// Triangle `t` (tree order): its vertices and unit normal.
+    pub(crate) fn triangle(&self, t: usize) -> ([Vec3A; 3], Vec3A) {
+        (self.triangles[t], self.normals[t])
+    }
+
     /// The area of node `i` projected towards unit direction `d`.
-    fn projected(&self, i: usize, d: Vec3A, kind: ClusterKind) -> f32 {
+    pub(crate) fn projected(&self, i: usize, d: Vec3A, kind: ClusterKind) -> f32 {
         let n = &self.nodes[i];
         match kind {
             ClusterKind::Isotropic if n.count > 1 => 0.25 * n.area,
@@ -313,36 +341,6 @@ pub fn triangle_row(a: &ClusterTree, i: usize, b: &ClusterTree) -> f64 {
         .map(|j| f64::from(triangle_to_triangle(a, i, b, j)))
         .sum();
     row * f64::from(a.areas[i])
-}
-
-/// A UV sphere of `rings` × `segments` quads (two triangles each; the
-/// poles' fans degenerate to one), outward-facing.
-pub fn uv_sphere(center: Vec3A, radius: f32, rings: u32, segments: u32) -> Vec<[Vec3A; 3]> {
-    let point = |ring: u32, seg: u32| {
-        let theta = PI * ring as f32 / rings as f32;
-        let phi = 2.0 * PI * seg as f32 / segments as f32;
-        center
-            + radius
-                * Vec3A::new(
-                    theta.sin() * phi.cos(),
-                    theta.sin() * phi.sin(),
-                    theta.cos(),
-                )
-    };
-    let mut triangles = Vec::with_capacity((2 * rings * segments) as usize);
-    for ring in 0..rings {
-        for seg in 0..segments {
-            let (a, b) = (point(ring, seg), point(ring, seg + 1));
-            let (c, d) = (point(ring + 1, seg + 1), point(ring + 1, seg));
-            if ring > 0 {
-                triangles.push([a, d, b]);
-            }
-            if ring + 1 < rings {
-                triangles.push([b, d, c]);
-            }
-        }
-    }
-    triangles
 }
 
 #[cfg(test)]

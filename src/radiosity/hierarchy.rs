@@ -22,19 +22,23 @@ use super::form_factor::{
     EXPOSURE_POINTS, Exchange, FormFactorMethod, exposure, faces, point_to_polygon,
     probed_element_to_element, sent_radiance,
 };
+use super::cluster::ClusterKind;
 use super::mesh::{back_of, exposed_backs};
 use crate::accel::Geometry;
 use crate::math::Rgb;
 use crate::scene::Scene;
 use rayon::prelude::*;
 
+mod clusters;
 mod queries;
 mod smooth;
 
-/// A link: the node gathers from `source` with form factor `f`, of which
-/// the share `visibility` of its shadow rays arrived; `f_max` is the
-/// oracle's unoccluded bound (geometry only, so kept rather than recomputed
-/// at every step).
+use clusters::{Clusters, is_cluster};
+
+/// A link: the node gathers from `source` (a node, or a cluster: see
+/// [`clusters`]) with form factor `f`, of which the share `visibility` of
+/// its shadow rays arrived; `f_max` is the oracle's unoccluded bound
+/// (geometry only, so kept rather than recomputed at every step).
 #[derive(Clone, Copy, Debug)]
 struct Link {
     source: u32,
@@ -61,8 +65,6 @@ struct Node {
 }
 
 const NONE: u32 = u32::MAX;
-/// Most patches (input triangles): their pairs are the initial links.
-const MAX_PATCHES: usize = 4096;
 /// Deepest level of a patch's tree.
 const MAX_DEPTH: u8 = 10;
 
@@ -77,6 +79,8 @@ pub struct HierarchySettings {
     pub samples: u32,
     /// Most nodes (each about 100 bytes plus its links).
     pub max_nodes: usize,
+    /// How clusters above the patches estimate their projected area.
+    pub clusters: ClusterKind,
 }
 
 /// The trees, their links and the solution.
@@ -88,6 +92,8 @@ pub struct Hierarchy {
     back_roots: Vec<u32>,
     /// Per scene triangle, whether its back is a patch of its own.
     two_sided: Vec<bool>,
+    /// The clusters above the patches, their links and radiance.
+    clusters: Clusters,
     min_area: f32,
     emitted: f64,
     settings: HierarchySettings,
@@ -159,6 +165,20 @@ impl Hierarchy {
             ));
         }
         let geometry = &scene.geometry;
+        // Every triangle may be a patch on both sides; refused before any
+        // allocation grows with them.
+        let most = 2 * geometry.triangles().len();
+        let per_patch = std::mem::size_of::<Node>() + clusters::BYTES_PER_PATCH;
+        if most > settings.max_nodes {
+            return Err(format!(
+                "{} triangles may need {} patches (about {} MiB before refinement), more than \
+                 the budget of {} elements",
+                geometry.triangles().len(),
+                most,
+                (most * per_patch) >> 20,
+                settings.max_nodes
+            ));
+        }
         let bounds = geometry.bounds();
         let diagonal = (bounds.max - bounds.min).length();
         let mut nodes = Vec::new();
@@ -218,11 +238,13 @@ impl Hierarchy {
             );
         }
         let min_size = settings.min_size * diagonal;
+        let clusters = Clusters::build(&nodes, settings.clusters);
         let mut h = Hierarchy {
             nodes,
             roots,
             back_roots,
             two_sided,
+            clusters,
             // The area of an equilateral triangle of edge min_size.
             min_area: 0.433 * min_size * min_size,
             emitted,
@@ -249,23 +271,11 @@ impl Hierarchy {
         if let Some(note) = super::mesh::unpatched_lights(scene) {
             h.notes.push(note);
         }
-        // Without clustering every pair of patches starts with a link.
-        if h.nodes.len() > MAX_PATCHES {
-            return Err(format!(
-                "hierarchical radiosity links every pair of input triangles at the start \
-                 (there is no clustering yet): {} patches are more than {MAX_PATCHES}",
-                h.nodes.len()
-            ));
-        }
-        let patches = h.nodes.len() as u32;
-        let pairs: Vec<(u32, u32, bool)> = (0..patches)
-            .flat_map(|p| (0..patches).map(move |q| (p, q, false)))
-            .filter(|&(p, q, _)| {
-                p != q && faces(&h.nodes[p as usize].element, &h.nodes[q as usize].element)
-            })
-            .collect();
+        // One self-link of the whole scene, refined by the oracle.
         h.measure_exposure(geometry);
-        h.link(geometry, pairs);
+        if let Some(root) = h.clusters.root() {
+            h.link_all(geometry, vec![(root, root, false)]);
+        }
         Ok(h)
     }
 
@@ -276,6 +286,9 @@ impl Hierarchy {
     /// around a block lit the block's base too little (its dark band, 28% of
     /// the squared error at ε 1e-4).
     fn exitant(&self, k: u32) -> Rgb {
+        if is_cluster(k) {
+            return self.cluster_sent(k);
+        }
         let node = &self.nodes[k as usize];
         // Nodes made by this round's refinement are measured before the next.
         let exposure = if node.exposure.is_nan() {
@@ -284,6 +297,16 @@ impl Hierarchy {
             node.exposure
         };
         sent_radiance(node.radiance, node.element.emission, exposure)
+    }
+
+    /// The radiance node or cluster k sent in the last step's gather (what
+    /// it sends now, if made since).
+    fn sent_by(&self, k: u32) -> Rgb {
+        if is_cluster(k) {
+            return self.cluster_sent(k);
+        }
+        let from = self.gathered_from.get(k as usize);
+        from.copied().unwrap_or_else(|| self.exitant(k))
     }
 
     /// Measures the exposure of nodes made since the last call, in parallel.
@@ -312,15 +335,16 @@ impl Hierarchy {
     /// Leaves and links, for reports.
     pub fn counts(&self) -> (usize, usize) {
         let leaves = self.nodes.iter().filter(|n| n.children == NONE).count();
-        let links = self.nodes.iter().map(|n| n.links.len()).sum();
-        (leaves, links)
+        let links = self.nodes.iter().map(|n| n.links.len()).sum::<usize>();
+        (leaves, links + self.clusters.link_count())
     }
 
     /// Bytes the nodes and links take.
     pub fn memory_bytes(&self) -> usize {
-        let (_, links) = self.counts();
+        let links: usize = self.nodes.iter().map(|n| n.links.len()).sum();
         self.nodes.len() * std::mem::size_of::<Node>()
             + links * std::mem::size_of::<Link>()
+            + self.clusters.memory_bytes()
             + self.gathered_from.len() * std::mem::size_of::<Rgb>()
             + self.vertex_radiance.memory_bytes()
     }
@@ -354,6 +378,9 @@ impl Hierarchy {
 
     /// Whether node `k` may be subdivided.
     fn divisible(&self, k: u32) -> bool {
+        if is_cluster(k) {
+            return true;
+        }
         let n = &self.nodes[k as usize];
         n.depth < MAX_DEPTH && n.element.area > 4.0 * self.min_area
     }
@@ -401,7 +428,18 @@ impl Hierarchy {
         Some(first)
     }
 
-    /// Links every (gatherer, source, forced) pair, subdividing while the
+    /// Links every (gatherer, source, forced) pair: those with a cluster at
+    /// one end through the clusters' oracle, which hands the pairs of
+    /// elements it reaches to [`Hierarchy::link`].
+    fn link_all(&mut self, geometry: &Geometry, pairs: Vec<(u32, u32, bool)>) {
+        let (clustered, mut elements): (Vec<_>, Vec<_>) = pairs
+            .into_iter()
+            .partition(|&(p, q, _)| is_cluster(p) || is_cluster(q));
+        self.link_clusters(geometry, clustered, &mut elements);
+        self.link(geometry, elements);
+    }
+
+    /// Links every (gatherer, source, forced) pair of elements, subdividing while the
     /// oracle finds an exchange too coarse; a forced pair is split once
     /// regardless. The new links' form factors, where the rays go, are
     /// estimated in parallel between rounds of refinement; a partly visible
@@ -531,16 +569,27 @@ impl Hierarchy {
         let sent: Vec<Rgb> = (0..self.nodes.len() as u32)
             .map(|k| self.exitant(k))
             .collect();
+        self.clusters.pull(&sent);
+        self.gathered_from = sent;
         let gathered: Vec<Rgb> = self
             .nodes
             .par_iter()
             .map(|n| {
                 n.links
                     .iter()
-                    .fold(Rgb::ZERO, |acc, l| acc + l.f * sent[l.source as usize])
+                    .fold(Rgb::ZERO, |acc, l| acc + l.f * self.sent_by(l.source))
             })
             .collect();
-        self.gathered_from = sent;
+        // What the patches' ancestor clusters gathered, by each patch's normal.
+        let patches = self.clusters.patch_count() as u32;
+        let from_clusters: Vec<Rgb> = (0..patches)
+            .into_par_iter()
+            .map(|k| {
+                let e = &self.nodes[k as usize].element;
+                let centroid = (e.vertices[0] + e.vertices[1] + e.vertices[2]) / 3.0;
+                self.cluster_irradiance(k, centroid, e.normal)
+            })
+            .collect();
         for (n, g) in self.nodes.iter_mut().zip(gathered) {
             n.gathered = g;
         }
@@ -553,13 +602,13 @@ impl Hierarchy {
                 .unwrap_or_else(|| self.back_roots[r - self.roots.len()]);
             if root != NONE {
                 let old = self.nodes[root as usize].radiance;
-                let new = self.push_pull(root, Rgb::ZERO);
+                let new = self.push_pull(root, from_clusters[root as usize]);
                 change += self.nodes[root as usize].element.area as f64
                     * luminance((new - old).abs()) as f64;
             }
         }
         // Refine: every link the oracle now finds too coarse is replaced by finer ones.
-        let mut coarse = Vec::new();
+        let mut coarse = self.coarse_cluster_links();
         for p in 0..self.nodes.len() as u32 {
             let before = coarse.len();
             for l in &self.nodes[p as usize].links {
@@ -577,7 +626,7 @@ impl Hierarchy {
                     .retain(|l| !removed.iter().any(|&(_, q, _)| q == l.source));
             }
         }
-        self.link(geometry, coarse);
+        self.link_all(geometry, coarse);
         change / self.emitted
     }
 

@@ -26,6 +26,7 @@
 //! center = [0, 1, 0]
 //! radius = 0.5
 //! material = "glass"
+//! triangles = 100000       # optional: a UV sphere mesh of about this many triangles
 //!
 //! [[quad]]                 # corner + s u + t v, s, t in [0, 1]; normal u x v
 //! corner = [0, 0, 0]
@@ -218,6 +219,10 @@ pub struct SphereDesc {
     pub center: [f32; 3],
     pub radius: f32,
     pub material: String,
+    /// A UV sphere mesh of about this many triangles (flat shaded) in
+    /// place of the exact sphere: what radiosity, which meshes triangles,
+    /// can solve, and a large mesh for tests and benches.
+    pub triangles: Option<u32>,
     #[serde(default)]
     pub velocity: [f32; 3],
 }

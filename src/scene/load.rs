@@ -270,13 +270,44 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
                 ),
             ));
         }
+        let emissive = materials[material as usize].is_emissive();
+        if let Some(wanted) = s.triangles {
+            // About 4 rings² triangles with twice as many segments as rings.
+            let rings = ((wanted as f64 / 4.0).sqrt().ceil() as u32).max(2);
+            let count = 4 * rings as usize * rings as usize;
+            if wanted == 0 || triangles.len() + count > limits.max_triangles {
+                return Err(at(
+                    sphere.span(),
+                    format!(
+                        "sphere: `triangles` must be in 1..={} (--max-triangles), got {wanted}",
+                        limits.max_triangles.saturating_sub(triangles.len())
+                    ),
+                ));
+            }
+            let mesh = crate::scene::mesh::uv_sphere(center, s.radius, rings, 2 * rings)
+                .into_iter()
+                .map(|vertices| TriangleInput {
+                    vertices,
+                    material,
+                    uvs: None,
+                    normals: None,
+                });
+            match motion_of(s.velocity, sphere.span(), emissive)? {
+                Some(velocity) => moving.push(MovingInput {
+                    triangles: mesh.collect(),
+                    spheres: Vec::new(),
+                    velocity,
+                }),
+                None => triangles.extend(mesh),
+            }
+            continue;
+        }
         let primitive = Sphere {
             center,
             radius: s.radius,
             material,
             light: NO_LIGHT,
         };
-        let emissive = materials[material as usize].is_emissive();
         match motion_of(s.velocity, sphere.span(), emissive)? {
             Some(velocity) => moving.push(MovingInput {
                 triangles: Vec::new(),

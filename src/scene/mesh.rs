@@ -252,6 +252,37 @@ pub fn smooth_by_angle(triangles: &mut [TriangleInput], max_angle: f32) {
     }
 }
 
+/// A UV sphere of `rings` × `segments` quads (two triangles each; the
+/// poles' fans degenerate to one), outward-facing.
+pub fn uv_sphere(center: Vec3A, radius: f32, rings: u32, segments: u32) -> Vec<[Vec3A; 3]> {
+    use std::f32::consts::PI;
+    let point = |ring: u32, seg: u32| {
+        let theta = PI * ring as f32 / rings as f32;
+        let phi = 2.0 * PI * seg as f32 / segments as f32;
+        center
+            + radius
+                * Vec3A::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                )
+    };
+    let mut triangles = Vec::with_capacity((2 * rings * segments) as usize);
+    for ring in 0..rings {
+        for seg in 0..segments {
+            let (a, b) = (point(ring, seg), point(ring, seg + 1));
+            let (c, d) = (point(ring + 1, seg + 1), point(ring + 1, seg));
+            if ring > 0 {
+                triangles.push([a, d, b]);
+            }
+            if ring + 1 < rings {
+                triangles.push([b, d, c]);
+            }
+        }
+    }
+    triangles
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -52,7 +52,11 @@ impl Hierarchy {
             .iter()
             .chain(&self.back_roots)
             .filter(|&&r| r != NONE)
-            .map(|&r| (r, 0.0))
+            .map(|&r| {
+                let e = &self.nodes[r as usize].element;
+                let centroid = (e.vertices[0] + e.vertices[1] + e.vertices[2]) / 3.0;
+                (r, self.cluster_form_factor(r, centroid, e.normal))
+            })
             .collect();
         while let Some((k, above)) = stack.pop() {
             let n = &self.nodes[k as usize];

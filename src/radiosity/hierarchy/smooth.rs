@@ -1,7 +1,7 @@
 //! The smooth display of a hierarchy: radiance gathered at the leaves'
 //! vertices over their links and their ancestors'.
 
-use super::{Hierarchy, NONE, VERTEX_RAYS};
+use super::{Hierarchy, NONE, VERTEX_RAYS, is_cluster};
 use crate::accel::Geometry;
 use crate::math::Rgb;
 use crate::radiosity::VertexField;
@@ -61,9 +61,14 @@ impl Hierarchy {
                 // Just inside: on a neighbour's edge the integral is singular.
                 let x = v + 0.05 * (centroid - v);
                 let mut irradiance = Rgb::ZERO;
-                let mut a = k;
+                let (mut a, mut root) = (k, k);
                 while a != NONE {
                     for link in &self.nodes[a as usize].links {
+                        if is_cluster(link.source) {
+                            let f = self.point_to_cluster(x, e.normal, link.source);
+                            irradiance += (link.visibility * f) * self.sent_by(link.source);
+                            continue;
+                        }
                         let q = &self.nodes[link.source as usize];
                         // One-sided sources send nothing behind their plane.
                         if q.element.normal.dot(x - q.element.vertices[0]) <= 0.0 {
@@ -78,12 +83,12 @@ impl Hierarchy {
                         } else {
                             link.visibility
                         };
-                        let from = self.gathered_from.get(link.source as usize);
-                        let sent = from.copied().unwrap_or_else(|| self.exitant(link.source));
-                        irradiance += (visibility * f) * sent;
+                        irradiance += (visibility * f) * self.sent_by(link.source);
                     }
+                    root = a;
                     a = parent[a as usize];
                 }
+                irradiance += self.cluster_irradiance(root, x, e.normal);
                 let x_error = crate::math::gamma(7) * x.abs();
                 let (open, _) = open_at(
                     geometry,
