@@ -23,6 +23,8 @@ mod lab;
 mod form_factors;
 // Radiosity: a closed box against its closed form at any scale, the Cornell box.
 mod radiosity;
+// Radiosity with clusters on a mesh of 100 000 triangles against path tracing.
+mod clusters;
 // BSDF energy conservation, reciprocity and sample/eval/pdf consistency.
 mod bsdf;
 // Whitted by hand, MC ray tracing's ray count.

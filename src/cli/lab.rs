@@ -43,15 +43,15 @@ pub(super) struct ExperimentArg(pub(super) Experiment);
 
 impl ValueEnum for ExperimentArg {
     fn value_variants<'a>() -> &'a [Self] {
-        const VARIANTS: [ExperimentArg; 7] = [
-            ExperimentArg(Experiment::ALL[0]),
-            ExperimentArg(Experiment::ALL[1]),
-            ExperimentArg(Experiment::ALL[2]),
-            ExperimentArg(Experiment::ALL[3]),
-            ExperimentArg(Experiment::ALL[4]),
-            ExperimentArg(Experiment::ALL[5]),
-            ExperimentArg(Experiment::ALL[6]),
-        ];
+        const VARIANTS: [ExperimentArg; Experiment::ALL.len()] = {
+            let mut all = [ExperimentArg(Experiment::Pi); Experiment::ALL.len()];
+            let mut i = 0;
+            while i < all.len() {
+                all[i] = ExperimentArg(Experiment::ALL[i]);
+                i += 1;
+            }
+            all
+        };
         &VARIANTS
     }
 

@@ -9,6 +9,7 @@
 //! writes it (`tracelab lab`), the viewer draws it live (its "MC lab" tab)
 //! from the partial reports an experiment publishes as its N grows.
 
+pub mod cluster_solve;
 pub mod clusters;
 pub mod coins;
 pub mod importance;
@@ -46,10 +47,12 @@ pub enum Experiment {
     Warps,
     /// The form factor between two meshes by cluster links (radiosity).
     Clusters,
+    /// Radiosity with clusters on a mesh of N triangles: links and memory against N.
+    ClusterSolve,
 }
 
 impl Experiment {
-    pub const ALL: [Experiment; 7] = [
+    pub const ALL: [Experiment; 8] = [
         Experiment::Pi,
         Experiment::Coins,
         Experiment::Stratified,
@@ -57,6 +60,7 @@ impl Experiment {
         Experiment::PointSets,
         Experiment::Warps,
         Experiment::Clusters,
+        Experiment::ClusterSolve,
     ];
 
     /// Name on the command line.
@@ -69,6 +73,7 @@ impl Experiment {
             Experiment::PointSets => "point-sets",
             Experiment::Warps => "warps",
             Experiment::Clusters => "clusters",
+            Experiment::ClusterSolve => "cluster-solve",
         }
     }
 
@@ -82,6 +87,7 @@ impl Experiment {
             Experiment::PointSets => "Point sets",
             Experiment::Warps => "Warps and their pdfs",
             Experiment::Clusters => "Clusters: the form factor of two meshes",
+            Experiment::ClusterSolve => "Clusters: radiosity of a mesh in a room",
         }
     }
 
@@ -95,6 +101,7 @@ impl Experiment {
             Experiment::PointSets => point_sets::TEXT,
             Experiment::Warps => warps::TEXT,
             Experiment::Clusters => clusters::TEXT,
+            Experiment::ClusterSolve => cluster_solve::TEXT,
         }
     }
 
@@ -113,6 +120,7 @@ impl Experiment {
             Experiment::PointSets => (4096, 256),
             Experiment::Warps => (1_000_000, 1),
             Experiment::Clusters => (4096, 1),
+            Experiment::ClusterSolve => (100_000, 1),
         };
         LabSettings {
             experiment: self,
@@ -136,6 +144,12 @@ impl Experiment {
                 settings.n
             ));
         }
+        if self == Experiment::ClusterSolve && settings.n > MAX_SOLVE_TRIANGLES {
+            return Err(format!(
+                "cluster-solve meshes at most {MAX_SOLVE_TRIANGLES} triangles (about 600 bytes each with its BVH), got {}",
+                settings.n
+            ));
+        }
         if self == Experiment::Clusters && settings.n > MAX_CLUSTER_TRIANGLES {
             return Err(format!(
                 "clusters sums every pair of triangles for its reference, O(N^2): N is at most {MAX_CLUSTER_TRIANGLES}, got {}",
@@ -155,6 +169,7 @@ impl Experiment {
             Experiment::PointSets => point_sets::run(settings, progress),
             Experiment::Warps => warps::run(settings, progress),
             Experiment::Clusters => clusters::run(settings, progress),
+            Experiment::ClusterSolve => cluster_solve::run(settings, progress),
         }?;
         progress.publish(&report);
         Ok(report)
@@ -180,6 +195,9 @@ pub struct LabSettings {
 
 /// The largest mesh `clusters` accepts (its reference is O(N²)).
 pub const MAX_CLUSTER_TRIANGLES: u32 = 16_384;
+
+/// The largest sphere `cluster-solve` meshes.
+pub const MAX_SOLVE_TRIANGLES: u32 = 2_000_000;
 
 /// The largest point set `point-sets` accepts.
 pub const MAX_POINT_SET: u32 = 1 << 16;

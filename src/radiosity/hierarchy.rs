@@ -17,12 +17,12 @@
 //! its open part may see through them.
 
 use super::VertexField;
+use super::cluster::ClusterKind;
 use super::element::Element;
 use super::form_factor::{
     EXPOSURE_POINTS, Exchange, FormFactorMethod, exposure, faces, point_to_polygon,
     probed_element_to_element, sent_radiance,
 };
-use super::cluster::ClusterKind;
 use super::mesh::{back_of, exposed_backs};
 use crate::accel::Geometry;
 use crate::math::Rgb;

@@ -231,6 +231,7 @@ pub fn lab_panel(ui: &mut egui::Ui, lab: &mut LabState) {
                 Experiment::Coins => 1 << 14,
                 Experiment::PointSets => crate::lab::MAX_POINT_SET,
                 Experiment::Clusters => crate::lab::MAX_CLUSTER_TRIANGLES,
+                Experiment::ClusterSolve => crate::lab::MAX_SOLVE_TRIANGLES,
                 _ => 10_000_000,
             };
             ui.label("Largest N");
@@ -242,7 +243,10 @@ pub fn lab_panel(ui: &mut egui::Ui, lab: &mut LabState) {
             ui.end_row();
             if !matches!(
                 current,
-                Experiment::Importance | Experiment::Warps | Experiment::Clusters
+                Experiment::Importance
+                    | Experiment::Warps
+                    | Experiment::Clusters
+                    | Experiment::ClusterSolve
             ) {
                 ui.label("Runs");
                 ui.add(

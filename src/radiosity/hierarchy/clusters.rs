@@ -204,7 +204,11 @@ impl Hierarchy {
         }
         let e = &self.nodes[r as usize].element;
         let c = (e.vertices[0] + e.vertices[1] + e.vertices[2]) / 3.0;
-        let radius = e.vertices.iter().map(|v| (*v - c).length()).fold(0.0, f32::max);
+        let radius = e
+            .vertices
+            .iter()
+            .map(|v| (*v - c).length())
+            .fold(0.0, f32::max);
         (c, radius, e.area)
     }
 
@@ -213,7 +217,10 @@ impl Hierarchy {
     fn projected_of(&self, r: u32, d: Vec3A) -> f32 {
         if is_cluster(r) {
             let kind = self.clusters.kind;
-            return self.clusters.tree.projected((r & !CLUSTER) as usize, d, kind);
+            return self
+                .clusters
+                .tree
+                .projected((r & !CLUSTER) as usize, d, kind);
         }
         let e = &self.nodes[r as usize].element;
         e.area * e.normal.dot(d).max(0.0)
@@ -246,7 +253,8 @@ impl Hierarchy {
         }
         let d = between / r;
         let spread = ((rp + rq) / r).min(1.0);
-        let widened = |x: u32, d: Vec3A, area: f32| (self.projected_of(x, d) + spread * area).min(area);
+        let widened =
+            |x: u32, d: Vec3A, area: f32| (self.projected_of(x, d) + spread * area).min(area);
         Some(widened(p, d, ap) * widened(q, -d, aq) / (PI * gap * gap))
     }
 
@@ -262,7 +270,11 @@ impl Hierarchy {
     fn split_pair(&mut self, p: u32, q: u32) -> Option<Vec<(u32, u32)>> {
         if p == q {
             let c = self.children_of(p)?;
-            return Some(c.iter().flat_map(|&a| c.iter().map(move |&b| (a, b))).collect());
+            return Some(
+                c.iter()
+                    .flat_map(|&a| c.iter().map(move |&b| (a, b)))
+                    .collect(),
+            );
         }
         let (can_p, can_q) = (self.divisible(p), self.divisible(q));
         if !can_p && !can_q {
@@ -283,7 +295,10 @@ impl Hierarchy {
         if is_cluster(r) {
             let (_, _, children) = self.clusters.tree.range((r & !CLUSTER) as usize);
             let c = children?;
-            return Some(vec![self.clusters.reference(c), self.clusters.reference(c + 1)]);
+            return Some(vec![
+                self.clusters.reference(c),
+                self.clusters.reference(c + 1),
+            ]);
         }
         let first = self.subdivide(r)?;
         Some((first..first + 4).collect())
@@ -325,7 +340,10 @@ impl Hierarchy {
                         if is_cluster(a) || is_cluster(b) {
                             next.push((a, b, false));
                         } else if a != b
-                            && faces(&self.nodes[a as usize].element, &self.nodes[b as usize].element)
+                            && faces(
+                                &self.nodes[a as usize].element,
+                                &self.nodes[b as usize].element,
+                            )
                         {
                             elements.push((a, b, false));
                         }
