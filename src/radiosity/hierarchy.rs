@@ -273,6 +273,10 @@ impl Hierarchy {
         }
         // One self-link of the whole scene, refined by the oracle.
         h.measure_exposure(geometry);
+        // The clusters' radiance (the lights) for the oracle's first round.
+        let sent: Vec<Rgb> = (0..h.nodes.len() as u32).map(|k| h.exitant(k)).collect();
+        let mean: Vec<Rgb> = h.nodes.iter().map(|n| n.radiance).collect();
+        h.clusters.pull(&sent, &mean);
         if let Some(root) = h.clusters.root() {
             h.link_all(geometry, vec![(root, root, false)]);
         }
@@ -372,7 +376,7 @@ impl Hierarchy {
     /// relative to the emitted power.
     fn transfer(&self, p: u32, q: u32, f_max: f32) -> f32 {
         let e = &self.nodes[p as usize].element;
-        let light = luminance(e.reflectance * self.exitant(q));
+        let light = luminance(e.reflectance * self.oracle_radiance(q));
         (light as f64 * f_max as f64 * e.area as f64 / self.emitted) as f32
     }
 
@@ -569,7 +573,8 @@ impl Hierarchy {
         let sent: Vec<Rgb> = (0..self.nodes.len() as u32)
             .map(|k| self.exitant(k))
             .collect();
-        self.clusters.pull(&sent);
+        let mean: Vec<Rgb> = self.nodes.iter().map(|n| n.radiance).collect();
+        self.clusters.pull(&sent, &mean);
         self.gathered_from = sent;
         let gathered: Vec<Rgb> = self
             .nodes
