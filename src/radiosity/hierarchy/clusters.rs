@@ -512,7 +512,7 @@ impl Hierarchy {
     pub(super) fn cluster_irradiance(&self, root: u32, x: Vec3A, n: Vec3A) -> Rgb {
         let mut irradiance = Rgb::ZERO;
         self.for_cluster_links(root, |l| {
-            irradiance += self.clusters.irradiance(l, x, n) * self.sent_by(l.source);
+            irradiance += self.link_irradiance(l, x, n) * self.sent_by(l.source);
         });
         irradiance
     }
@@ -522,8 +522,23 @@ impl Hierarchy {
     /// `gathered_share`).
     pub(super) fn cluster_form_factor(&self, root: u32, x: Vec3A, n: Vec3A) -> f32 {
         let mut sum = 0.0;
-        self.for_cluster_links(root, |l| sum += self.clusters.irradiance(l, x, n));
+        self.for_cluster_links(root, |l| sum += self.link_irradiance(l, x, n));
         sum
+    }
+
+    /// [`Clusters::irradiance`], with an element source's projected area
+    /// taken towards `x` itself (a cluster's costs its triangles, so it
+    /// stays the link's).
+    fn link_irradiance(&self, l: &ClusterLink, x: Vec3A, n: Vec3A) -> f32 {
+        if self.clusters.kind == ClusterKind::Oriented && !is_cluster(l.source) {
+            let between = l.center - x;
+            let r2 = between.length_squared();
+            let d = between / r2.sqrt();
+            let e = &self.nodes[l.source as usize].element;
+            let intensity = e.area * e.normal.dot(-d).max(0.0) * l.visibility / PI;
+            return intensity * n.dot(d).max(0.0) / r2;
+        }
+        self.clusters.irradiance(l, x, n)
     }
 
     /// Calls `f` on every link of patch `root`'s ancestor clusters.
