@@ -576,6 +576,7 @@ impl Hierarchy {
         let mean: Vec<Rgb> = self.nodes.iter().map(|n| n.radiance).collect();
         self.clusters.pull(&sent, &mean);
         self.gathered_from = sent;
+        self.refresh_weights();
         let gathered: Vec<Rgb> = self
             .nodes
             .par_iter()
