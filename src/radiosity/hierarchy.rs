@@ -275,8 +275,7 @@ impl Hierarchy {
         h.measure_exposure(geometry);
         // The clusters' radiance (the lights) for the oracle's first round.
         let sent: Vec<Rgb> = (0..h.nodes.len() as u32).map(|k| h.exitant(k)).collect();
-        let mean: Vec<Rgb> = h.nodes.iter().map(|n| n.radiance).collect();
-        h.clusters.pull(&sent, &mean);
+        h.pull_clusters(&sent);
         if let Some(root) = h.clusters.root() {
             h.link_all(geometry, vec![(root, root, false)]);
         }
@@ -573,8 +572,7 @@ impl Hierarchy {
         let sent: Vec<Rgb> = (0..self.nodes.len() as u32)
             .map(|k| self.exitant(k))
             .collect();
-        let mean: Vec<Rgb> = self.nodes.iter().map(|n| n.radiance).collect();
-        self.clusters.pull(&sent, &mean);
+        self.pull_clusters(&sent);
         self.gathered_from = sent;
         self.refresh_weights();
         let gathered: Vec<Rgb> = self

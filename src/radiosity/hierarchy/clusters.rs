@@ -260,6 +260,13 @@ impl Hierarchy {
         }
     }
 
+    /// Pulls the patches' radiance up the clusters, `sent` by node.
+    pub(super) fn pull_clusters(&mut self, sent: &[Rgb]) {
+        let patches = self.clusters.patch_count();
+        let mean: Vec<Rgb> = self.nodes[..patches].iter().map(|n| n.radiance).collect();
+        self.clusters.pull(sent, &mean);
+    }
+
     /// The radiance the oracle bounds a source's by: a cluster's brightest
     /// patch's, a node's own.
     pub(super) fn oracle_radiance(&self, q: u32) -> Rgb {
