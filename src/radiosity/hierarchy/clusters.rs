@@ -203,23 +203,6 @@ impl Clusters {
             };
         }
     }
-
-    /// The irradiance per unit of the source's radiance a link brings to
-    /// the point `x` (normal `n`) of a patch of the cluster: oriented, by
-    /// the point's own distance and cosine to the source's centre (by the
-    /// cluster's centre, patches as far as a cluster's radius from it were
-    /// lit up to 35% wrong, in blocks the size of clusters); isotropic, a
-    /// quarter of the cluster's value for every patch alike.
-    fn irradiance(&self, l: &ClusterLink, x: Vec3A, n: Vec3A) -> f32 {
-        match self.kind {
-            ClusterKind::Oriented => {
-                let between = l.center - x;
-                let r2 = between.length_squared();
-                l.intensity * n.dot(between).max(0.0) / (r2 * r2.sqrt())
-            }
-            ClusterKind::Isotropic => 0.25 * l.g,
-        }
-    }
 }
 
 impl Hierarchy {
@@ -536,39 +519,51 @@ impl Hierarchy {
     /// over its ancestor clusters' links, from their weights.
     pub(super) fn cluster_irradiance(&self, root: u32, x: Vec3A, n: Vec3A) -> Rgb {
         let mut irradiance = Rgb::ZERO;
-        let oriented = self.clusters.kind == ClusterKind::Oriented;
-        self.for_cluster_links(root, |l| {
-            if !oriented {
-                irradiance += l.weight;
-                return;
-            }
-            let between = l.center - x;
-            let cos = n.dot(between);
-            if cos <= 0.0 {
-                return;
-            }
-            let r2 = between.length_squared();
-            let kernel = if l.area_normal == Vec3A::ZERO {
-                cos / (r2 * r2.sqrt())
-            } else {
-                cos * (-l.area_normal.dot(between)).max(0.0) / (r2 * r2)
-            };
-            irradiance += kernel * l.weight;
-        });
+        self.for_cluster_links(root, |l| irradiance += self.kernel(l, x, n) * l.weight);
         irradiance
     }
 
-    /// A link's weight for [`Hierarchy::cluster_irradiance`] from its
-    /// source's radiance now (see [`Hierarchy::sent_by`]): oriented, the
-    /// radiance times V / π and, for a cluster source, its projected area
-    /// from the cluster's centre; isotropic, a quarter of g times it.
-    fn link_weight(&self, l: &ClusterLink) -> Rgb {
-        let sent = self.sent_by(l.source);
-        match self.clusters.kind {
-            ClusterKind::Isotropic => 0.25 * l.g * sent,
-            ClusterKind::Oriented if l.area_normal == Vec3A::ZERO => l.intensity * sent,
-            ClusterKind::Oriented => (l.visibility / PI) * sent,
+    /// The geometric part of what a link brings to the point `x` (normal
+    /// `n`) of a patch of its cluster; times the link's weight, the
+    /// irradiance. Oriented, by the point's own distance and cosine to the
+    /// source's centre (by the cluster's centre, patches a cluster's radius
+    /// from it were lit up to 35% wrong, in blocks the size of clusters),
+    /// and an element source's projected area towards the point itself (a
+    /// cluster source's costs its triangles, so it is the link's, in the
+    /// weight); isotropic, 1: every patch alike.
+    #[inline]
+    fn kernel(&self, l: &ClusterLink, x: Vec3A, n: Vec3A) -> f32 {
+        if self.clusters.kind == ClusterKind::Isotropic {
+            return 1.0;
         }
+        let between = l.center - x;
+        let cos = n.dot(between);
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        let r2 = between.length_squared();
+        if l.area_normal == Vec3A::ZERO {
+            cos / (r2 * r2.sqrt())
+        } else {
+            cos * (-l.area_normal.dot(between)).max(0.0) / (r2 * r2)
+        }
+    }
+
+    /// A link's weight per unit of its source's radiance: oriented, V / π
+    /// and, for a cluster source, its projected area from the cluster's
+    /// centre; isotropic, a quarter of g (Sillion).
+    fn unit_weight(&self, l: &ClusterLink) -> f32 {
+        match self.clusters.kind {
+            ClusterKind::Isotropic => 0.25 * l.g,
+            ClusterKind::Oriented if l.area_normal == Vec3A::ZERO => l.intensity,
+            ClusterKind::Oriented => l.visibility / PI,
+        }
+    }
+
+    /// A link's weight from its source's radiance now (see
+    /// [`Hierarchy::sent_by`]).
+    fn link_weight(&self, l: &ClusterLink) -> Rgb {
+        self.unit_weight(l) * self.sent_by(l.source)
     }
 
     /// Sets every cluster link's weight from the radiance the step gathers.
@@ -591,21 +586,8 @@ impl Hierarchy {
     /// `gathered_share`).
     pub(super) fn cluster_form_factor(&self, root: u32, x: Vec3A, n: Vec3A) -> f32 {
         let mut sum = 0.0;
-        self.for_cluster_links(root, |l| sum += self.link_form_factor(l, x, n));
+        self.for_cluster_links(root, |l| sum += self.kernel(l, x, n) * self.unit_weight(l));
         sum
-    }
-
-    /// [`Clusters::irradiance`], with an element source's projected area
-    /// taken towards `x` itself (a cluster's costs its triangles, so it
-    /// stays the link's).
-    fn link_form_factor(&self, l: &ClusterLink, x: Vec3A, n: Vec3A) -> f32 {
-        if self.clusters.kind == ClusterKind::Oriented && l.area_normal != Vec3A::ZERO {
-            let between = l.center - x;
-            let r2 = between.length_squared();
-            let projected = (-l.area_normal.dot(between)).max(0.0) / r2.sqrt();
-            return projected * l.visibility / PI * n.dot(between).max(0.0) / (r2 * r2.sqrt());
-        }
-        self.clusters.irradiance(l, x, n)
     }
 
     /// Calls `f` on every link of patch `root`'s ancestor clusters.
