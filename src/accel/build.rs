@@ -93,22 +93,7 @@ impl Geometry {
             AccelChoice::Bvh => false,
             AccelChoice::Soup => true,
         };
-        if !triangles.is_empty() && use_soup {
-            geometry.store_soup(triangles);
-        } else if !triangles.is_empty() {
-            let vertices: Vec<[Vec3A; 3]> = triangles.iter().map(|t| t.vertices).collect();
-            match build_wide_bvh(&vertices) {
-                Some((bvh, order)) => {
-                    geometry.store_in_order(triangles, order);
-                    geometry.tri_index = TriangleIndex::Bvh(bvh);
-                }
-                None => {
-                    // Correct at any depth, if slow: better than missed hits.
-                    geometry.store_soup(triangles);
-                    geometry.bvh_too_deep = true;
-                }
-            }
-        }
+        geometry.store_triangles(triangles, use_soup);
         if spheres.len() <= SPHERE_LIST_MAX {
             geometry.spheres = spheres;
         } else {
@@ -140,12 +125,90 @@ impl Geometry {
     }
 
     /// Stores `triangles[i]` for each i of `order`: the order hit indices refer to.
-    fn store_in_order(
-        &mut self,
-        triangles: &[TriangleInput],
-        order: impl IntoIterator<Item = usize>,
-    ) {
-        for i in order {
+    /// Stores the triangles as a soup or under a BVH; returns per stored
+    /// triangle its index in `triangles`.
+    fn store_triangles(&mut self, triangles: &[TriangleInput], use_soup: bool) -> Vec<usize> {
+        if triangles.is_empty() {
+            return Vec::new();
+        }
+        if !use_soup {
+            let vertices: Vec<[Vec3A; 3]> = triangles.iter().map(|t| t.vertices).collect();
+            if let Some((bvh, order)) = build_wide_bvh(&vertices) {
+                self.store_in_order(triangles, &order);
+                self.tri_index = TriangleIndex::Bvh(bvh);
+                return order;
+            }
+            // Correct at any depth, if slow: better than missed hits.
+            self.bvh_too_deep = true;
+        }
+        self.store_soup(triangles)
+    }
+
+    /// A copy in which triangle `i` is replaced by `pieces[i]` where that
+    /// is not empty: triangles within it (radiosity's discontinuity
+    /// meshing), with its material, light, and texture coordinates and
+    /// normals interpolated at their corners. Spheres, moving objects,
+    /// masks and the offset mode are kept. Returns, per triangle of the
+    /// copy, the triangle it comes from.
+    pub fn with_pieces(&self, pieces: &[Vec<[Vec3A; 3]>]) -> (Geometry, Vec<u32>) {
+        let mut inputs = Vec::with_capacity(self.tri_vertices.len());
+        let mut origin = Vec::with_capacity(self.tri_vertices.len());
+        for (i, v) in self.tri_vertices.iter().enumerate() {
+            let material = self.tri_shading[i].material;
+            let (uvs, normals) = (self.tri_uvs.get(i), self.tri_normals.get(i));
+            match pieces.get(i).filter(|p| !p.is_empty()) {
+                None => inputs.push(TriangleInput {
+                    vertices: *v,
+                    material,
+                    uvs: uvs.copied(),
+                    normals: normals.copied(),
+                }),
+                Some(parts) => {
+                    let n = (v[1] - v[0]).cross(v[2] - v[0]);
+                    let weights = |p: Vec3A| {
+                        let inv = 1.0 / n.length_squared();
+                        let b1 = (p - v[0]).cross(v[2] - v[0]).dot(n) * inv;
+                        let b2 = (v[1] - v[0]).cross(p - v[0]).dot(n) * inv;
+                        [1.0 - b1 - b2, b1, b2]
+                    };
+                    for part in parts {
+                        let b = part.map(weights);
+                        inputs.push(TriangleInput {
+                            vertices: *part,
+                            material,
+                            uvs: uvs.map(|t| b.map(|w| w[0] * t[0] + w[1] * t[1] + w[2] * t[2])),
+                            normals: normals.map(|t| {
+                                b.map(|w| (w[0] * t[0] + w[1] * t[1] + w[2] * t[2]).normalize())
+                            }),
+                        });
+                        origin.push(i as u32);
+                    }
+                    continue;
+                }
+            }
+            origin.push(i as u32);
+        }
+        let mut geometry = Geometry {
+            keep_uvs: self.keep_uvs,
+            keep_normals: self.keep_normals,
+            sphere_bvh: self.sphere_bvh.clone(),
+            spheres: self.spheres.clone(),
+            moving: self.moving.clone(),
+            offset: self.offset,
+            bvh_too_deep: self.bvh_too_deep,
+            masks: self.masks.clone(),
+            ..Geometry::default()
+        };
+        let order = geometry.store_triangles(&inputs, inputs.len() <= SOUP_MAX_TRIANGLES);
+        let from: Vec<u32> = order.iter().map(|&k| origin[k]).collect();
+        for (slot, &old) in from.iter().enumerate() {
+            geometry.tri_shading[slot].light = self.tri_shading[old as usize].light;
+        }
+        (geometry, from)
+    }
+
+    fn store_in_order(&mut self, triangles: &[TriangleInput], order: &[usize]) {
+        for &i in order {
             self.tri_vertices.push(triangles[i].vertices);
             self.tri_shading.push(TriangleShading::new(&triangles[i]));
             if self.keep_uvs {
@@ -161,9 +224,11 @@ impl Geometry {
 
     /// Stores the triangles for a soup (those in a face of their bounding
     /// box last) and tests them all.
-    fn store_soup(&mut self, triangles: &[TriangleInput]) {
+    fn store_soup(&mut self, triangles: &[TriangleInput]) -> Vec<usize> {
         let vertices: Vec<[Vec3A; 3]> = triangles.iter().map(|t| t.vertices).collect();
-        self.store_in_order(triangles, TriangleSoup::order(&vertices));
+        let order: Vec<usize> = TriangleSoup::order(&vertices).into_iter().collect();
+        self.store_in_order(triangles, &order);
         self.tri_index = TriangleIndex::Soup(TriangleSoup::new(&self.tri_vertices));
+        order
     }
 }

@@ -86,6 +86,11 @@ pub struct RadiosityFlags {
     /// Radiosity: draw the elements' edges over the image, coloured by level.
     #[arg(long)]
     wireframe: bool,
+    /// Radiosity: split receivers along the umbra and penumbra boundaries
+    /// of polygonal lights first (discontinuity meshing; drawn in cyan
+    /// with --wireframe).
+    #[arg(long)]
+    discontinuity_meshing: bool,
 }
 
 impl RadiosityFlags {
@@ -109,6 +114,7 @@ impl RadiosityFlags {
             adaptive_rounds: self.adaptive_rounds,
             adaptive_tolerance: self.adaptive_tolerance,
             radiosity_wireframe: self.wireframe,
+            radiosity_discontinuity: self.discontinuity_meshing,
             radiosity_display: match self.display {
                 DisplayArg::Flat => RadiosityDisplay::Flat,
                 DisplayArg::Smooth => RadiosityDisplay::Smooth,

@@ -67,6 +67,8 @@ pub struct IntegratorOptions {
     pub adaptive_rounds: u32,
     pub adaptive_tolerance: f32,
     pub radiosity_wireframe: bool,
+    /// Radiosity: split receivers along the shadows' discontinuity lines.
+    pub radiosity_discontinuity: bool,
     /// Photon mapping: photons per iteration (0: one per pixel), the first
     /// iteration's radius (fraction of the scene's diagonal) and alpha.
     pub photons: u32,
@@ -105,6 +107,7 @@ impl Default for IntegratorOptions {
             adaptive_rounds: 0,
             adaptive_tolerance: 0.5,
             radiosity_wireframe: false,
+            radiosity_discontinuity: false,
             photons: 0,
             photon_radius: 0.002,
             photon_alpha: 2.0 / 3.0,
@@ -128,6 +131,7 @@ impl IntegratorOptions {
         self.adaptive_rounds = other.adaptive_rounds;
         self.adaptive_tolerance = other.adaptive_tolerance;
         self.radiosity_wireframe = other.radiosity_wireframe;
+        self.radiosity_discontinuity = other.radiosity_discontinuity;
     }
 
     /// The MIS heuristic of estimators that always combine strategies

@@ -311,11 +311,23 @@ impl Mesh {
 
     /// The smooth display's radiance: per element, its three vertices'
     /// ([`super::reconstruct::vertex_radiance`]), and the T-vertices of an
-    /// adaptive mesh ([`VertexField`]).
-    pub fn vertex_radiance(&self, radiance: &[Rgb]) -> VertexField {
-        let corners =
-            super::reconstruct::vertex_radiance(self.elements.iter().zip(radiance.iter().copied()));
-        VertexField::new(self.elements.iter().enumerate(), corners)
+    /// adaptive mesh ([`VertexField`]). Elements no light leaves
+    /// (`exposure` 0: the floor under a block) are left out of their
+    /// neighbours' fits and vertices, and shown flat: at a block's foot
+    /// they would pull the lit floor's vertices towards their darkness
+    /// (the jump a discontinuity mesh's contact lines are there to keep).
+    pub fn vertex_radiance(&self, radiance: &[Rgb], exposure: &[f32]) -> VertexField {
+        let visible: Vec<usize> = (0..self.elements.len())
+            .filter(|&k| exposure.get(k).is_none_or(|&x| x > 0.0))
+            .collect();
+        let fitted = super::reconstruct::vertex_radiance(
+            visible.iter().map(|&k| (&self.elements[k], radiance[k])),
+        );
+        let mut corners: Vec<[Rgb; 3]> = radiance.iter().map(|&l| [l; 3]).collect();
+        for (&k, c) in visible.iter().zip(fitted) {
+            corners[k] = c;
+        }
+        VertexField::new(visible.iter().map(|&k| (k, &self.elements[k])), corners)
     }
 
     /// The element of scene triangle `triangle`, or of its back, that

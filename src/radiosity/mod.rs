@@ -3,6 +3,7 @@
 //! The technique that renders with them is `crate::integrator::radiosity`.
 
 pub mod cluster;
+pub mod discontinuity;
 pub mod element;
 pub mod form_factor;
 pub mod hierarchy;

@@ -521,6 +521,25 @@ impl Scene {
         })
     }
 
+    /// The scene with triangle `i` split into `pieces[i]` where that is not
+    /// empty ([`Geometry::with_pieces`]: radiosity's discontinuity
+    /// meshing), and per triangle of the new scene the one it comes from.
+    pub fn with_pieces(&self, pieces: &[Vec<[Vec3A; 3]>]) -> (Scene, Vec<u32>) {
+        let (geometry, from) = self.geometry.with_pieces(pieces);
+        let scene = Scene {
+            camera: self.camera.clone(),
+            features: Features::detect(&self.materials, &geometry, &self.lights, &self.camera),
+            shortcuts: Shortcuts::new(&geometry, &flat_light_corners(&self.lights)),
+            geometry: Arc::new(geometry),
+            materials: self.materials.clone(),
+            textures: self.textures.clone(),
+            lights: self.lights.clone(),
+            warnings: self.warnings.clone(),
+            hints: self.hints.clone(),
+        };
+        (scene, from)
+    }
+
     /// What radiosity makes of material `m` (see
     /// [`crate::bsdf::Bsdf::diffuse_albedo`]); a textured diffuse colour
     /// is read as the texture's mean, which counts as dropping detail.

@@ -307,6 +307,14 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                 &mut options.radiosity_wireframe,
                 "Wireframe (colour by level)",
             );
+            ui.checkbox(
+                &mut options.radiosity_discontinuity,
+                "Discontinuity meshing (lines in cyan)",
+            )
+            .on_hover_text(
+                "Split receivers along the umbra and penumbra boundaries of polygonal lights \
+                 before meshing, so that no element straddles a shadow's edge",
+            );
             ui.horizontal(|ui| {
                 ui.label("Form factors");
                 let before = options.form_factor_method;

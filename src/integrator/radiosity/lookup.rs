@@ -37,6 +37,40 @@ pub(super) fn on_edge(scene: &Scene, surface: &Surface, distance: f32) -> bool {
     (0..3).any(|k| weights[k] * 2.0 * surface.element.area / opposite[k] < 0.6 * pixel)
 }
 
+/// The colour of discontinuity lines over the wireframe.
+pub(super) const LINE_COLOUR: Rgb = Rgb::new(0.0, 0.85, 1.0);
+
+/// Whether a hit at `distance` from the camera lies within about a pixel
+/// of a discontinuity line (an edge of its triangle that lies on one).
+pub(super) fn on_line(
+    scene: &Scene,
+    state: &RadiosityState,
+    hit: &SurfaceHit,
+    distance: f32,
+) -> bool {
+    let Some(meshed) = state.meshed() else {
+        return false;
+    };
+    let t = hit.primitive as usize;
+    let (Some(flags), Some(&v)) = (meshed.on_line.get(t), scene.geometry.triangles().get(t)) else {
+        return false;
+    };
+    if !flags.contains(&true) {
+        return false;
+    }
+    let camera = &scene.camera;
+    let pixel = distance * 2.0 * camera.tan_half_fov_y / camera.height.max(1) as f32;
+    let (b1, b2) = barycentrics(hit.point, v);
+    let weights = [1.0 - b1 - b2, b1, b2];
+    let area2 = (v[1] - v[0]).cross(v[2] - v[0]).length();
+    let opposite = [
+        (v[2] - v[1]).length(),
+        (v[0] - v[2]).length(),
+        (v[1] - v[0]).length(),
+    ];
+    (0..3).any(|k| flags[k] && weights[k] * area2 / opposite[k] < 0.9 * pixel)
+}
+
 /// The wireframe's colour for elements of subdivision `level`.
 pub(super) fn level_colour(level: u8) -> Rgb {
     const COLOURS: [[f32; 3]; 8] = [
