@@ -375,7 +375,7 @@ fn hierarchical_radiosity_matches_mitsuba_on_the_cornell_box() {
 
 /// RMSE over the pixels whose reference stays at or below 1 in every
 /// channel: all but the 444 that see the light.
-fn masked_rmse(image: &tracelab::image::Image, reference: &tracelab::image::Image) -> f64 {
+pub fn masked_rmse(image: &tracelab::image::Image, reference: &tracelab::image::Image) -> f64 {
     let (mut squared, mut kept) = (0.0f64, 0usize);
     for (p, r) in image.pixels.iter().zip(&reference.pixels) {
         if r.iter().all(|&v| v <= 1.0) {

@@ -25,6 +25,8 @@ mod form_factors;
 mod radiosity;
 // Radiosity with clusters on a mesh of 100 000 triangles against path tracing.
 mod clusters;
+// Discontinuity meshing: penumbra lines where similar triangles put them.
+mod discontinuity;
 // BSDF energy conservation, reciprocity and sample/eval/pdf consistency.
 mod bsdf;
 // Whitted by hand, MC ray tracing's ray count.
