@@ -26,7 +26,7 @@ use crate::scene::Scene;
 use crate::scene::light::Light;
 use glam::Vec3A;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 /// Rays per fan before bisection.
 const FAN_RAYS: u32 = 32;
@@ -110,8 +110,11 @@ fn polygons(scene: &Scene) -> Vec<Polygon> {
 /// welded, so that edges know both their faces.
 struct Welded {
     positions: Vec<Vec3A>,
-    /// Per edge (vertex pair, smaller first), the third vertex of each face.
-    edges: HashMap<(u32, u32), Vec<u32>>,
+    /// Per edge (vertex pair, smaller first), the third vertex of each face;
+    /// ordered, so that lines come in the same order every run and the
+    /// triangulation (which merges close points first come, first kept) is
+    /// the same.
+    edges: BTreeMap<(u32, u32), Vec<u32>>,
     /// Per vertex, the vertices it shares an edge with.
     neighbours: Vec<Vec<u32>>,
 }
@@ -121,7 +124,7 @@ impl Welded {
         let geometry = &scene.geometry;
         let mut ids: HashMap<[i64; 3], u32> = HashMap::new();
         let mut positions = Vec::new();
-        let mut edges: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+        let mut edges: BTreeMap<(u32, u32), Vec<u32>> = BTreeMap::new();
         for (i, v) in geometry.triangles().iter().enumerate() {
             if scene.materials[geometry.triangle_material(i) as usize].is_emissive() {
                 continue;
