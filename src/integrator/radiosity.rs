@@ -17,10 +17,11 @@
 //! - `smooth`: interpolated from the element's vertices, each the
 //!   area-weighted mean of the elements that share it on the same plane;
 //! - `gather`: emitted light, direct light by light sampling (one shadow
-//!   ray), and indirect light by one cosine-sampled ray that reads L - E of
-//!   the element it lands on: path tracing's first bounce with the mesh's
-//!   solution in place of the rest, so it agrees with path tracing up to
-//!   the mesh's error in the indirect term.
+//!   ray), and indirect light read from the solution (L - E) where one
+//!   cosine-sampled ray lands and at a point of one element chosen by the
+//!   light it reflects, combined by the power heuristic: path tracing's
+//!   first bounce with the mesh's solution in place of the rest, so it
+//!   agrees with path tracing up to the mesh's error in the indirect term.
 
 use super::{IntegratorOptions, RayCounts, Solver, SolverProgress, Technique};
 use crate::math::{Frame, Ray, Rgb};
@@ -190,6 +191,8 @@ pub struct RadiosityState {
     /// With discontinuity meshing, the scene split along the lines, which
     /// the solver and the display work on in place of the one given.
     meshed: Option<Meshed>,
+    /// The elements the gather samples as light sources.
+    senders: lookup::Senders,
 }
 
 /// A scene split along its discontinuity lines.
@@ -498,6 +501,7 @@ impl Radiosity {
                 displayed: None,
                 back_twins: back_twins(&scene.geometry),
                 meshed: None,
+                senders: lookup::Senders::default(),
             });
         }
         let mesh = Mesh::build(scene, self.patch_size, MAX_ELEMENTS).map_err(crate::Error::new)?;
@@ -523,14 +527,34 @@ impl Radiosity {
             displayed: None,
             back_twins: back_twins(&scene.geometry),
             meshed: None,
+            senders: lookup::Senders::default(),
         })
     }
 
     /// The smooth display's vertex values of the current solution.
     fn prepare_display(&self, scene: &Scene, state: &mut RadiosityState) {
         let key = (state.steps, state.counts().0);
-        if self.display == RadiosityDisplay::Smooth && state.displayed != Some(key) {
-            state.displayed = Some(key);
+        if state.displayed == Some(key) {
+            return;
+        }
+        state.displayed = Some(key);
+        // Every display gathers somewhere (the backs of thin surfaces).
+        state.senders = match &state.model {
+            Model::Matrix(m) => lookup::Senders::new(
+                m.mesh.elements.len(),
+                m.mesh
+                    .elements
+                    .iter()
+                    .zip(&m.solution.radiance)
+                    .enumerate()
+                    .map(|(k, (e, l))| (k, e, *l)),
+            ),
+            Model::Hierarchical(h) => {
+                let (numbers, leaves) = h.numbered_leaves();
+                lookup::Senders::new(numbers, leaves)
+            }
+        };
+        if self.display == RadiosityDisplay::Smooth {
             match &mut state.model {
                 Model::Matrix(m) => {
                     m.vertex_radiance = m

@@ -12,6 +12,8 @@ use crate::scene::Scene;
 
 /// What the solution says at a surface point.
 pub(super) struct Surface {
+    /// The element's number (a hierarchy's node, a mesh's element).
+    pub(super) index: usize,
     /// The element's radiance (emission included).
     pub(super) radiance: Rgb,
     pub(super) element: Element,
@@ -118,6 +120,7 @@ pub(super) fn surface_at(
     };
     let (e1, e2) = barycentrics(hit.point, element.vertices);
     Some(Surface {
+        index: k,
         radiance,
         element,
         barycentrics: glam::Vec2::new(e1, e2),
@@ -168,8 +171,68 @@ fn barycentrics(p: glam::Vec3A, [a, b, c]: [glam::Vec3A; 3]) -> (f32, f32) {
     )
 }
 
+/// The solution's elements as light sources for the gather: chosen in
+/// proportion to the light they reflect (luminance of L − E times area),
+/// so that a room lit by one bright spot on its ceiling gathers from the
+/// spot instead of waiting for a cosine ray to meet it.
+#[derive(Clone, Debug, Default)]
+pub struct Senders {
+    /// Per sender: its number, element and reflected radiance.
+    senders: Vec<(u32, Element, Rgb)>,
+    /// Cumulative probabilities over `senders`, the last 1.
+    cdf: Vec<f32>,
+    /// Per element number, its probability (0 for those never chosen).
+    pmf: Vec<f32>,
+}
+
+impl Senders {
+    /// From `numbers` element numbers and the elements (number, element,
+    /// radiance) that may send.
+    pub fn new<'a>(
+        numbers: usize,
+        elements: impl Iterator<Item = (usize, &'a Element, Rgb)>,
+    ) -> Senders {
+        let mut senders = Vec::new();
+        let mut cdf = Vec::new();
+        let mut total = 0.0f64;
+        for (k, e, l) in elements {
+            let reflected = (l - e.emission).max(Rgb::ZERO);
+            let weight = crate::math::luminance(reflected) as f64 * e.area as f64;
+            if weight > 0.0 && weight.is_finite() {
+                total += weight;
+                senders.push((k as u32, *e, reflected));
+                cdf.push(total);
+            }
+        }
+        let mut pmf = vec![0.0f32; if senders.is_empty() { 0 } else { numbers }];
+        let mut before = 0.0;
+        let cdf = cdf
+            .into_iter()
+            .zip(&senders)
+            .map(|(c, s)| {
+                pmf[s.0 as usize] = ((c - before) / total) as f32;
+                before = c;
+                (c / total) as f32
+            })
+            .collect();
+        Senders { senders, cdf, pmf }
+    }
+
+    /// Solid-angle density at a point of choosing element `k` and a
+    /// uniform point on it seen at `distance` and cosine `cos_there`.
+    fn pdf(&self, k: usize, element: &Element, distance: f32, cos_there: f32) -> f32 {
+        let p = self.pmf.get(k).copied().unwrap_or(0.0);
+        if p == 0.0 || !(cos_there > 0.0) {
+            return 0.0;
+        }
+        p * distance * distance / (element.area * cos_there)
+    }
+}
+
 /// Reflected radiance at a diffuse hit: direct light by one light sample,
-/// indirect by one cosine-sampled ray reading the solution (L - E) where it lands.
+/// indirect by the solution (L - E) read where a cosine-sampled ray lands
+/// and at a point of an element chosen by [`Senders`], the two combined by
+/// the power heuristic.
 pub(super) fn gather(
     scene: &Scene,
     state: &RadiosityState,
@@ -198,17 +261,53 @@ pub(super) fn gather(
             }
         }
     }
+    let senders = &state.senders;
+    let mis = |a: f32, b: f32| {
+        if a > 0.0 {
+            a * a / (a * a + b * b)
+        } else {
+            0.0
+        }
+    };
     let local = square_to_cosine_hemisphere(sampler.next_2d_for(Domain::Bsdf));
     let ray = hit.spawn_ray(Frame::from_normal(normal).to_world(local));
     counts.bounce += 1;
     // A patch's back sends nothing: the solution has its front only.
-    let indirect = match scene.geometry.intersect(&ray) {
+    let mut indirect = match scene.geometry.intersect(&ray) {
         Some(next) => match facing_surface(scene, state, &next, ray.direction) {
-            Some((s, true)) => s.radiance - s.element.emission,
+            Some((s, true)) => {
+                let cos_there = s.element.normal.dot(-ray.direction);
+                let p_sender = senders.pdf(s.index, &s.element, next.t, cos_there);
+                // Cosine sampling: f cos / p = ρ.
+                (s.radiance - s.element.emission) * mis(local.z / std::f32::consts::PI, p_sender)
+            }
             _ => Rgb::ZERO,
         },
         None => Rgb::ZERO,
     };
-    // Cosine sampling: f cos / p = ρ.
+    let u = sampler.next_1d_for(Domain::Light);
+    let u_point = sampler.next_2d_for(Domain::Light);
+    let pick = senders.cdf.partition_point(|&c| c <= u);
+    if pick < senders.senders.len() {
+        let (k, e, l) = &senders.senders[pick];
+        let b = crate::sampling::warp::square_to_uniform_triangle(u_point);
+        let y = b.x * e.vertices[0] + b.y * e.vertices[1] + (1.0 - b.x - b.y) * e.vertices[2];
+        let d = y - hit.point;
+        let distance = d.length();
+        let w = d / distance;
+        let (cos_here, cos_there) = (normal.dot(w), -e.normal.dot(w));
+        let p_sender = senders.pdf(*k as usize, e, distance, cos_there);
+        if cos_here > 0.0 && p_sender > 0.0 {
+            counts.shadow += 1;
+            let y_error = crate::math::gamma(7) * y.abs();
+            let shadow =
+                crate::math::ray_between(hit.point, hit.error, normal, y, y_error, e.normal);
+            if !scene.geometry.occluded(&shadow) {
+                let p_cosine = cos_here / std::f32::consts::PI;
+                indirect +=
+                    *l * (cos_here / (std::f32::consts::PI * p_sender) * mis(p_sender, p_cosine));
+            }
+        }
+    }
     direct + reflectance * indirect
 }

@@ -72,6 +72,18 @@ impl Hierarchy {
         out
     }
 
+    /// The leaves with their node numbers (as [`Hierarchy::leaf_at`] gives
+    /// them), elements and radiance, and how many node numbers there are.
+    pub fn numbered_leaves(&self) -> (usize, impl Iterator<Item = (usize, &Element, Rgb)>) {
+        let leaves = self
+            .nodes
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| n.children == NONE)
+            .map(|(k, n)| (k, &n.element, n.radiance));
+        (self.nodes.len(), leaves)
+    }
+
     /// The leaves' elements and radiance (for tests and displays).
     pub fn leaves(&self) -> impl Iterator<Item = (&Element, Rgb)> {
         self.nodes
