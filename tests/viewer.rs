@@ -398,6 +398,21 @@ fn radiosity_controls_drive_the_solver() {
     assert!(solver.converged && solver.elements > 206, "{solver:?}");
     harness.run_steps(2);
     harness.get_by_label_contains("MB, residual");
+    // Discontinuity meshing: the receivers are split along the shadows'
+    // lines before meshing, and the notes line says how.
+    click(&mut harness, "Discontinuity meshing (lines in cyan)");
+    assert!(
+        harness
+            .state()
+            .app
+            .settings
+            .a
+            .integrator
+            .radiosity_discontinuity
+    );
+    step_until(&mut harness, "the discontinuity mesh's solution", finished);
+    harness.run_steps(2);
+    harness.get_by_label_contains("critical wedges");
 }
 
 #[test]
