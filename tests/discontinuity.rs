@@ -169,9 +169,9 @@ fn discontinuity_meshing_beats_a_uniform_mesh_of_as_many_elements_on_the_cornell
 /// 0.01% and to 0.0014 RMSE, so its own noise is about 0.0007). Radiosity
 /// has every bounce: the room's walls are white, and the default depth of
 /// 8 leaves a reference 4–8% dark. Deterministic like the Cornell box test
-/// above: without the lines the solution is 6, 4.5 and 3% low (the
-/// ceiling's lit spot 9% low) and measures 0.00580; with them 0.00456 and
-/// within 1.5%.
+/// above: without the lines 0.00284, with them 0.00205 (before dark
+/// sources kept their links, 0.00580 and 0.00456: the ceiling's lit spot
+/// 9% low without lines, the ceiling beside the shade dark with both).
 #[test]
 fn discontinuity_meshing_brings_the_indirect_room_within_two_percent() {
     let scene = Scene::load(&crate::common::repo_path("scenes/indirect.toml")).unwrap();

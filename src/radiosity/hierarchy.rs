@@ -482,9 +482,19 @@ impl Hierarchy {
                 let link = link_of((q, f_max), &x);
                 if self.splits(p, &link) {
                     pairs.push((p, q, true));
-                } else if x.f > 0.0 || self.partly_hidden(p) {
-                    // A partly hidden gatherer keeps its dark links: its open
-                    // part may see through them (the ceiling by the light).
+                } else if x.f > 0.0
+                    || (f_max > 0.0 && self.transfer(p, q, f_max) == 0.0)
+                    || self.partly_hidden(p)
+                {
+                    // Kept although its rays all missed: a partly hidden
+                    // gatherer's dark links (its open part may see through
+                    // them: the ceiling by the light), and a link from a
+                    // source still dark when linked, which is re-examined
+                    // once the source is lit. Dropped, the indirect room's
+                    // ceiling beside the lamp shade lost for good a wall it
+                    // sees through the opening (15% of its light there):
+                    // masked RMSE 0.00580 -> 0.00284 against the deep
+                    // reference; Cornell box ε 3e-5 0.00159 -> 0.00160.
                     self.nodes[p as usize].links.push(link);
                 }
             }
