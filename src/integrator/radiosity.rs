@@ -37,6 +37,9 @@ use crate::shortcuts::PrimaryPixel;
 use lookup::{LINE_COLOUR, facing_surface, gather, level_colour, on_edge, on_line};
 
 mod lookup;
+mod meshed;
+pub use meshed::Meshed;
+use meshed::discontinuity_mesh;
 
 /// Most elements (the form factor matrix of 16 384 elements takes 1 GiB).
 pub const MAX_ELEMENTS: usize = 16_384;
@@ -193,15 +196,6 @@ pub struct RadiosityState {
     meshed: Option<Meshed>,
     /// The elements the gather samples as light sources.
     senders: lookup::Senders,
-}
-
-/// A scene split along its discontinuity lines.
-pub struct Meshed {
-    pub scene: std::sync::Arc<Scene>,
-    /// Per triangle of `scene`, which of its edges (opposite the vertex of
-    /// that index) lie on a discontinuity line.
-    pub on_line: Vec<[bool; 3]>,
-    pub lines: usize,
 }
 
 impl RadiosityState {
@@ -669,51 +663,4 @@ impl Radiosity {
         state.residual = 1.0;
         state.settled = state.rounds >= self.adaptive_rounds;
     }
-}
-
-/// `scene` split along the discontinuities its polygonal lights cast, and
-/// notes saying what was found.
-fn discontinuity_mesh(scene: &Scene, size: Option<f32>) -> (Meshed, Vec<String>) {
-    use crate::radiosity::discontinuity;
-    let lines = discontinuity::find(scene);
-    let pieces = discontinuity::split(scene, &lines, size);
-    let corners: Vec<Vec<[glam::Vec3A; 3]>> = pieces
-        .iter()
-        .map(|p| p.iter().map(|p| p.vertices).collect())
-        .collect();
-    let (meshed, _) = scene.with_pieces(&corners);
-    // Pieces are found again by their corners, which the split keeps to the bit.
-    let key = |v: &[glam::Vec3A; 3]| v.map(|p| p.to_array().map(f32::to_bits));
-    let flags: std::collections::HashMap<_, [bool; 3]> = pieces
-        .iter()
-        .flatten()
-        .map(|p| (key(&p.vertices), p.on_line))
-        .collect();
-    let on_line: Vec<[bool; 3]> = meshed
-        .geometry
-        .triangles()
-        .iter()
-        .map(|v| flags.get(&key(v)).copied().unwrap_or_default())
-        .collect();
-    let count: usize = lines.segments.iter().map(Vec::len).sum();
-    let split = pieces.iter().filter(|p| !p.is_empty()).count();
-    let mut notes = lines.notes;
-    notes.push(format!(
-        "discontinuity meshing: {} critical wedges (VE {}, EV {}) and {} contact tests, {} rays, \
-         gave {count} line segments; {split} triangles split into {} pieces",
-        lines.wedges[0] + lines.wedges[1],
-        lines.wedges[0],
-        lines.wedges[1],
-        lines.wedges[2],
-        lines.rays,
-        pieces.iter().map(Vec::len).sum::<usize>(),
-    ));
-    (
-        Meshed {
-            scene: std::sync::Arc::new(meshed),
-            on_line,
-            lines: count,
-        },
-        notes,
-    )
 }
