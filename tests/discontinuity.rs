@@ -174,34 +174,8 @@ fn discontinuity_meshing_beats_a_uniform_mesh_of_as_many_elements_on_the_cornell
 /// 9% low without lines, the ceiling beside the shade dark with both).
 #[test]
 fn discontinuity_meshing_brings_the_indirect_room_within_two_percent() {
-    let scene = Scene::load(&crate::common::repo_path("scenes/indirect.toml")).unwrap();
     let reference = crate::common::reference("indirect_bdpt_deep_ref.exr");
-    let render = |discontinuity: bool| {
-        let options = IntegratorOptions {
-            kind: IntegratorKind::Radiosity,
-            radiosity_solver: RadiositySolver::Hierarchical,
-            radiosity_epsilon: 3e-5,
-            patch_size: 0.005,
-            radiosity_display: RadiosityDisplay::Smooth,
-            radiosity_discontinuity: discontinuity,
-            ..IntegratorOptions::default()
-        };
-        let (snapshot, stats) = crate::common::render_with(
-            scene.clone(),
-            options.build(),
-            tracelab::sampling::SamplerKind::Independent,
-            64,
-            0,
-            0,
-            64,
-        );
-        assert!(
-            stats.solver.is_some_and(|p| p.converged),
-            "{:?}",
-            stats.solver
-        );
-        snapshot.image
-    };
+    let render = |discontinuity| indirect_room(RadiosityDisplay::Smooth, discontinuity);
     let (plain, meshed) = (render(false), render(true));
     let plain_rmse = crate::radiosity::masked_rmse(&plain, &reference);
     let meshed_rmse = crate::radiosity::masked_rmse(&meshed, &reference);
@@ -233,15 +207,31 @@ fn discontinuity_meshing_brings_the_indirect_room_within_two_percent() {
 /// 2% (measured 1.002, 1.003, 1.004) fails a mis-weighted combination.
 #[test]
 fn the_gather_samples_the_solutions_bright_elements() {
-    let scene = Scene::load(&crate::common::repo_path("scenes/indirect.toml")).unwrap();
     let reference = crate::common::reference("indirect_bdpt_deep_ref.exr");
+    let image = indirect_room(RadiosityDisplay::Gather, true);
+    let rmse = crate::radiosity::masked_rmse(&image, &reference);
+    let (mean, expected) = (image.mean(), reference.mean());
+    eprintln!("gather: masked RMSE {rmse:.4}, mean {mean:?} vs {expected:?}");
+    assert!(rmse < 0.035, "{rmse}");
+    for c in 0..3 {
+        assert!(
+            (mean[c] / expected[c] - 1.0).abs() < 0.02,
+            "{mean:?} vs {expected:?}"
+        );
+    }
+}
+
+/// scenes/indirect.toml solved by hierarchical radiosity (ε 3e-5, patch
+/// size 0.005) to convergence and shown with `display`.
+fn indirect_room(display: RadiosityDisplay, discontinuity: bool) -> tracelab::image::Image {
+    let scene = Scene::load(&crate::common::repo_path("scenes/indirect.toml")).unwrap();
     let options = IntegratorOptions {
         kind: IntegratorKind::Radiosity,
         radiosity_solver: RadiositySolver::Hierarchical,
         radiosity_epsilon: 3e-5,
         patch_size: 0.005,
-        radiosity_display: RadiosityDisplay::Gather,
-        radiosity_discontinuity: true,
+        radiosity_display: display,
+        radiosity_discontinuity: discontinuity,
         ..IntegratorOptions::default()
     };
     // A solver's pass is a step; once converged, passes add display samples.
@@ -259,14 +249,5 @@ fn the_gather_samples_the_solutions_bright_elements() {
         "{:?}",
         stats.solver
     );
-    let rmse = crate::radiosity::masked_rmse(&snapshot.image, &reference);
-    let (mean, expected) = (snapshot.image.mean(), reference.mean());
-    eprintln!("gather: masked RMSE {rmse:.4}, mean {mean:?} vs {expected:?}");
-    assert!(rmse < 0.035, "{rmse}");
-    for c in 0..3 {
-        assert!(
-            (mean[c] / expected[c] - 1.0).abs() < 0.02,
-            "{mean:?} vs {expected:?}"
-        );
-    }
+    snapshot.image
 }
