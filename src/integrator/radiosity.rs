@@ -501,7 +501,7 @@ impl Radiosity {
         let mesh = Mesh::build(scene, self.patch_size, MAX_ELEMENTS).map_err(crate::Error::new)?;
         let (form_factors, solution) = self.matrix_system(scene, &mesh);
         let vertex_radiance = if self.display == RadiosityDisplay::Smooth {
-            mesh.vertex_radiance(&solution.radiance, &solution.exposure)
+            mesh.vertex_radiance(&solution.radiance, &solution.exposure, &[])
         } else {
             VertexField::default()
         };
@@ -549,11 +549,16 @@ impl Radiosity {
             }
         };
         if self.display == RadiosityDisplay::Smooth {
+            let lines = state
+                .meshed
+                .as_ref()
+                .map(Meshed::line_edges)
+                .unwrap_or_default();
             match &mut state.model {
                 Model::Matrix(m) => {
-                    m.vertex_radiance = m
-                        .mesh
-                        .vertex_radiance(&m.solution.radiance, &m.solution.exposure)
+                    m.vertex_radiance =
+                        m.mesh
+                            .vertex_radiance(&m.solution.radiance, &m.solution.exposure, &lines)
                 }
                 Model::Hierarchical(h) => h.smooth(&scene.geometry),
             }

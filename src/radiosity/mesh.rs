@@ -316,12 +316,18 @@ impl Mesh {
     /// neighbours' fits and vertices, and shown flat: at a block's foot
     /// they would pull the lit floor's vertices towards their darkness
     /// (the jump a discontinuity mesh's contact lines are there to keep).
-    pub fn vertex_radiance(&self, radiance: &[Rgb], exposure: &[f32]) -> VertexField {
+    pub fn vertex_radiance(
+        &self,
+        radiance: &[Rgb],
+        exposure: &[f32],
+        lines: &[super::reconstruct::LineEdge],
+    ) -> VertexField {
         let visible: Vec<usize> = (0..self.elements.len())
             .filter(|&k| exposure.get(k).is_none_or(|&x| x > 0.0))
             .collect();
         let fitted = super::reconstruct::vertex_radiance(
             visible.iter().map(|&k| (&self.elements[k], radiance[k])),
+            lines,
         );
         let mut corners: Vec<[Rgb; 3]> = radiance.iter().map(|&l| [l; 3]).collect();
         for (&k, c) in visible.iter().zip(fitted) {

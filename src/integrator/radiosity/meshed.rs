@@ -12,6 +12,27 @@ pub struct Meshed {
     pub lines: usize,
 }
 
+impl Meshed {
+    /// The pieces' edges that lie on discontinuity lines, for the smooth
+    /// display's one-sided fits.
+    pub fn line_edges(&self) -> Vec<crate::radiosity::reconstruct::LineEdge> {
+        let triangles = self.scene.geometry.triangles();
+        triangles
+            .iter()
+            .zip(&self.on_line)
+            .flat_map(|(v, flags)| {
+                let normal = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+                (0..3)
+                    .filter(|&i| flags[i])
+                    .map(move |i| crate::radiosity::reconstruct::LineEdge {
+                        ends: [v[(i + 1) % 3], v[(i + 2) % 3]],
+                        normal,
+                    })
+            })
+            .collect()
+    }
+}
+
 /// `scene` split along the discontinuities its polygonal lights cast, and
 /// notes saying what was found.
 pub(super) fn discontinuity_mesh(scene: &Scene, size: Option<f32>) -> (Meshed, Vec<String>) {
