@@ -124,10 +124,10 @@ fn radiosity_frames(h: &mut Harness<'static, Window>) {
         {
             let options = &mut h.state_mut().app.settings.a.integrator;
             options.kind = IntegratorKind::Radiosity;
-            options.radiosity_solver = solver;
-            options.patch_size = patch_size;
-            options.adaptive_rounds = 1;
-            options.radiosity_epsilon = 1e-5;
+            options.radiosity.solver = solver;
+            options.radiosity.patch_size = patch_size;
+            options.radiosity.adaptive_rounds = 1;
+            options.radiosity.epsilon = 1e-5;
         }
         let mut frames = Vec::new();
         let start = Instant::now();
@@ -271,9 +271,9 @@ fn main() {
         settings.a.integrator.kind = IntegratorKind::Path;
         settings.b = settings.a;
         settings.b.integrator.kind = IntegratorKind::Mcrt;
-        settings.b.integrator.glossy_rays = 2;
-        settings.b.integrator.shadow_rays = 2;
-        settings.b.integrator.max_depth = 3;
+        settings.b.integrator.mcrt.glossy_rays = 2;
+        settings.b.integrator.mcrt.shadow_rays = 2;
+        settings.b.integrator.mcrt.max_depth = 3;
         settings.compare = true;
         settings.lock = Lock::EqualTime;
     }

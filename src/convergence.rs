@@ -65,27 +65,44 @@ impl BenchConfig {
                     .parse::<u32>()
                     .map_err(|_| err(format!("`{key}` needs a whole number, got `{value}`")))
             };
+            let kind = integrator.kind;
+            let missing = || err(format!("`{key}` is not a setting of {}", kind.name()));
             match key {
-                "max-depth" => integrator.max_depth = number()?,
-                "rr-depth" => integrator.rr_depth = number()?,
-                "rr" => integrator.russian_roulette = value != "off",
+                "max-depth" => *integrator.max_depth_mut().ok_or_else(missing)? = number()?,
+                "rr-depth" => integrator.length_mut().ok_or_else(missing)?.rr_depth = number()?,
+                "rr" => {
+                    integrator
+                        .length_mut()
+                        .ok_or_else(missing)?
+                        .russian_roulette = value != "off"
+                }
                 "seen-emitters" => {
-                    integrator.exact_seen_emitters = match value {
+                    let exact = match value {
                         "exact" => true,
                         "sampled" => false,
                         _ => return Err(err(format!("seen-emitters `{value}` (exact, sampled)"))),
+                    };
+                    match kind {
+                        IntegratorKind::Path => integrator.path.exact_seen_emitters = exact,
+                        IntegratorKind::Mcrt => integrator.mcrt.exact_seen_emitters = exact,
+                        _ => return Err(missing()),
                     }
                 }
-                "shadow-rays" => integrator.shadow_rays = number()?,
-                "glossy-rays" => integrator.glossy_rays = number()?,
-                "strategy" => {
-                    integrator.strategy = match value {
+                "shadow-rays" if kind == IntegratorKind::Mcrt => {
+                    integrator.mcrt.shadow_rays = number()?
+                }
+                "glossy-rays" if kind == IntegratorKind::Mcrt => {
+                    integrator.mcrt.glossy_rays = number()?
+                }
+                "strategy" if kind == IntegratorKind::Path => {
+                    integrator.path.strategy = match value {
                         "bsdf" => Strategy::Bsdf,
                         "light" => Strategy::Light,
                         "mis" => Strategy::Mis,
                         _ => return Err(err(format!("strategy `{value}` (bsdf, light, mis)"))),
                     }
                 }
+                "shadow-rays" | "glossy-rays" | "strategy" => return Err(missing()),
                 "light-sampling" => {
                     light_sampling = Some(match value {
                         "area" => LightSampling::Area,
@@ -102,6 +119,7 @@ impl BenchConfig {
                 _ => return Err(err(format!("unknown option `{key}`"))),
             }
         }
+        integrator.validate().map_err(err)?;
         Ok(BenchConfig {
             label: text.to_string(),
             integrator,
@@ -319,11 +337,16 @@ mod tests {
         let c =
             BenchConfig::parse("mcrt:independent:shadow-rays=5:glossy-rays=2:max-depth=3").unwrap();
         assert_eq!(c.integrator.kind, IntegratorKind::Mcrt);
-        assert_eq!((c.integrator.shadow_rays, c.integrator.glossy_rays), (5, 2));
-        assert_eq!(c.integrator.max_depth, 3);
+        assert_eq!(
+            (c.integrator.mcrt.shadow_rays, c.integrator.mcrt.glossy_rays),
+            (5, 2)
+        );
+        assert_eq!(c.integrator.max_depth(), Some(3));
+        // A setting the technique does not have is refused, not ignored.
+        assert!(BenchConfig::parse("light:independent:shadow-rays=5").is_err());
         let c = BenchConfig::parse("path:sobol:strategy=light:light-sampling=solid-angle").unwrap();
         assert_eq!(c.sampler, SamplerKind::Sobol);
-        assert_eq!(c.integrator.strategy, Strategy::Light);
+        assert_eq!(c.integrator.path.strategy, Strategy::Light);
         assert_eq!(c.light_sampling, Some(LightSampling::SolidAngle));
         assert_eq!(c.distribute, None);
         let c = BenchConfig::parse("path:sobol:distribute=4").unwrap();

@@ -50,12 +50,9 @@ intensity = [1.0, 1.0, 1.0]
 }
 
 fn ambient_occlusion(ao_distance: f32) -> tracelab::integrator::Integrator {
-    IntegratorOptions {
-        kind: IntegratorKind::AmbientOcclusion,
-        ao_distance,
-        ..Default::default()
-    }
-    .build()
+    let mut options = IntegratorOptions::of(IntegratorKind::AmbientOcclusion);
+    options.ao.distance = ao_distance;
+    options.build()
 }
 
 #[test]

@@ -21,12 +21,14 @@ fn clusters_solve_a_sphere_of_100k_triangles_within_one_percent_of_path_tracing(
     assert!(scene.geometry.triangles().len() > 100_000);
     scene.set_resolution(64, 64);
     let radiosity = IntegratorOptions {
-        kind: IntegratorKind::Radiosity,
-        radiosity_solver: RadiositySolver::Hierarchical,
-        radiosity_epsilon: 1e-4,
-        patch_size: 0.02,
-        radiosity_display: RadiosityDisplay::Smooth,
-        ..IntegratorOptions::default()
+        radiosity: tracelab::integrator::radiosity::Radiosity {
+            solver: RadiositySolver::Hierarchical,
+            epsilon: 1e-4,
+            patch_size: 0.02,
+            display: RadiosityDisplay::Smooth,
+            ..Default::default()
+        },
+        ..IntegratorOptions::of(IntegratorKind::Radiosity)
     };
     let (solved, stats) = crate::common::render_with(
         scene.clone(),

@@ -117,12 +117,14 @@ fn penumbra_lines_fall_where_similar_triangles_put_them_and_pieces_never_straddl
 fn discontinuity_meshing_beats_a_uniform_mesh_of_as_many_elements_on_the_cornell_box() {
     let render = |discontinuity: bool| {
         let options = IntegratorOptions {
-            kind: IntegratorKind::Radiosity,
-            radiosity_solver: RadiositySolver::GaussSeidel,
-            patch_size: 0.15,
-            radiosity_display: RadiosityDisplay::Smooth,
-            radiosity_discontinuity: discontinuity,
-            ..IntegratorOptions::default()
+            radiosity: tracelab::integrator::radiosity::Radiosity {
+                solver: RadiositySolver::GaussSeidel,
+                patch_size: 0.15,
+                display: RadiosityDisplay::Smooth,
+                discontinuity,
+                ..Default::default()
+            },
+            ..IntegratorOptions::of(IntegratorKind::Radiosity)
         };
         crate::common::render_with(
             crate::common::cornell_box(),
@@ -226,13 +228,15 @@ fn the_gather_samples_the_solutions_bright_elements() {
 fn indirect_room(display: RadiosityDisplay, discontinuity: bool) -> tracelab::image::Image {
     let scene = Scene::load(&crate::common::repo_path("scenes/indirect.toml")).unwrap();
     let options = IntegratorOptions {
-        kind: IntegratorKind::Radiosity,
-        radiosity_solver: RadiositySolver::Hierarchical,
-        radiosity_epsilon: 3e-5,
-        patch_size: 0.005,
-        radiosity_display: display,
-        radiosity_discontinuity: discontinuity,
-        ..IntegratorOptions::default()
+        radiosity: tracelab::integrator::radiosity::Radiosity {
+            solver: RadiositySolver::Hierarchical,
+            epsilon: 3e-5,
+            patch_size: 0.005,
+            display,
+            discontinuity,
+            ..Default::default()
+        },
+        ..IntegratorOptions::of(IntegratorKind::Radiosity)
     };
     // A solver's pass is a step; once converged, passes add display samples.
     let (snapshot, stats) = crate::common::render_with(

@@ -62,13 +62,12 @@ intensity = [1.0, 1.0, 1.0]
 fn mc_ray_tracing_casts_186_rays_per_pixel_with_two_branching_levels_and_5_by_5_branching() {
     // Cook's tree with D = 2 levels of branching gathers light of three
     // bounces: --max-depth counts bounces, so it is max_depth 3.
-    let options = IntegratorOptions {
-        kind: IntegratorKind::Mcrt,
-        max_depth: 3,
-        shadow_rays: 5,
-        glossy_rays: 5,
-        ..Default::default()
-    };
+    let mut options = IntegratorOptions::of(IntegratorKind::Mcrt);
+    (
+        options.mcrt.max_depth,
+        options.mcrt.shadow_rays,
+        options.mcrt.glossy_rays,
+    ) = (3, 5, 5);
     let tracelab::integrator::Integrator::Camera(tracelab::integrator::CameraIntegrator::Mcrt(
         mcrt,
     )) = options.build()
@@ -147,12 +146,8 @@ material = "glass"
 "#;
 
 fn whitted(text: &str, glass_shadows: GlassShadows, max_depth: u32) -> Vec<[f32; 3]> {
-    let options = IntegratorOptions {
-        kind: IntegratorKind::Whitted,
-        max_depth,
-        glass_shadows,
-        ..Default::default()
-    };
+    let mut options = IntegratorOptions::of(IntegratorKind::Whitted);
+    (options.whitted.max_depth, options.whitted.glass_shadows) = (max_depth, glass_shadows);
     let (a, _) = render_with(
         load("whitted", text),
         options.build(),

@@ -41,14 +41,12 @@ fn closed_box(scale: f32, name: &str) -> Scene {
 }
 
 fn radiosity(solver: RadiositySolver, patch_size: f32) -> Radiosity {
-    let options = IntegratorOptions {
-        kind: IntegratorKind::Radiosity,
-        radiosity_solver: solver,
+    Radiosity {
+        solver,
         patch_size,
-        radiosity_ambient: false,
-        ..IntegratorOptions::default()
-    };
-    <Radiosity as tracelab::integrator::Technique>::from_options(&options)
+        ambient: false,
+        ..Radiosity::default()
+    }
 }
 
 #[test]
@@ -409,12 +407,14 @@ fn hierarchical_cornell_box(
     steps: u32,
 ) -> (tracelab::film::FilmSnapshot, tracelab::render::RenderStats) {
     let options = IntegratorOptions {
-        kind: IntegratorKind::Radiosity,
-        radiosity_solver: RadiositySolver::Hierarchical,
-        radiosity_epsilon: epsilon,
-        patch_size: 0.005,
-        radiosity_display: tracelab::integrator::radiosity::RadiosityDisplay::Smooth,
-        ..IntegratorOptions::default()
+        radiosity: Radiosity {
+            solver: RadiositySolver::Hierarchical,
+            epsilon,
+            patch_size: 0.005,
+            display: tracelab::integrator::radiosity::RadiosityDisplay::Smooth,
+            ..Radiosity::default()
+        },
+        ..IntegratorOptions::of(IntegratorKind::Radiosity)
     };
     crate::common::render_with(
         crate::common::cornell_box(),
@@ -464,12 +464,14 @@ fn lit_panel(twin: bool, camera_above: bool, name: &str) -> Scene {
 fn radiosity_shows_a_thin_panel_from_either_side() {
     let image = |scene: Scene| {
         let options = IntegratorOptions {
-            kind: IntegratorKind::Radiosity,
-            radiosity_solver: RadiositySolver::Hierarchical,
-            radiosity_epsilon: 1e-4,
-            patch_size: 0.05,
-            radiosity_display: tracelab::integrator::radiosity::RadiosityDisplay::Smooth,
-            ..IntegratorOptions::default()
+            radiosity: Radiosity {
+                solver: RadiositySolver::Hierarchical,
+                epsilon: 1e-4,
+                patch_size: 0.05,
+                display: tracelab::integrator::radiosity::RadiosityDisplay::Smooth,
+                ..Radiosity::default()
+            },
+            ..IntegratorOptions::of(IntegratorKind::Radiosity)
         };
         crate::common::render_with(
             scene,
@@ -555,12 +557,14 @@ fn the_back_of_a_thin_surface_reflects_light() {
         (RadiositySolver::Hierarchical, 0.02),
     ] {
         let options = IntegratorOptions {
-            kind: IntegratorKind::Radiosity,
-            radiosity_solver: solver,
-            radiosity_epsilon: 1e-5,
-            patch_size,
-            radiosity_display: tracelab::integrator::radiosity::RadiosityDisplay::Smooth,
-            ..IntegratorOptions::default()
+            radiosity: Radiosity {
+                solver,
+                epsilon: 1e-5,
+                patch_size,
+                display: tracelab::integrator::radiosity::RadiosityDisplay::Smooth,
+                ..Radiosity::default()
+            },
+            ..IntegratorOptions::of(IntegratorKind::Radiosity)
         };
         let radiosity = render(options, 16, 0);
         eprintln!(

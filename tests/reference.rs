@@ -20,11 +20,9 @@ use tracelab::render::Adaptive;
 use tracelab::sampling::SamplerKind;
 
 fn options(kind: IntegratorKind, max_depth: u32) -> IntegratorOptions {
-    IntegratorOptions {
-        kind,
-        max_depth,
-        ..Default::default()
-    }
+    let mut options = IntegratorOptions::of(kind);
+    *options.max_depth_mut().expect("a technique with a depth") = max_depth;
+    options
 }
 
 fn check_against_reference(options: IntegratorOptions, reference_name: &str, variance_name: &str) {
@@ -115,9 +113,10 @@ fn direct_lighting_matches_mitsuba_on_the_cornell_box() {
 fn path_tracing_with_bsdf_or_light_sampling_alone_matches_mitsuba() {
     for strategy in [Strategy::Bsdf, Strategy::Light] {
         check_against_reference(
-            IntegratorOptions {
-                strategy,
-                ..options(IntegratorKind::Path, 8)
+            {
+                let mut o = options(IntegratorKind::Path, 8);
+                o.path.strategy = strategy;
+                o
             },
             "cornell_box_path_ref.exr",
             "cornell_box_path_ref_var.exr",
@@ -142,10 +141,10 @@ fn mc_ray_tracing_without_branching_matches_mitsuba() {
         ),
     ] {
         check_against_reference(
-            IntegratorOptions {
-                shadow_rays: 1,
-                glossy_rays: 1,
-                ..options(IntegratorKind::Mcrt, depth)
+            {
+                let mut o = options(IntegratorKind::Mcrt, depth);
+                (o.mcrt.shadow_rays, o.mcrt.glossy_rays) = (1, 1);
+                o
             },
             reference,
             variance,
@@ -193,10 +192,8 @@ fn vertex_connection_and_merging_matches_mitsuba_on_the_cornell_box() {
 /// no noise reaches.
 #[test]
 fn path_tracing_with_samples_spread_by_noise_matches_mitsuba_with_less_error() {
-    let sampled_edges = IntegratorOptions {
-        exact_seen_emitters: false,
-        ..options(IntegratorKind::Path, 8)
-    };
+    let mut sampled_edges = options(IntegratorKind::Path, 8);
+    sampled_edges.path.exact_seen_emitters = false;
     let uniform = check_adaptive_against_reference(
         sampled_edges,
         None,
@@ -246,10 +243,10 @@ fn path_tracing_with_exact_seen_emitters_matches_mitsuba_with_less_error() {
     // the same margin holds for it.
     for kind in [IntegratorKind::Path, IntegratorKind::Mcrt] {
         let exact = check_against_reference_rmse(options(kind, 8));
-        let sampled = check_against_reference_rmse(IntegratorOptions {
-            exact_seen_emitters: false,
-            ..options(kind, 8)
-        });
+        let mut sampled = options(kind, 8);
+        sampled.path.exact_seen_emitters = false;
+        sampled.mcrt.exact_seen_emitters = false;
+        let sampled = check_against_reference_rmse(sampled);
         assert!(
             exact * 2.0 < sampled,
             "{kind:?}: RMSE with seen emitters exact {exact:.5}, sampled {sampled:.5}"

@@ -321,7 +321,15 @@ fn radiosity_controls_drive_the_solver() {
     click(&mut harness, "hierarchical");
     click(&mut harness, "flat");
     // Each form-factor method starts from the count at which it is accurate.
-    let samples = |h: &Harness<'_, Window>| h.state().app.settings.a.integrator.form_factor_samples;
+    let samples = |h: &Harness<'_, Window>| {
+        h.state()
+            .app
+            .settings
+            .a
+            .integrator
+            .radiosity
+            .form_factor_samples
+    };
     click(&mut harness, "Ray casting");
     assert_eq!(samples(&harness), 256);
     click(&mut harness, "Contour integral");
@@ -329,7 +337,7 @@ fn radiosity_controls_drive_the_solver() {
     let options = harness.state().app.settings.a.integrator;
     assert_eq!(options.kind, IntegratorKind::Radiosity);
     assert_eq!(
-        options.radiosity_solver,
+        options.radiosity.solver,
         tracelab::radiosity::RadiositySolver::Hierarchical
     );
     // The solver runs its steps (the target of 4 "spp" is 4 steps here) and
@@ -347,22 +355,30 @@ fn radiosity_controls_drive_the_solver() {
     harness.get_by_label_contains("links");
     // Another solver restarts from its own mesh (a coarse one, for time).
     // Progressive refinement converges over thousands of shots: 50 here.
-    harness.state_mut().app.settings.a.integrator.patch_size = 0.3;
     harness
         .state_mut()
         .app
         .settings
         .a
         .integrator
-        .radiosity_iterations = 50;
+        .radiosity
+        .patch_size = 0.3;
+    harness
+        .state_mut()
+        .app
+        .settings
+        .a
+        .integrator
+        .radiosity
+        .iterations = 50;
     click(&mut harness, "progressive");
-    let ambient = harness.state().app.settings.a.integrator.radiosity_ambient;
+    let ambient = harness.state().app.settings.a.integrator.radiosity.ambient;
     click(&mut harness, "Ambient term");
     step_until(&mut harness, "the progressive solution", finished);
     let options = harness.state().app.settings.a.integrator;
-    assert_eq!(options.radiosity_ambient, !ambient);
+    assert_eq!(options.radiosity.ambient, !ambient);
     assert_eq!(
-        options.radiosity_solver,
+        options.radiosity.solver,
         tracelab::radiosity::RadiositySolver::Progressive
     );
     // Gauss-Seidel with a round of adaptive subdivision and the wireframe:
@@ -373,7 +389,8 @@ fn radiosity_controls_drive_the_solver() {
         .settings
         .a
         .integrator
-        .radiosity_iterations = 0;
+        .radiosity
+        .iterations = 0;
     click(&mut harness, "gauss-seidel");
     harness.get_by_role_and_label(egui::accesskit::Role::Slider, "Adaptive subdivision rounds");
     harness
@@ -382,6 +399,7 @@ fn radiosity_controls_drive_the_solver() {
         .settings
         .a
         .integrator
+        .radiosity
         .adaptive_rounds = 1;
     click(&mut harness, "Wireframe (colour by level)");
     step_until(&mut harness, "the adaptive solution", finished);
@@ -392,7 +410,8 @@ fn radiosity_controls_drive_the_solver() {
             .settings
             .a
             .integrator
-            .radiosity_wireframe
+            .radiosity
+            .wireframe
     );
     let solver = harness.state().app.frame().views[0].stats.solver.unwrap();
     assert!(solver.converged && solver.elements > 206, "{solver:?}");
@@ -408,7 +427,8 @@ fn radiosity_controls_drive_the_solver() {
             .settings
             .a
             .integrator
-            .radiosity_discontinuity
+            .radiosity
+            .discontinuity
     );
     step_until(&mut harness, "the discontinuity mesh's solution", finished);
     harness.run_steps(2);
@@ -425,7 +445,10 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
     click(&mut harness, "Balance");
     let options = harness.state().app.settings.a.integrator;
     assert_eq!(options.kind, IntegratorKind::Bdpt);
-    assert_eq!(options.mis, tracelab::integrator::MisHeuristic::Balance);
+    assert_eq!(
+        options.bdpt.mis,
+        tracelab::integrator::MisHeuristic::Balance
+    );
     step_until(&mut harness, "2 spp of BDPT", finished);
     assert!(harness.state().app.frame().views[0].stats.spp >= 2);
     // The strategy images fill in on their own thread.
@@ -443,7 +466,7 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
     harness.run_steps(2);
     let options = harness.state().app.settings.a.integrator;
     assert_eq!(options.kind, IntegratorKind::Photon);
-    assert_eq!(options.photon_k, 20);
+    assert_eq!(options.photon.k, 20);
     assert!(
         !harness.state().app.strategy_grid.open,
         "the grid closes with BDPT"
@@ -464,7 +487,7 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
     harness.run_steps(2);
     let options = harness.state().app.settings.a.integrator;
     assert_eq!(options.kind, IntegratorKind::Sppm);
-    assert_eq!(options.photon_alpha, 1.0);
+    assert_eq!(options.sppm.alpha, 1.0);
     step_until(&mut harness, "2 iterations of photon mapping", finished);
     assert!(harness.state().app.frame().views[0].stats.spp >= 2);
 
@@ -480,11 +503,11 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
     harness.run_steps(2);
     let options = harness.state().app.settings.a.integrator;
     assert_eq!(options.kind, IntegratorKind::Vcm);
-    assert_eq!(options.mis, tracelab::integrator::MisHeuristic::Power);
+    assert_eq!(options.vcm.mis, tracelab::integrator::MisHeuristic::Power);
     assert!(
-        (options.photon_radius - 0.01).abs() < 1e-6,
+        (options.vcm.radius - 0.01).abs() < 1e-6,
         "{}",
-        options.photon_radius
+        options.vcm.radius
     );
     step_until(&mut harness, "2 iterations of VCM", finished);
     assert!(harness.state().app.frame().views[0].stats.spp >= 2);

@@ -10,6 +10,7 @@ mod shared;
 mod solver;
 mod strategies;
 mod stress;
+mod technique;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
@@ -175,7 +176,7 @@ fn view(args: ViewArgs) -> Result<()> {
     if let Some(shot) = &args.screenshot {
         tracelab::image::check_writable(shot)?;
     }
-    args.radiosity.check()?;
+    let radiosity = args.radiosity.settings()?;
     let launch_kind = args.integrator.map(integrator_kind);
     tracelab::viewer::run(tracelab::viewer::Launch {
         scene: args.scene,
@@ -198,8 +199,7 @@ fn view(args: ViewArgs) -> Result<()> {
         lab: args.lab.map(|e| e.0),
         strategy_grid: args.strategy_grid,
         export_dir: args.export_dir,
-        radiosity: (launch_kind == Some(IntegratorKind::Radiosity))
-            .then(|| args.radiosity.options()),
+        radiosity: (launch_kind == Some(IntegratorKind::Radiosity)).then_some(radiosity),
         defines: args.define,
         strict: args.strict,
     })

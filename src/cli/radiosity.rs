@@ -10,8 +10,8 @@ use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::sync::Arc;
 use tracelab::image::{Image, check_writable};
-use tracelab::integrator::radiosity::RadiosityDisplay;
-use tracelab::integrator::{IntegratorKind, IntegratorOptions};
+use tracelab::integrator::radiosity::{Radiosity, RadiosityDisplay};
+use tracelab::integrator::{IntegratorKind, IntegratorOptions, Settings};
 use tracelab::plot::{Figure, PlotFormat, Series, SeriesStyle, log_log_plot, write_figure};
 use tracelab::radiosity::{FormFactorMethod, RadiositySolver};
 use tracelab::render::{RenderSettings, Session};
@@ -42,47 +42,52 @@ enum FormFactorArg {
     RayCast,
 }
 
-/// The radiosity technique's flags.
+/// The radiosity technique's flags; each left out keeps the setting it
+/// applies to ([`Radiosity`]'s defaults on the command line).
 #[derive(Args, Debug)]
 pub struct RadiosityFlags {
-    /// Radiosity: the solver.
-    #[arg(long, value_enum, default_value = "gauss-seidel")]
-    solver: SolverArg,
+    /// Radiosity: the solver [default: gauss-seidel].
+    #[arg(long, value_enum)]
+    solver: Option<SolverArg>,
     /// Radiosity, progressive solver: add the ambient term to the display.
     #[arg(long)]
     ambient_term: bool,
     /// Radiosity: sweeps (Jacobi, Gauss-Seidel) or shots (progressive) to
-    /// run; 0 runs until the solution stops changing.
-    #[arg(long, default_value_t = 0)]
-    iterations: u32,
+    /// run; 0 runs until the solution stops changing [default: 0].
+    #[arg(long)]
+    iterations: Option<u32>,
     /// Radiosity: longest element edge (the smallest one, hierarchical),
-    /// as a fraction of the scene's diagonal.
-    #[arg(long, default_value_t = 0.1)]
-    patch_size: f32,
+    /// as a fraction of the scene's diagonal [default: 0.1].
+    #[arg(long)]
+    patch_size: Option<f32>,
     /// Radiosity, hierarchical: a link may carry at most this share of the
-    /// emitted power (smaller: more links, more accuracy, more time).
-    #[arg(long, default_value_t = 1e-4)]
-    epsilon: f32,
+    /// emitted power (smaller: more links, more accuracy, more time)
+    /// [default: 1e-4].
+    #[arg(long)]
+    epsilon: Option<f32>,
     /// Radiosity: samples (point pairs or points) per element pair for form
     /// factors [default: 16 analytic, 256 ray-cast].
     #[arg(long)]
     ff_rays: Option<u32>,
     /// Radiosity: how the solution is shown (`flat`, `smooth`, or `gather`:
-    /// direct light sampled, indirect read from the solution).
-    #[arg(long, value_enum, default_value = "gather")]
-    display: DisplayArg,
+    /// direct light sampled, indirect read from the solution) [default: gather].
+    #[arg(long, value_enum)]
+    display: Option<DisplayArg>,
     /// Radiosity: form factors by the point-to-polygon contour integral
-    /// times visibility (`analytic`) or by point pairs (`ray-cast`).
-    #[arg(long, value_enum, default_value = "analytic")]
-    ff_method: FormFactorArg,
+    /// times visibility (`analytic`) or by point pairs (`ray-cast`)
+    /// [default: analytic].
+    #[arg(long, value_enum)]
+    ff_method: Option<FormFactorArg>,
     /// Radiosity, Jacobi, Gauss-Seidel or progressive: rounds of adaptive
-    /// subdivision after the first solve (split elements where neighbours differ).
-    #[arg(long, default_value_t = 0)]
-    adaptive_rounds: u32,
+    /// subdivision after the first solve (split elements where neighbours
+    /// differ) [default: 0].
+    #[arg(long)]
+    adaptive_rounds: Option<u32>,
     /// Radiosity: adaptive subdivision splits an element whose reflected
-    /// radiance differs from a neighbour's by more than this times the mean.
-    #[arg(long, default_value_t = 0.5)]
-    adaptive_tolerance: f32,
+    /// radiance differs from a neighbour's by more than this times the mean
+    /// [default: 0.5].
+    #[arg(long)]
+    adaptive_tolerance: Option<f32>,
     /// Radiosity: draw the elements' edges over the image, coloured by level.
     #[arg(long)]
     wireframe: bool,
@@ -94,66 +99,49 @@ pub struct RadiosityFlags {
 }
 
 impl RadiosityFlags {
-    /// Default options with the radiosity fields from the flags.
-    pub fn options(&self) -> IntegratorOptions {
-        IntegratorOptions {
-            radiosity_solver: match self.solver {
+    /// `settings` with the flags given applied, checked.
+    pub fn apply(&self, settings: &mut Radiosity) -> Result<()> {
+        if let Some(solver) = self.solver {
+            settings.solver = match solver {
                 SolverArg::Jacobi => RadiositySolver::Jacobi,
                 SolverArg::GaussSeidel => RadiositySolver::GaussSeidel,
                 SolverArg::Progressive => RadiositySolver::Progressive,
                 SolverArg::Hierarchical => RadiositySolver::Hierarchical,
-            },
-            radiosity_epsilon: self.epsilon,
-            patch_size: self.patch_size,
-            form_factor_method: self.form_factor_method(),
-            form_factor_samples: self
-                .ff_rays
-                .unwrap_or(self.form_factor_method().default_samples()),
-            radiosity_ambient: self.ambient_term,
-            radiosity_iterations: self.iterations,
-            adaptive_rounds: self.adaptive_rounds,
-            adaptive_tolerance: self.adaptive_tolerance,
-            radiosity_wireframe: self.wireframe,
-            radiosity_discontinuity: self.discontinuity_meshing,
-            radiosity_display: match self.display {
+            };
+        }
+        if let Some(method) = self.ff_method {
+            settings.form_factors = match method {
+                FormFactorArg::Analytic => FormFactorMethod::Analytic,
+                FormFactorArg::RayCast => FormFactorMethod::RayCast,
+            };
+            settings.form_factor_samples = settings.form_factors.default_samples();
+        }
+        settings.form_factor_samples = self.ff_rays.unwrap_or(settings.form_factor_samples);
+        settings.epsilon = self.epsilon.unwrap_or(settings.epsilon);
+        settings.patch_size = self.patch_size.unwrap_or(settings.patch_size);
+        settings.iterations = self.iterations.unwrap_or(settings.iterations);
+        settings.adaptive_rounds = self.adaptive_rounds.unwrap_or(settings.adaptive_rounds);
+        settings.adaptive_tolerance = self
+            .adaptive_tolerance
+            .unwrap_or(settings.adaptive_tolerance);
+        settings.ambient |= self.ambient_term;
+        settings.wireframe |= self.wireframe;
+        settings.discontinuity |= self.discontinuity_meshing;
+        if let Some(display) = self.display {
+            settings.display = match display {
                 DisplayArg::Flat => RadiosityDisplay::Flat,
                 DisplayArg::Smooth => RadiosityDisplay::Smooth,
                 DisplayArg::Gather => RadiosityDisplay::Gather,
-            },
-            ..IntegratorOptions::default()
+            };
         }
+        settings.validate().map_err(Error::new)
     }
 
-    fn form_factor_method(&self) -> FormFactorMethod {
-        match self.ff_method {
-            FormFactorArg::Analytic => FormFactorMethod::Analytic,
-            FormFactorArg::RayCast => FormFactorMethod::RayCast,
-        }
-    }
-
-    /// Refuses sizes and counts that mean nothing.
-    pub fn check(&self) -> Result<()> {
-        if !(self.epsilon > 0.0 && self.epsilon.is_finite()) {
-            return Err(Error::new(format!(
-                "--epsilon must be positive, got {}",
-                self.epsilon
-            )));
-        }
-        if !(self.adaptive_tolerance > 0.0 && self.adaptive_tolerance.is_finite()) {
-            return Err(Error::new(format!(
-                "--adaptive-tolerance must be positive, got {}",
-                self.adaptive_tolerance
-            )));
-        }
-        if !(self.patch_size > 0.0 && self.patch_size <= 1.0) || self.ff_rays == Some(0) {
-            return Err(Error::new(format!(
-                "--patch-size must be in (0, 1] (got {}) and --ff-rays at least 1 (got {})",
-                self.patch_size,
-                self.ff_rays
-                    .unwrap_or(self.form_factor_method().default_samples())
-            )));
-        }
-        Ok(())
+    /// The default settings with the flags applied, checked.
+    pub fn settings(&self) -> Result<Radiosity> {
+        let mut settings = Radiosity::default();
+        self.apply(&mut settings)?;
+        Ok(settings)
     }
 }
 
@@ -296,7 +284,7 @@ fn print_row(first: &str, row: &Row) {
 }
 
 pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
-    args.radiosity.check()?;
+    let settings = args.radiosity.settings()?;
     check_sweeps(args)?;
     for path in [&args.csv, &args.plot, &args.scaling_plot]
         .into_iter()
@@ -320,8 +308,8 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
         &limits,
     )?;
     let options = IntegratorOptions {
-        kind: IntegratorKind::Radiosity,
-        ..args.radiosity.options()
+        radiosity: settings,
+        ..IntegratorOptions::of(IntegratorKind::Radiosity)
     };
     let scene = Arc::new(scene);
     if !args.sweep_epsilon.is_empty() || !args.sweep_patch_size.is_empty() {
@@ -329,14 +317,12 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
     }
     let rows = run(scene.clone(), &reference, options, args, true)?;
     // Progressive refinement: the plot shows both ambient settings.
-    let other = if options.radiosity_solver == RadiositySolver::Progressive && args.plot.is_some() {
-        let other = IntegratorOptions {
-            radiosity_ambient: !options.radiosity_ambient,
-            ..options
-        };
+    let other = if options.radiosity.solver == RadiositySolver::Progressive && args.plot.is_some() {
+        let mut other = options;
+        other.radiosity.ambient = !options.radiosity.ambient;
         println!(
             "and {} the ambient term, for the plot:",
-            if other.radiosity_ambient {
+            if other.radiosity.ambient {
                 "with"
             } else {
                 "without"
@@ -375,7 +361,7 @@ pub fn radiosity(args: &RadiosityArgs) -> Result<()> {
             ),
         ];
         if let Some(other_rows) = &other {
-            let (this, that) = if options.radiosity_ambient {
+            let (this, that) = if options.radiosity.ambient {
                 ("with ambient", "without ambient")
             } else {
                 ("without ambient", "with ambient")
@@ -430,7 +416,9 @@ fn check_sweeps(args: &RadiosityArgs) -> Result<()> {
             "--sweep-patch-size values must be in (0, 1], got {s}"
         )));
     }
-    if !args.sweep_epsilon.is_empty() && !matches!(args.radiosity.solver, SolverArg::Hierarchical) {
+    if !args.sweep_epsilon.is_empty()
+        && !matches!(args.radiosity.solver, Some(SolverArg::Hierarchical))
+    {
         return Err(Error::new(
             "--sweep-epsilon needs --solver hierarchical (epsilon is its oracle's)",
         ));
@@ -475,17 +463,12 @@ fn sweep(
         print_header(name);
         let mut points = Vec::new();
         for &value in values {
-            let run_options = if name == "epsilon" {
-                IntegratorOptions {
-                    radiosity_epsilon: value,
-                    ..options
-                }
+            let mut run_options = options;
+            if name == "epsilon" {
+                run_options.radiosity.epsilon = value;
             } else {
-                IntegratorOptions {
-                    patch_size: value,
-                    ..options
-                }
-            };
+                run_options.radiosity.patch_size = value;
+            }
             let rows = run(scene.clone(), reference, run_options, args, false)?;
             let Some(last) = rows.last() else { continue };
             let label = if name == "epsilon" {

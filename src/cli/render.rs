@@ -2,35 +2,30 @@
 //! and a summary of what it cost; `--debug-sample` replays one path.
 
 use super::choices::*;
-use super::radiosity::RadiosityFlags;
 use super::shared::{override_resolution, progress_bar};
 use super::solver::{render_solver, render_until};
-use super::{IntegratorArg, integrator_kind};
+use super::technique::TechniqueFlags;
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tracelab::film::{EXTREME_LUMINANCE, FinalImage, FlaggedPixel};
 use tracelab::image::check_writable;
-use tracelab::integrator::{
-    CameraIntegrator, GlassShadows, Integrator, IntegratorKind, IntegratorOptions, MisHeuristic,
-    SplattingIntegrator, Strategy,
-};
+use tracelab::integrator::{CameraIntegrator, Integrator, SplattingIntegrator};
 use tracelab::math::OffsetMode;
 use tracelab::render::{Adaptive, RenderSettings, RenderStats, Session};
 use tracelab::replay::replay_sample;
 use tracelab::sampling::{Domains, SamplerKind};
 use tracelab::scene::light::LightSampling;
-use tracelab::scene::{Limits, LoadOptions, RenderHints, Scene};
+use tracelab::scene::{Limits, LoadOptions, Scene};
 use tracelab::{Error, Result};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// Scene file: tracelab TOML, Mitsuba XML, or a bare OBJ or PLY mesh.
     scene: PathBuf,
-    /// Technique (default: the scene file's integrator, else path).
-    #[arg(long, value_enum)]
-    integrator: Option<IntegratorArg>,
+    #[command(flatten)]
+    pub(crate) technique: TechniqueFlags,
     /// Mitsuba XML: set a parameter `$name` (as Mitsuba's -D).
     #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
     define: Vec<(String, String)>,
@@ -54,26 +49,6 @@ pub struct RenderArgs {
     /// pixel,lens,time,light,bsdf (default all).
     #[arg(long, value_parser = parse_domains)]
     domains: Option<Domains>,
-    /// Maximum bounces (1 = direct lighting); Mitsuba's max_depth is one
-    /// more (default: the scene file's, else 8).
-    #[arg(long)]
-    max_depth: Option<u32>,
-    /// Russian roulette starts after this many bounces (default: the scene
-    /// file's, else 5).
-    #[arg(long)]
-    rr_depth: Option<u32>,
-    /// Turn Russian roulette off.
-    #[arg(long)]
-    no_rr: bool,
-    /// Turn next-event estimation (light sampling) off: the same as --strategy bsdf.
-    #[arg(long, conflicts_with = "strategy")]
-    no_nee: bool,
-    /// Path tracing: sample the BSDF, the lights, or both with MIS.
-    #[arg(long, value_enum)]
-    strategy: Option<StrategyArg>,
-    /// How light and BSDF samples are combined (none = light sampling only).
-    #[arg(long, value_enum, default_value = "power")]
-    mis: MisArg,
     /// How area lights are sampled (default: the scene's, i.e. triangles by
     /// area and spheres by solid angle unless its [lights] table says otherwise).
     #[arg(long, value_enum)]
@@ -82,51 +57,6 @@ pub struct RenderArgs {
     /// or `fixed:EPS` (the classic epsilon along the normal, to see its artifacts).
     #[arg(long, value_parser = OffsetMode::parse, default_value = "robust")]
     offset: OffsetMode,
-    /// MC ray tracing: light samples (shadow rays) per hit.
-    #[arg(long, default_value_t = 1)]
-    shadow_rays: u32,
-    /// MC ray tracing: BSDF samples (branching rays) per hit.
-    #[arg(long, default_value_t = 1)]
-    glossy_rays: u32,
-    /// Ambient occlusion: occluders count within this fraction of the
-    /// scene's bounding-box diagonal (0: no limit).
-    #[arg(long, default_value_t = 0.1)]
-    ao_distance: f32,
-    /// Photon mapping: photons per iteration (0: one per pixel).
-    #[arg(long, default_value_t = 0)]
-    photons: u32,
-    /// Photon mapping and VCM: gather (merge) radius of the first
-    /// iteration, as a fraction of the scene's bounding-box diagonal.
-    #[arg(long, default_value_t = 0.002)]
-    radius: f32,
-    /// Photon mapping and VCM: the radius shrinks as r_i^2 = r_1^2 i^(alpha - 1)
-    /// (0 < alpha <= 1; 1 keeps it fixed, a biased estimate).
-    #[arg(long, default_value_t = 2.0 / 3.0)]
-    alpha: f32,
-    /// Photon mapping (Jensen): photons per density estimate (1 to 256).
-    #[arg(long, default_value_t = 50)]
-    k: u32,
-    /// Photon mapping (Jensen): the largest gather radius, as a fraction of
-    /// the scene's bounding-box diagonal.
-    #[arg(long, default_value_t = 0.05)]
-    gather_radius: f32,
-    #[command(flatten)]
-    pub(crate) radiosity: RadiosityFlags,
-    /// Path tracing and Whitted: run the general code, not the code
-    /// specialised for the scene's features (to measure what that saves).
-    #[arg(long)]
-    general: bool,
-    /// Path and MC ray tracing: emitters seen directly through a pixel are integrated
-    /// exactly over it where nothing can hide them (`exact`), or sampled by
-    /// the camera rays like everything else (`sampled`).
-    #[arg(long, value_enum, default_value = "exact")]
-    seen_emitters: SeenEmittersArg,
-    /// Whitted: constant ambient radiance times the diffuse albedo.
-    #[arg(long, default_value_t = 0.0)]
-    ambient: f32,
-    /// Whitted: shadow rays through glass are blocked, or tinted by the glass.
-    #[arg(long, value_enum, default_value = "opaque")]
-    glass_shadows: GlassShadowsArg,
     /// Image width (overrides the scene).
     #[arg(long)]
     width: Option<u32>,
@@ -274,7 +204,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     }
     let load_time = load_start.elapsed();
 
-    let integrator = integrator_options(args, &hints)?.build();
+    let integrator = args.technique.options(&hints)?.build();
     let sampler = match (args.sampler, &hints.sampler) {
         (Some(s), _) => s.kind(),
         (None, Some(name)) => SamplerArg::from_str(name, true)
@@ -439,91 +369,6 @@ fn render_rays(session: &Session, budget: f64) -> RenderStats {
     }
     bar.finish_and_clear();
     session.stats()
-}
-
-/// Estimator options from the command line.
-fn integrator_options(args: &RenderArgs, hints: &RenderHints) -> Result<IntegratorOptions> {
-    let kind = match (args.integrator, &hints.integrator) {
-        (Some(i), _) => integrator_kind(i),
-        (None, Some(name)) => IntegratorKind::ALL
-            .iter()
-            .copied()
-            .find(|k| k.name() == name)
-            .ok_or_else(|| {
-                Error::new(format!(
-                    "the scene asks for an unknown technique \"{name}\""
-                ))
-            })?,
-        (None, None) => IntegratorKind::Path,
-    };
-    let strategy = match (args.strategy, args.no_nee, args.mis) {
-        (Some(StrategyArg::Bsdf), ..) | (None, true, _) => Strategy::Bsdf,
-        (Some(StrategyArg::Light), ..) | (None, false, MisArg::None) => Strategy::Light,
-        (Some(StrategyArg::Mis), _, MisArg::None) => {
-            return Err(Error::new("--strategy mis needs --mis balance or power"));
-        }
-        _ => Strategy::Mis,
-    };
-    if !(args.ao_distance >= 0.0 && args.ao_distance.is_finite()) {
-        return Err(Error::new(format!(
-            "--ao-distance {} is not a fraction >= 0 of the scene's size",
-            args.ao_distance
-        )));
-    }
-    args.radiosity.check()?;
-    if !(args.radius > 0.0 && args.radius < 1.0) {
-        return Err(Error::new(format!(
-            "--radius {} is not a fraction in (0, 1) of the scene's size",
-            args.radius
-        )));
-    }
-    if !(1..=256).contains(&args.k) {
-        return Err(Error::new(format!("--k {} is not in 1..=256", args.k)));
-    }
-    if !(args.gather_radius > 0.0 && args.gather_radius < 1.0) {
-        return Err(Error::new(format!(
-            "--gather-radius {} is not a fraction in (0, 1) of the scene's size",
-            args.gather_radius
-        )));
-    }
-    if !(args.alpha > 0.0 && args.alpha <= 1.0) {
-        return Err(Error::new(format!(
-            "--alpha {} is not in (0, 1]",
-            args.alpha
-        )));
-    }
-    if kind == IntegratorKind::Mcrt && args.shadow_rays + args.glossy_rays == 0 {
-        return Err(Error::new(
-            "--shadow-rays and --glossy-rays cannot both be 0",
-        ));
-    }
-    Ok(IntegratorOptions {
-        kind,
-        max_depth: args.max_depth.or(hints.max_depth).unwrap_or(8),
-        russian_roulette: !args.no_rr,
-        rr_depth: args.rr_depth.or(hints.rr_depth).unwrap_or(5),
-        strategy,
-        mis: match args.mis {
-            MisArg::Balance => MisHeuristic::Balance,
-            MisArg::None | MisArg::Power => MisHeuristic::Power,
-        },
-        shadow_rays: args.shadow_rays,
-        glossy_rays: args.glossy_rays,
-        ambient: args.ambient,
-        glass_shadows: match args.glass_shadows {
-            GlassShadowsArg::Opaque => GlassShadows::Opaque,
-            GlassShadowsArg::Tinted => GlassShadows::Tinted,
-        },
-        general: args.general,
-        exact_seen_emitters: args.seen_emitters == SeenEmittersArg::Exact,
-        ao_distance: args.ao_distance,
-        photons: args.photons,
-        photon_radius: args.radius,
-        photon_alpha: args.alpha,
-        photon_k: args.k,
-        gather_radius: args.gather_radius,
-        ..args.radiosity.options()
-    })
 }
 
 /// Renders passes until `budget` is spent, sizing passes so as not to overshoot.

@@ -10,7 +10,7 @@
 //! V: the estimator is the fraction of unblocked cosine samples, a Bernoulli
 //! variable of variance AO (1 - AO). Camera rays that hit nothing give 0.
 
-use super::{CameraEstimator, IntegratorOptions, RayCounts, Technique};
+use super::{CameraEstimator, RayCounts, Settings, Technique};
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
@@ -18,6 +18,34 @@ use crate::scene::Scene;
 use crate::shortcuts::{PrimaryPixel, ShortcutsUsed};
 
 /// Settings of the ambient occlusion estimator.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct AoSettings {
+    /// Occluders count within this fraction of the scene's bounding-box
+    /// diagonal (0: no limit).
+    pub distance: f32,
+}
+
+impl Default for AoSettings {
+    fn default() -> Self {
+        AoSettings { distance: 0.1 }
+    }
+}
+
+impl Settings for AoSettings {
+    fn validate(&self) -> Result<(), String> {
+        if self.distance >= 0.0 && self.distance.is_finite() {
+            Ok(())
+        } else {
+            Err(format!(
+                "ambient occlusion distance {} is not a fraction >= 0 of the scene's size",
+                self.distance
+            ))
+        }
+    }
+}
+
+/// The ambient occlusion estimator.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AmbientOcclusion {
     /// Occluders farther than this fraction of the scene's bounding-box
@@ -48,8 +76,10 @@ impl AmbientOcclusion {
 impl Technique for AmbientOcclusion {
     const SUMMARY: &'static str = "Ambient occlusion: the cosine-weighted open fraction of the hemisphere at the first hit, within a distance.";
 
-    fn from_options(options: &IntegratorOptions) -> Self {
-        AmbientOcclusion::with_relative_distance(options.ao_distance)
+    type Settings = AoSettings;
+
+    fn new(settings: &AoSettings) -> Self {
+        AmbientOcclusion::with_relative_distance(settings.distance)
     }
 
     fn describe(&self) -> String {

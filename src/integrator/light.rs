@@ -16,7 +16,7 @@
 //! radiance scaling at refraction does not apply to particles (Veach's
 //! thesis, 5.2).
 
-use super::{IntegratorOptions, RayCounts, SplattingEstimator, Technique, survives_roulette};
+use super::{PathLength, RayCounts, Settings, SplattingEstimator, Technique, survives_roulette};
 use crate::camera::CameraConnection;
 use crate::math::{Frame, Rgb, ray_between};
 use crate::sampling::{Domain, Sampler};
@@ -25,7 +25,25 @@ use crate::scene::light::EmissionSample;
 use crate::scene::material::Bsdf;
 use glam::{Vec2, Vec3A};
 
-/// Settings of the light tracer.
+/// Settings of the light tracer: how long its particles' paths run.
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct LightSettings {
+    #[serde(flatten)]
+    pub length: PathLength,
+}
+
+impl Settings for LightSettings {
+    fn max_depth_mut(&mut self) -> Option<&mut u32> {
+        Some(&mut self.length.max_depth)
+    }
+
+    fn length_mut(&mut self) -> Option<&mut PathLength> {
+        Some(&mut self.length)
+    }
+}
+
+/// The light tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightTracer {
     /// Bounces after leaving the light (0 = only lights seen directly).
@@ -56,11 +74,13 @@ impl Technique for LightTracer {
     const SUMMARY: &'static str =
         "Light (particle) tracing: paths from the lights, every vertex connected to the camera.";
 
-    fn from_options(options: &IntegratorOptions) -> Self {
+    type Settings = LightSettings;
+
+    fn new(settings: &LightSettings) -> Self {
         LightTracer {
-            max_depth: options.max_depth,
-            rr_depth: options.rr_depth,
-            russian_roulette: options.russian_roulette,
+            max_depth: settings.length.max_depth,
+            rr_depth: settings.length.rr_depth,
+            russian_roulette: settings.length.russian_roulette,
         }
     }
 

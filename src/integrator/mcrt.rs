@@ -14,7 +14,7 @@
 //! light sample can be taken: specular surfaces, or N = 0). Cook's tree of
 //! two branching levels (the classic 186-ray example) is D = 3.
 
-use super::{CameraEstimator, IntegratorOptions, MisHeuristic, RayCounts, Technique};
+use super::{CameraEstimator, MisHeuristic, RayCounts, Settings, Technique};
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::{Domain, Sampler};
@@ -22,6 +22,52 @@ use crate::scene::Scene;
 use crate::shortcuts::{PrimaryPixel, ShortcutsUsed};
 
 /// Settings of the branching ray tracer.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct McrtSettings {
+    /// Bounces: 1 = direct lighting only.
+    pub max_depth: u32,
+    /// Light samples (shadow rays) per hit: N.
+    pub shadow_rays: u32,
+    /// BSDF samples per hit, each recursing: M.
+    pub glossy_rays: u32,
+    /// How the two sample sets combine (`None` reads as power).
+    pub mis: MisHeuristic,
+    /// Emitters seen directly integrated exactly over each pixel where
+    /// that is possible (`crate::accel::seen_emitters`).
+    pub exact_seen_emitters: bool,
+}
+
+impl Default for McrtSettings {
+    fn default() -> Self {
+        McrtSettings {
+            max_depth: 8,
+            shadow_rays: 1,
+            glossy_rays: 1,
+            mis: MisHeuristic::Power,
+            exact_seen_emitters: true,
+        }
+    }
+}
+
+impl Settings for McrtSettings {
+    fn validate(&self) -> Result<(), String> {
+        if self.shadow_rays + self.glossy_rays == 0 {
+            return Err("shadow rays and glossy rays cannot both be 0".into());
+        }
+        Ok(())
+    }
+
+    fn max_depth_mut(&mut self) -> Option<&mut u32> {
+        Some(&mut self.max_depth)
+    }
+
+    fn mis_mut(&mut self) -> Option<&mut MisHeuristic> {
+        Some(&mut self.mis)
+    }
+}
+
+/// The branching ray tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct McRayTracer {
     /// Bounces: 1 = direct lighting only.
@@ -62,13 +108,15 @@ impl Technique for McRayTracer {
     const SUMMARY: &'static str =
         "Monte Carlo (distribution) ray tracing: N shadow rays and M branching BSDF rays per hit.";
 
-    fn from_options(options: &IntegratorOptions) -> Self {
+    type Settings = McrtSettings;
+
+    fn new(settings: &McrtSettings) -> Self {
         McRayTracer {
-            max_depth: options.max_depth,
-            shadow_rays: options.shadow_rays,
-            glossy_rays: options.glossy_rays,
-            mis: options.combining_heuristic(),
-            exact_seen_emitters: options.exact_seen_emitters,
+            max_depth: settings.max_depth,
+            shadow_rays: settings.shadow_rays,
+            glossy_rays: settings.glossy_rays,
+            mis: super::options::combining(settings.mis),
+            exact_seen_emitters: settings.exact_seen_emitters,
         }
     }
 

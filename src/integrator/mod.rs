@@ -36,7 +36,7 @@ pub use bdpt::Bdpt;
 pub use light::{LightTracer, Splat};
 pub use mcrt::McRayTracer;
 pub use mis::MisHeuristic;
-pub use options::{IntegratorOptions, Strategy};
+pub use options::{PathLength, Settings, Strategy};
 pub use path::PathTracer;
 pub use whitted::{GlassShadows, WhittedTracer};
 
@@ -132,9 +132,10 @@ pub fn camera_ray(
 pub trait Technique: Sized + Send + Sync {
     /// One sentence for the command line's help: what the technique does.
     const SUMMARY: &'static str;
-    /// The technique's settings, read from the options the CLI and the
-    /// viewer both fill in.
-    fn from_options(options: &IntegratorOptions) -> Self;
+    /// The settings it is made from, its own struct in its own file.
+    type Settings: Settings;
+    /// The technique with `settings`.
+    fn new(settings: &Self::Settings) -> Self;
     /// Short description with the settings, for summaries and metadata.
     fn describe(&self) -> String;
     /// The settings resolved for `scene` (pbrt's preprocess): a distance
@@ -310,11 +311,24 @@ pub enum TechniqueKind {
 /// [`IntegratorOptions::build`].
 macro_rules! register_techniques {
     (
-        camera { $($cv:ident($ct:ty) = $cname:literal, $clabel:literal;)* }
-        splatting { $($sv:ident($st:ty) = $sname:literal, $slabel:literal;)* }
-        multi_pass { $($mv:ident($mt:ty) = $mname:literal, $mlabel:literal;)* }
-        solver { $($xv:ident($xt:ty) = $xname:literal, $xlabel:literal;)* }
+        camera { $($cv:ident($ct:ty, $cf:ident) = $cname:literal, $clabel:literal;)* }
+        splatting { $($sv:ident($st:ty, $sf:ident) = $sname:literal, $slabel:literal;)* }
+        multi_pass { $($mv:ident($mt:ty, $mf:ident) = $mname:literal, $mlabel:literal;)* }
+        solver { $($xv:ident($xt:ty, $xf:ident) = $xname:literal, $xlabel:literal;)* }
     ) => {
+        /// The chosen technique and every technique's settings (each
+        /// keeps its own while another is chosen, as the viewer's A and B
+        /// do); a file's `[integrator]` table in the same form.
+        #[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+        #[serde(default)]
+        pub struct IntegratorOptions {
+            pub kind: IntegratorKind,
+            $(pub $cf: <$ct as Technique>::Settings,)*
+            $(pub $sf: <$st as Technique>::Settings,)*
+            $(pub $mf: <$mt as Technique>::Settings,)*
+            $(pub $xf: <$xt as Technique>::Settings,)*
+        }
+
         /// Which technique, by name.
         #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
         pub enum IntegratorKind {
@@ -373,13 +387,53 @@ macro_rules! register_techniques {
             pub fn build(&self) -> Integrator {
                 match self.kind {
                     $(IntegratorKind::$cv =>
-                        Integrator::Camera(CameraIntegrator::$cv(<$ct>::from_options(self))),)*
+                        Integrator::Camera(CameraIntegrator::$cv(<$ct>::new(&self.$cf))),)*
                     $(IntegratorKind::$sv =>
-                        Integrator::Splatting(SplattingIntegrator::$sv(<$st>::from_options(self))),)*
+                        Integrator::Splatting(SplattingIntegrator::$sv(<$st>::new(&self.$sf))),)*
                     $(IntegratorKind::$mv =>
-                        Integrator::MultiPass(MultiPassIntegrator::$mv(<$mt>::from_options(self))),)*
+                        Integrator::MultiPass(MultiPassIntegrator::$mv(<$mt>::new(&self.$mf))),)*
                     $(IntegratorKind::$xv =>
-                        Integrator::Solver(SolverIntegrator::$xv(<$xt>::from_options(self))),)*
+                        Integrator::Solver(SolverIntegrator::$xv(<$xt>::new(&self.$xf))),)*
+                }
+            }
+
+            /// [`Settings::validate`] of the chosen technique's settings.
+            pub fn validate(&self) -> Result<(), String> {
+                match self.kind {
+                    $(IntegratorKind::$cv => self.$cf.validate(),)*
+                    $(IntegratorKind::$sv => self.$sf.validate(),)*
+                    $(IntegratorKind::$mv => self.$mf.validate(),)*
+                    $(IntegratorKind::$xv => self.$xf.validate(),)*
+                }
+            }
+
+            /// [`Settings::max_depth_mut`] of the chosen technique.
+            pub fn max_depth_mut(&mut self) -> Option<&mut u32> {
+                match self.kind {
+                    $(IntegratorKind::$cv => self.$cf.max_depth_mut(),)*
+                    $(IntegratorKind::$sv => self.$sf.max_depth_mut(),)*
+                    $(IntegratorKind::$mv => self.$mf.max_depth_mut(),)*
+                    $(IntegratorKind::$xv => self.$xf.max_depth_mut(),)*
+                }
+            }
+
+            /// [`Settings::length_mut`] of the chosen technique.
+            pub fn length_mut(&mut self) -> Option<&mut PathLength> {
+                match self.kind {
+                    $(IntegratorKind::$cv => self.$cf.length_mut(),)*
+                    $(IntegratorKind::$sv => self.$sf.length_mut(),)*
+                    $(IntegratorKind::$mv => self.$mf.length_mut(),)*
+                    $(IntegratorKind::$xv => self.$xf.length_mut(),)*
+                }
+            }
+
+            /// [`Settings::mis_mut`] of the chosen technique.
+            pub fn mis_mut(&mut self) -> Option<&mut MisHeuristic> {
+                match self.kind {
+                    $(IntegratorKind::$cv => self.$cf.mis_mut(),)*
+                    $(IntegratorKind::$sv => self.$sf.mis_mut(),)*
+                    $(IntegratorKind::$mv => self.$mf.mis_mut(),)*
+                    $(IntegratorKind::$xv => self.$xf.mis_mut(),)*
                 }
             }
         }
@@ -635,21 +689,21 @@ impl IntegratorKind {
 // The registration list: one line per technique.
 register_techniques! {
     camera {
-        Whitted(WhittedTracer) = "whitted", "Whitted ray tracing";
-        Mcrt(McRayTracer) = "mcrt", "Monte Carlo ray tracing";
-        Path(PathTracer) = "path", "Path tracing";
-        AmbientOcclusion(ambient_occlusion::AmbientOcclusion) = "ao", "Ambient occlusion";
+        Whitted(WhittedTracer, whitted) = "whitted", "Whitted ray tracing";
+        Mcrt(McRayTracer, mcrt) = "mcrt", "Monte Carlo ray tracing";
+        Path(PathTracer, path) = "path", "Path tracing";
+        AmbientOcclusion(ambient_occlusion::AmbientOcclusion, ao) = "ao", "Ambient occlusion";
     }
     splatting {
-        Light(LightTracer) = "light", "Light tracing";
-        Bdpt(Bdpt) = "bdpt", "Bidirectional path tracing";
+        Light(LightTracer, light) = "light", "Light tracing";
+        Bdpt(Bdpt, bdpt) = "bdpt", "Bidirectional path tracing";
     }
     multi_pass {
-        Photon(photon::PhotonMap2Pass) = "photon", "Photon mapping (Jensen)";
-        Sppm(sppm::PhotonMapper) = "sppm", "Progressive photon mapping";
-        Vcm(vcm::Vcm) = "vcm", "Vertex connection and merging";
+        Photon(photon::PhotonMap2Pass, photon) = "photon", "Photon mapping (Jensen)";
+        Sppm(sppm::PhotonMapper, sppm) = "sppm", "Progressive photon mapping";
+        Vcm(vcm::Vcm, vcm) = "vcm", "Vertex connection and merging";
     }
     solver {
-        Radiosity(radiosity::Radiosity) = "radiosity", "Radiosity";
+        Radiosity(radiosity::Radiosity, radiosity) = "radiosity", "Radiosity";
     }
 }

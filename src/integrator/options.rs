@@ -1,10 +1,12 @@
-//! Estimator settings as plain data, the one form that the CLI and the viewer
-//! both fill in; [`IntegratorOptions::build`] turns them into an
-//! [`super::Integrator`], each technique reading the fields it has.
+//! What techniques' settings have in common. Each technique owns one
+//! settings struct in its own file (defaults, validation, serde for files);
+//! [`IntegratorOptions`], generated from the registration list in
+//! `mod.rs`, holds one of each and the chosen technique, and is the one
+//! form that the CLI, the viewer and an imported file's integrator block
+//! all fill in.
 
-use super::radiosity::RadiosityDisplay;
-use super::{GlassShadows, IntegratorKind, MisHeuristic};
-use crate::radiosity::{FormFactorMethod, RadiositySolver};
+use super::{IntegratorKind, IntegratorOptions, MisHeuristic};
+use crate::scene::RenderHints;
 
 /// Which sampling strategies the path tracer uses for direct light.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
@@ -20,127 +22,171 @@ pub enum Strategy {
     Mis,
 }
 
-/// Every estimator setting; each estimator reads the ones it has.
+/// How long the paths of a path-building technique run; each such
+/// technique keeps its own.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
-pub struct IntegratorOptions {
-    pub kind: IntegratorKind,
+pub struct PathLength {
     /// Bounces (1 = direct lighting); Mitsuba's max_depth is one more.
     pub max_depth: u32,
     pub russian_roulette: bool,
+    /// Roulette starts after this many bounces (Mitsuba's `rr_depth`).
     pub rr_depth: u32,
-    pub strategy: Strategy,
-    /// Heuristic for [`Strategy::Mis`] and MC ray tracing (never `None`).
-    pub mis: MisHeuristic,
-    /// MC ray tracing branching factors.
-    pub shadow_rays: u32,
-    pub glossy_rays: u32,
-    /// Whitted's constant ambient radiance (grey).
-    pub ambient: f32,
-    pub glass_shadows: GlassShadows,
-    /// Path tracing and Whitted: the general code even where a specialised
-    /// one applies.
-    pub general: bool,
-    /// Path and MC ray tracing: emitters seen directly are integrated
-    /// exactly over each pixel where that is possible (`crate::accel::seen_emitters`); off,
-    /// camera rays sample them like everything else.
-    pub exact_seen_emitters: bool,
-    /// Ambient occlusion: occluders count within this fraction of the
-    /// scene's bounding-box diagonal (0: no limit).
-    pub ao_distance: f32,
-    /// Radiosity: the solver, the longest element edge (fraction of the
-    /// scene's diagonal), how form factors are estimated and with how many
-    /// samples per pair, the ambient term (progressive), and the steps to
-    /// run (0: until converged).
-    pub radiosity_solver: RadiositySolver,
-    pub patch_size: f32,
-    pub form_factor_method: FormFactorMethod,
-    pub form_factor_samples: u32,
-    pub radiosity_ambient: bool,
-    pub radiosity_iterations: u32,
-    pub radiosity_display: RadiosityDisplay,
-    pub radiosity_epsilon: f32,
-    /// Radiosity (Jacobi, Gauss-Seidel, progressive): rounds of adaptive
-    /// subdivision after the first solve, splitting elements whose reflected
-    /// radiance differs from a neighbour's by more than the tolerance times
-    /// the mean; and the wireframe overlay of the elements.
-    pub adaptive_rounds: u32,
-    pub adaptive_tolerance: f32,
-    pub radiosity_wireframe: bool,
-    /// Radiosity: split receivers along the shadows' discontinuity lines.
-    pub radiosity_discontinuity: bool,
-    /// Photon mapping: photons per iteration (0: one per pixel), the first
-    /// iteration's radius (fraction of the scene's diagonal) and alpha.
-    pub photons: u32,
-    pub photon_radius: f32,
-    pub photon_alpha: f32,
-    /// Jensen's photon map: photons per density estimate, and the largest
-    /// gather radius (fraction of the scene's diagonal).
-    pub photon_k: u32,
-    pub gather_radius: f32,
 }
 
-impl Default for IntegratorOptions {
+impl Default for PathLength {
     fn default() -> Self {
-        IntegratorOptions {
-            kind: IntegratorKind::Path,
+        PathLength {
             max_depth: 8,
             russian_roulette: true,
             rr_depth: 5,
-            strategy: Strategy::Mis,
-            mis: MisHeuristic::Power,
-            shadow_rays: 1,
-            glossy_rays: 1,
-            ambient: 0.0,
-            glass_shadows: GlassShadows::Opaque,
-            general: false,
-            exact_seen_emitters: true,
-            ao_distance: 0.1,
-            radiosity_solver: RadiositySolver::GaussSeidel,
-            patch_size: 0.1,
-            form_factor_method: FormFactorMethod::Analytic,
-            form_factor_samples: FormFactorMethod::Analytic.default_samples(),
-            radiosity_ambient: true,
-            radiosity_iterations: 0,
-            radiosity_display: RadiosityDisplay::Gather,
-            radiosity_epsilon: 1e-4,
-            adaptive_rounds: 0,
-            adaptive_tolerance: 0.5,
-            radiosity_wireframe: false,
-            radiosity_discontinuity: false,
-            photons: 0,
-            photon_radius: 0.002,
-            photon_alpha: 2.0 / 3.0,
-            photon_k: 50,
-            gather_radius: 0.05,
         }
+    }
+}
+
+/// A technique's settings: plain data with defaults, saved and read by
+/// serde, checked before a render starts. The accessors give the settings
+/// that several techniques share (depth, roulette, MIS) to the CLI, the
+/// viewer and imported files without knowing which technique it is.
+pub trait Settings:
+    Clone
+    + Copy
+    + std::fmt::Debug
+    + PartialEq
+    + Default
+    + serde::Serialize
+    + serde::de::DeserializeOwned
+{
+    /// Why these settings cannot run, in a sentence naming the setting.
+    fn validate(&self) -> Result<(), String> {
+        Ok(())
+    }
+    /// The maximum depth, where the technique has one.
+    fn max_depth_mut(&mut self) -> Option<&mut u32> {
+        None
+    }
+    /// Depth and roulette, where the technique has both.
+    fn length_mut(&mut self) -> Option<&mut PathLength> {
+        None
+    }
+    /// The heuristic that combines its strategies, where it has one.
+    fn mis_mut(&mut self) -> Option<&mut MisHeuristic> {
+        None
+    }
+}
+
+/// Settings of techniques that have none (tests' stand-ins).
+impl Settings for () {}
+
+/// A fraction of the scene's diagonal, strictly between 0 and 1.
+pub(crate) fn check_fraction(name: &str, value: f32) -> Result<(), String> {
+    if value > 0.0 && value < 1.0 {
+        Ok(())
+    } else {
+        Err(format!(
+            "{name} {value} is not a fraction in (0, 1) of the scene's size"
+        ))
+    }
+}
+
+/// The heuristic of estimators that always combine strategies (`None` is
+/// not one of them).
+pub(crate) fn combining(mis: MisHeuristic) -> MisHeuristic {
+    if mis == MisHeuristic::None {
+        MisHeuristic::Power
+    } else {
+        mis
     }
 }
 
 impl IntegratorOptions {
-    /// Takes radiosity's settings from `other`, leaving the rest.
-    pub fn set_radiosity_from(&mut self, other: &IntegratorOptions) {
-        self.radiosity_solver = other.radiosity_solver;
-        self.patch_size = other.patch_size;
-        self.radiosity_epsilon = other.radiosity_epsilon;
-        self.form_factor_method = other.form_factor_method;
-        self.form_factor_samples = other.form_factor_samples;
-        self.radiosity_ambient = other.radiosity_ambient;
-        self.radiosity_iterations = other.radiosity_iterations;
-        self.radiosity_display = other.radiosity_display;
-        self.adaptive_rounds = other.adaptive_rounds;
-        self.adaptive_tolerance = other.adaptive_tolerance;
-        self.radiosity_wireframe = other.radiosity_wireframe;
-        self.radiosity_discontinuity = other.radiosity_discontinuity;
+    /// The default settings of technique `kind`.
+    pub fn of(kind: IntegratorKind) -> IntegratorOptions {
+        IntegratorOptions {
+            kind,
+            ..IntegratorOptions::default()
+        }
     }
 
-    /// The MIS heuristic of estimators that always combine strategies
-    /// (`None` is not one of them).
-    pub fn combining_heuristic(&self) -> MisHeuristic {
-        if self.mis == MisHeuristic::None {
-            MisHeuristic::Power
-        } else {
-            self.mis
+    /// The maximum depth of the chosen technique, where it has one.
+    pub fn max_depth(&self) -> Option<u32> {
+        self.clone().max_depth_mut().map(|d| *d)
+    }
+
+    /// What an imported file's integrator block asks for: the technique
+    /// (unless `keep_kind`), its depth and where roulette starts; returns
+    /// what was taken, for the user to read.
+    pub fn take_hints(
+        &mut self,
+        hints: &RenderHints,
+        keep_kind: bool,
+    ) -> Result<Vec<String>, String> {
+        let mut taken = Vec::new();
+        if let Some(name) = hints.integrator.as_deref().filter(|_| !keep_kind) {
+            self.kind = IntegratorKind::from_name(name)
+                .ok_or_else(|| format!("the scene asks for an unknown technique \"{name}\""))?;
+            taken.push(self.kind.label().to_string());
         }
+        if let (Some(d), Some(depth)) = (hints.max_depth, self.max_depth_mut()) {
+            *depth = d;
+            taken.push(format!("max depth {d}"));
+        }
+        if let (Some(d), Some(length)) = (hints.rr_depth, self.length_mut()) {
+            length.rr_depth = d;
+            taken.push(format!("roulette from {d}"));
+        }
+        Ok(taken)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hints_set_the_chosen_techniques_own_depth() {
+        let hints = RenderHints {
+            integrator: Some("bdpt".into()),
+            max_depth: Some(4),
+            rr_depth: Some(2),
+            ..RenderHints::default()
+        };
+        let mut options = IntegratorOptions::default();
+        let taken = options.take_hints(&hints, false).unwrap();
+        assert_eq!(taken.len(), 3, "{taken:?}");
+        assert_eq!(options.kind, IntegratorKind::Bdpt);
+        assert_eq!(
+            (options.bdpt.length.max_depth, options.bdpt.length.rr_depth),
+            (4, 2)
+        );
+        // Path tracing keeps its own.
+        assert_eq!(options.path.length, PathLength::default());
+        // Ambient occlusion has no depth: nothing is set, nothing said.
+        let mut ao = IntegratorOptions::of(IntegratorKind::AmbientOcclusion);
+        assert_eq!(ao.take_hints(&hints, true).unwrap(), Vec::<String>::new());
+        let unknown = RenderHints {
+            integrator: Some("volpath2".into()),
+            ..RenderHints::default()
+        };
+        assert!(options.take_hints(&unknown, false).is_err());
+    }
+
+    #[test]
+    fn settings_read_from_a_file_keep_what_it_leaves_out_at_the_defaults() {
+        let options: IntegratorOptions =
+            toml::from_str("kind = \"vcm\"\n[vcm]\nmax_depth = 3\nradius = 0.01\n").unwrap();
+        assert_eq!(options.kind, IntegratorKind::Vcm);
+        assert_eq!(
+            (options.vcm.length.max_depth, options.vcm.radius),
+            (3, 0.01)
+        );
+        assert_eq!(options.vcm.length.rr_depth, 5);
+        assert_eq!(options.path, IntegratorOptions::default().path);
+        let back: IntegratorOptions = toml::from_str(&toml::to_string(&options).unwrap()).unwrap();
+        assert_eq!(back, options);
+        // Each technique checks its own.
+        let mut bad = options;
+        bad.vcm.alpha = 1.5;
+        assert!(bad.validate().unwrap_err().contains("alpha 1.5"));
     }
 }

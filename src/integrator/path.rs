@@ -9,7 +9,7 @@
 //! where beta_k is the product of f cos / p_bsdf (and 1/q of roulette) so far.
 
 use super::{
-    CameraEstimator, IntegratorOptions, MisHeuristic, RayCounts, Strategy, Technique,
+    CameraEstimator, MisHeuristic, PathLength, RayCounts, Settings, Strategy, Technique,
     survives_roulette,
 };
 use crate::accel::{NO_LIGHT, SurfaceHit};
@@ -96,6 +96,50 @@ impl PendingShadow {
 }
 
 /// Settings of the path tracer.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct PathSettings {
+    #[serde(flatten)]
+    pub length: PathLength,
+    /// Which strategies find direct light.
+    pub strategy: Strategy,
+    /// How they combine under [`Strategy::Mis`] (`None` reads as power).
+    pub mis: MisHeuristic,
+    /// The general loop even where a specialised one applies.
+    pub general: bool,
+    /// Emitters seen directly integrated exactly over each pixel where
+    /// that is possible (`crate::accel::seen_emitters`); off, camera rays
+    /// sample them like everything else.
+    pub exact_seen_emitters: bool,
+}
+
+impl Default for PathSettings {
+    fn default() -> Self {
+        PathSettings {
+            length: PathLength::default(),
+            strategy: Strategy::Mis,
+            mis: MisHeuristic::Power,
+            general: false,
+            exact_seen_emitters: true,
+        }
+    }
+}
+
+impl Settings for PathSettings {
+    fn max_depth_mut(&mut self) -> Option<&mut u32> {
+        Some(&mut self.length.max_depth)
+    }
+
+    fn length_mut(&mut self) -> Option<&mut PathLength> {
+        Some(&mut self.length)
+    }
+
+    fn mis_mut(&mut self) -> Option<&mut MisHeuristic> {
+        Some(&mut self.mis)
+    }
+}
+
+/// The path tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathTracer {
     /// Maximum number of bounces: 0 = only emitters seen directly, 1 = direct
@@ -135,18 +179,20 @@ impl Technique for PathTracer {
     const SUMMARY: &'static str =
         "Path tracing with next-event estimation, MIS and Russian roulette.";
 
-    fn from_options(options: &IntegratorOptions) -> Self {
+    type Settings = PathSettings;
+
+    fn new(settings: &PathSettings) -> Self {
         PathTracer {
-            max_depth: options.max_depth,
-            rr_depth: options.rr_depth,
-            russian_roulette: options.russian_roulette,
-            nee: options.strategy != Strategy::Bsdf,
-            mis: match options.strategy {
+            max_depth: settings.length.max_depth,
+            rr_depth: settings.length.rr_depth,
+            russian_roulette: settings.length.russian_roulette,
+            nee: settings.strategy != Strategy::Bsdf,
+            mis: match settings.strategy {
                 Strategy::Light => MisHeuristic::None,
-                _ => options.combining_heuristic(),
+                _ => super::options::combining(settings.mis),
             },
-            general: options.general,
-            exact_seen_emitters: options.exact_seen_emitters,
+            general: settings.general,
+            exact_seen_emitters: settings.exact_seen_emitters,
         }
     }
 

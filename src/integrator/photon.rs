@@ -20,8 +20,9 @@
 //! plot's plateau and shrinks with the photon count.
 
 use super::light::photon_shading_factor;
+use super::options::check_fraction;
 use super::photon_map::{self, MAX_K, PhotonMap};
-use super::{IntegratorOptions, MultiPassEstimator, RayCounts, Technique};
+use super::{MultiPassEstimator, RayCounts, Settings, Technique};
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Sampler};
@@ -31,6 +32,44 @@ use glam::Vec3A;
 use std::f32::consts::PI;
 
 /// Settings of Jensen's two-pass photon mapping.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct PhotonSettings {
+    /// Bounces of a full path, as for path tracing.
+    pub max_depth: u32,
+    /// Photons per map (0: one per pixel).
+    pub photons: u32,
+    /// Photons per density estimate (1 to 256).
+    pub k: u32,
+    /// The largest gather radius, a fraction of the scene's diagonal.
+    pub gather_radius: f32,
+}
+
+impl Default for PhotonSettings {
+    fn default() -> Self {
+        PhotonSettings {
+            max_depth: 8,
+            photons: 0,
+            k: 50,
+            gather_radius: 0.05,
+        }
+    }
+}
+
+impl Settings for PhotonSettings {
+    fn validate(&self) -> Result<(), String> {
+        if !(1..=MAX_K as u32).contains(&self.k) {
+            return Err(format!("k {} is not in 1..={MAX_K}", self.k));
+        }
+        check_fraction("gather radius", self.gather_radius)
+    }
+
+    fn max_depth_mut(&mut self) -> Option<&mut u32> {
+        Some(&mut self.max_depth)
+    }
+}
+
+/// Jensen's two-pass photon mapping.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PhotonMap2Pass {
     /// Bounces of a full path, as for path tracing.
@@ -61,12 +100,14 @@ impl Technique for PhotonMap2Pass {
          direct light sampled, caustics by density estimation, indirect light by final gathering; \
          biased, the bias shrinks with the photon count.";
 
-    fn from_options(options: &IntegratorOptions) -> Self {
+    type Settings = PhotonSettings;
+
+    fn new(settings: &PhotonSettings) -> Self {
         PhotonMap2Pass {
-            max_depth: options.max_depth,
-            photons: options.photons,
-            k: options.photon_k.clamp(1, MAX_K as u32),
-            max_radius: options.gather_radius,
+            max_depth: settings.max_depth,
+            photons: settings.photons,
+            k: settings.k.clamp(1, MAX_K as u32),
+            max_radius: settings.gather_radius,
         }
     }
 

@@ -23,7 +23,7 @@
 //!   first bounce with the mesh's solution in place of the rest, so it
 //!   agrees with path tracing up to the mesh's error in the indirect term.
 
-use super::{IntegratorOptions, RayCounts, Solver, SolverProgress, Technique};
+use super::{RayCounts, Settings, Solver, SolverProgress, Technique};
 use crate::math::{Frame, Ray, Rgb};
 use crate::radiosity::mesh::back_twins;
 use crate::radiosity::{
@@ -51,8 +51,9 @@ const SPECULAR_DEPTH: u32 = 8;
 /// by the bright ceiling above it at 16 samples per pixel.
 const BACK_GATHERS: u32 = 16;
 
-/// Settings of the radiosity technique.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The radiosity technique: its settings are all it holds.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct Radiosity {
     pub solver: RadiositySolver,
     /// Longest element edge, as a fraction of the scene's diagonal.
@@ -77,6 +78,46 @@ pub struct Radiosity {
     /// Split receivers along the shadows' discontinuities first
     /// ([`crate::radiosity::discontinuity`]).
     pub discontinuity: bool,
+}
+
+impl Default for Radiosity {
+    fn default() -> Self {
+        Radiosity {
+            solver: RadiositySolver::GaussSeidel,
+            patch_size: 0.1,
+            form_factors: FormFactorMethod::Analytic,
+            form_factor_samples: FormFactorMethod::Analytic.default_samples(),
+            ambient: true,
+            iterations: 0,
+            display: RadiosityDisplay::Gather,
+            epsilon: 1e-4,
+            adaptive_rounds: 0,
+            adaptive_tolerance: 0.5,
+            wireframe: false,
+            discontinuity: false,
+        }
+    }
+}
+
+impl Settings for Radiosity {
+    fn validate(&self) -> Result<(), String> {
+        if !(self.epsilon > 0.0 && self.epsilon.is_finite()) {
+            return Err(format!("epsilon must be positive, got {}", self.epsilon));
+        }
+        if !(self.adaptive_tolerance > 0.0 && self.adaptive_tolerance.is_finite()) {
+            return Err(format!(
+                "adaptive tolerance must be positive, got {}",
+                self.adaptive_tolerance
+            ));
+        }
+        if !(self.patch_size > 0.0 && self.patch_size <= 1.0) || self.form_factor_samples == 0 {
+            return Err(format!(
+                "patch size must be in (0, 1] (got {}) and form factor samples at least 1 (got {})",
+                self.patch_size, self.form_factor_samples
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// How the solution is shown.
@@ -111,20 +152,12 @@ impl RadiosityDisplay {
 impl Technique for Radiosity {
     const SUMMARY: &'static str = "Radiosity: diffuse elements, form factors by ray casting, Jacobi, Gauss-Seidel or progressive refinement.";
 
-    fn from_options(options: &IntegratorOptions) -> Self {
+    type Settings = Radiosity;
+
+    fn new(settings: &Radiosity) -> Self {
         Radiosity {
-            solver: options.radiosity_solver,
-            patch_size: options.patch_size,
-            form_factors: options.form_factor_method,
-            form_factor_samples: options.form_factor_samples.max(1),
-            ambient: options.radiosity_ambient,
-            iterations: options.radiosity_iterations,
-            display: options.radiosity_display,
-            epsilon: options.radiosity_epsilon,
-            adaptive_rounds: options.adaptive_rounds,
-            adaptive_tolerance: options.adaptive_tolerance,
-            wireframe: options.radiosity_wireframe,
-            discontinuity: options.radiosity_discontinuity,
+            form_factor_samples: settings.form_factor_samples.max(1),
+            ..*settings
         }
     }
 

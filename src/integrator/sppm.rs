@@ -19,8 +19,9 @@
 //! iteration for that iteration's radius.
 
 use super::light::photon_shading_factor;
+use super::options::check_fraction;
 use super::photon_map::{self, PhotonMap};
-use super::{IntegratorOptions, MultiPassEstimator, RayCounts, Technique};
+use super::{MultiPassEstimator, RayCounts, Settings, Technique};
 use crate::math::{Ray, Rgb};
 use crate::sampling::Sampler;
 use crate::sampling::hash::hash_combine;
@@ -28,6 +29,51 @@ use crate::scene::Scene;
 use std::f32::consts::PI;
 
 /// Settings of the progressive photon mapper.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct SppmSettings {
+    /// Bounces of a full path, as for path tracing.
+    pub max_depth: u32,
+    /// Photons per iteration (0: one per pixel).
+    pub photons: u32,
+    /// The first iteration's radius, a fraction of the scene's diagonal.
+    pub radius: f32,
+    /// r_i^2 = r_1^2 i^(alpha - 1): 0 < alpha <= 1 (1 keeps it fixed, biased).
+    pub alpha: f32,
+}
+
+impl Default for SppmSettings {
+    fn default() -> Self {
+        SppmSettings {
+            max_depth: 8,
+            photons: 0,
+            radius: 0.002,
+            alpha: 2.0 / 3.0,
+        }
+    }
+}
+
+/// A radius and its shrinking, as SPPM and VCM take them.
+pub(crate) fn check_radius(radius: f32, alpha: f32) -> Result<(), String> {
+    check_fraction("radius", radius)?;
+    if alpha > 0.0 && alpha <= 1.0 {
+        Ok(())
+    } else {
+        Err(format!("alpha {alpha} is not in (0, 1]"))
+    }
+}
+
+impl Settings for SppmSettings {
+    fn validate(&self) -> Result<(), String> {
+        check_radius(self.radius, self.alpha)
+    }
+
+    fn max_depth_mut(&mut self) -> Option<&mut u32> {
+        Some(&mut self.max_depth)
+    }
+}
+
+/// The progressive photon mapper.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PhotonMapper {
     /// Bounces of a full path, as for path tracing.
@@ -56,12 +102,14 @@ impl Technique for PhotonMapper {
     const SUMMARY: &'static str = "Progressive photon mapping: direct light by light sampling, \
          the rest by density estimation in a photon map whose radius shrinks every iteration.";
 
-    fn from_options(options: &IntegratorOptions) -> Self {
+    type Settings = SppmSettings;
+
+    fn new(settings: &SppmSettings) -> Self {
         PhotonMapper {
-            max_depth: options.max_depth,
-            photons: options.photons,
-            radius: options.photon_radius,
-            alpha: options.photon_alpha,
+            max_depth: settings.max_depth,
+            photons: settings.photons,
+            radius: settings.radius,
+            alpha: settings.alpha,
         }
     }
 

@@ -11,7 +11,7 @@
 //!   L(x, wo) = Le + sum_lights f(wo, wl) I cos / d^2 V + ka albedo
 //!            + R L(x, reflect(wo)) + (1 - R) T L(x, refract(wo))
 
-use super::{CameraEstimator, IntegratorOptions, RayCounts, Technique};
+use super::{CameraEstimator, RayCounts, Settings, Technique};
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, offset_ray_origin, ray_between};
 use crate::sampling::Sampler;
@@ -34,6 +34,44 @@ pub enum GlassShadows {
 }
 
 /// Settings of the Whitted ray tracer.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct WhittedSettings {
+    /// Maximum number of specular bounces after the first hit.
+    pub max_depth: u32,
+    /// Constant ambient radiance (grey), times the diffuse albedo.
+    pub ambient: f32,
+    pub glass_shadows: GlassShadows,
+    /// The general code even where a specialised one applies.
+    pub general: bool,
+}
+
+impl Default for WhittedSettings {
+    fn default() -> Self {
+        WhittedSettings {
+            max_depth: 8,
+            ambient: 0.0,
+            glass_shadows: GlassShadows::Opaque,
+            general: false,
+        }
+    }
+}
+
+impl Settings for WhittedSettings {
+    fn validate(&self) -> Result<(), String> {
+        if self.ambient >= 0.0 && self.ambient.is_finite() {
+            Ok(())
+        } else {
+            Err(format!("ambient {} is not a radiance >= 0", self.ambient))
+        }
+    }
+
+    fn max_depth_mut(&mut self) -> Option<&mut u32> {
+        Some(&mut self.max_depth)
+    }
+}
+
+/// The Whitted ray tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WhittedTracer {
     /// Maximum number of specular bounces after the first hit.
@@ -64,12 +102,14 @@ impl Technique for WhittedTracer {
     const SUMMARY: &'static str =
         "Whitted ray tracing: point-light direct light, hard shadows, mirror and glass recursion.";
 
-    fn from_options(options: &IntegratorOptions) -> Self {
+    type Settings = WhittedSettings;
+
+    fn new(settings: &WhittedSettings) -> Self {
         WhittedTracer {
-            max_depth: options.max_depth,
-            ambient: Rgb::splat(options.ambient.max(0.0)),
-            glass_shadows: options.glass_shadows,
-            general: options.general,
+            max_depth: settings.max_depth,
+            ambient: Rgb::splat(settings.ambient.max(0.0)),
+            glass_shadows: settings.glass_shadows,
+            general: settings.general,
         }
     }
 

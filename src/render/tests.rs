@@ -28,7 +28,8 @@ struct PassNumber;
 
 impl Technique for PassNumber {
     const SUMMARY: &'static str = "test";
-    fn from_options(_: &IntegratorOptions) -> Self {
+    type Settings = ();
+    fn new(_: &()) -> Self {
         PassNumber
     }
     fn describe(&self) -> String {
@@ -79,7 +80,8 @@ struct Halving {
 
 impl Technique for Halving {
     const SUMMARY: &'static str = "test";
-    fn from_options(_: &IntegratorOptions) -> Self {
+    type Settings = ();
+    fn new(_: &()) -> Self {
         Halving { fail: false }
     }
     fn describe(&self) -> String {

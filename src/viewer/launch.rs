@@ -2,7 +2,8 @@
 //! a test), the settings they give, and where scene files are found.
 
 use super::settings::{Config, Settings, Tab, ViewMode, load_settings, settings_file};
-use crate::integrator::{IntegratorKind, IntegratorOptions};
+use crate::integrator::IntegratorKind;
+use crate::integrator::radiosity::Radiosity;
 use crate::lab::Experiment;
 use std::path::{Path, PathBuf};
 
@@ -34,7 +35,7 @@ pub struct Launch {
     /// Open the Monte Carlo lab on this experiment.
     pub lab: Option<Experiment>,
     /// Radiosity's settings from the command line (with `--integrator radiosity`).
-    pub radiosity: Option<IntegratorOptions>,
+    pub radiosity: Option<Radiosity>,
     /// Mitsuba XML: values for the file's `$name`s (`-D name=value`).
     pub defines: Vec<(String, String)>,
     /// Warnings about a scene file are errors.
@@ -55,8 +56,8 @@ impl Launch {
         if let Some(kind) = self.integrator {
             settings.a.integrator.kind = kind;
         }
-        if let Some(r) = &self.radiosity {
-            settings.a.integrator.set_radiosity_from(r);
+        if let Some(r) = self.radiosity {
+            settings.a.integrator.radiosity = r;
         }
         if let Some(spp) = self.target_spp {
             settings.target_spp = spp.max(1);
@@ -138,31 +139,11 @@ impl super::app::ViewerApp {
     /// technique and depths of view A, said in a toast.
     pub(super) fn apply_hints(&mut self, hints: &crate::scene::RenderHints) {
         // A technique named on the command line wins over the file's.
-        let launched_with_technique = self.launch.integrator.is_some();
-        let a = &mut self.settings.a.integrator;
-        let mut said = Vec::new();
-        if let Some(kind) = hints
-            .integrator
-            .as_deref()
-            .filter(|_| !launched_with_technique)
-            .and_then(|name| {
-                crate::integrator::IntegratorKind::ALL
-                    .iter()
-                    .copied()
-                    .find(|k| k.name() == name)
-            })
-        {
-            a.kind = kind;
-            said.push(kind.label().to_string());
-        }
-        if let Some(d) = hints.max_depth {
-            a.max_depth = d;
-            said.push(format!("max depth {d}"));
-        }
-        if let Some(d) = hints.rr_depth {
-            a.rr_depth = d;
-            said.push(format!("roulette from {d}"));
-        }
+        let keep_kind = self.launch.integrator.is_some();
+        let said = match self.settings.a.integrator.take_hints(hints, keep_kind) {
+            Ok(said) => said,
+            Err(e) => vec![e],
+        };
         if !said.is_empty() {
             self.toast(format!("from the scene file: {}", said.join(", ")));
         }

@@ -9,6 +9,7 @@
 //! options, scene lookup).
 
 pub mod app;
+pub mod controls;
 pub mod display;
 pub mod export;
 pub mod image_view;
@@ -132,7 +133,7 @@ fn strategy_grid(ctx: &egui::Context, app: &mut ViewerApp) {
     }
     let scene = app.scene().cloned();
     app.strategy_grid
-        .update(scene.as_ref(), Bdpt::from_options(&a.integrator), a.sampler);
+        .update(scene.as_ref(), Bdpt::new(&a.integrator.bdpt), a.sampler);
     app.strategy_grid.show(ctx);
 }
 

@@ -4,13 +4,11 @@
 
 use super::app::ViewerApp;
 use super::settings::{CompareLayout, Config, ToneMap, ViewMode};
-use crate::integrator::radiosity::RadiosityDisplay;
-use crate::integrator::{GlassShadows, IntegratorKind, MisHeuristic, Strategy};
+use crate::integrator::IntegratorKind;
 use crate::live::Lock;
 use crate::math::OffsetMode;
-use crate::radiosity::{FormFactorMethod, RadiositySolver};
 use crate::sampling::SamplerKind;
-use eframe::egui::{self, RichText};
+use eframe::egui;
 
 /// Which configuration the estimator controls edit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -152,14 +150,6 @@ fn compare_section(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing
     });
 }
 
-fn seen_emitters(ui: &mut egui::Ui, exact: &mut bool) {
-    ui.checkbox(exact, "Lights seen directly: exact per pixel")
-        .on_hover_text(
-            "A light seen through a pixel adds its exact share of the pixel's area \
-             instead of being hit or missed by each camera ray: no noise on its rim",
-        );
-}
-
 fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
     ui.heading("Estimator");
     let options = &mut config.integrator;
@@ -167,185 +157,7 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
         ui.radio_value(&mut options.kind, kind, kind.label())
             .on_hover_text(kind.summary());
     }
-    let depth_label = match options.kind {
-        IntegratorKind::Whitted => "Max specular depth",
-        _ => "Max depth (bounces)",
-    };
-    if !matches!(
-        options.kind,
-        IntegratorKind::AmbientOcclusion | IntegratorKind::Radiosity
-    ) {
-        ui.add(egui::Slider::new(&mut options.max_depth, 0..=32).text(depth_label));
-    }
-    match options.kind {
-        IntegratorKind::Whitted => {
-            ui.add(egui::Slider::new(&mut options.ambient, 0.0..=0.5).text("Ambient"));
-            ui.horizontal(|ui| {
-                ui.label("Glass shadows");
-                ui.radio_value(&mut options.glass_shadows, GlassShadows::Opaque, "Opaque");
-                ui.radio_value(&mut options.glass_shadows, GlassShadows::Tinted, "Tinted");
-            });
-        }
-        IntegratorKind::Mcrt => {
-            ui.add(egui::Slider::new(&mut options.shadow_rays, 0..=16).text("Shadow rays N"));
-            ui.add(egui::Slider::new(&mut options.glossy_rays, 0..=16).text("Glossy rays M"));
-            if options.shadow_rays + options.glossy_rays == 0 {
-                options.shadow_rays = 1;
-            }
-            mis_heuristic(ui, &mut options.mis);
-            seen_emitters(ui, &mut options.exact_seen_emitters);
-            let rays = u64::from(options.glossy_rays).pow(options.max_depth.clamp(1, 17) - 1);
-            if rays > 100_000 {
-                ui.label(
-                    RichText::new(format!("M^(D-1) = {rays} rays per sample: slow"))
-                        .color(egui::Color32::YELLOW),
-                );
-            }
-        }
-        IntegratorKind::Path => {
-            ui.horizontal(|ui| {
-                ui.label("Strategy");
-                ui.radio_value(&mut options.strategy, Strategy::Bsdf, "BSDF");
-                ui.radio_value(&mut options.strategy, Strategy::Light, "Light");
-                ui.radio_value(&mut options.strategy, Strategy::Mis, "MIS");
-            });
-            if options.strategy == Strategy::Mis {
-                mis_heuristic(ui, &mut options.mis);
-            }
-            roulette(ui, &mut options.russian_roulette, &mut options.rr_depth);
-            seen_emitters(ui, &mut options.exact_seen_emitters);
-        }
-        IntegratorKind::Light => roulette(ui, &mut options.russian_roulette, &mut options.rr_depth),
-        IntegratorKind::Bdpt => {
-            mis_heuristic(ui, &mut options.mis);
-            roulette(ui, &mut options.russian_roulette, &mut options.rr_depth);
-        }
-        IntegratorKind::Photon => {
-            ui.add(
-                egui::Slider::new(&mut options.photons, 0..=4_000_000)
-                    .logarithmic(true)
-                    .text("Photons per map (0: one per pixel)"),
-            );
-            ui.add(
-                egui::Slider::new(&mut options.photon_k, 1..=256).text("k (photons per estimate)"),
-            );
-            ui.add(
-                egui::Slider::new(&mut options.gather_radius, 1e-3..=0.2)
-                    .logarithmic(true)
-                    .text("Largest radius (of the scene's diagonal)"),
-            );
-        }
-        IntegratorKind::Vcm => {
-            mis_heuristic(ui, &mut options.mis);
-            roulette(ui, &mut options.russian_roulette, &mut options.rr_depth);
-            merge_radius(ui, options);
-        }
-        IntegratorKind::Sppm => {
-            ui.add(
-                egui::Slider::new(&mut options.photons, 0..=4_000_000)
-                    .logarithmic(true)
-                    .text("Photons per iteration (0: one per pixel)"),
-            );
-            merge_radius(ui, options);
-        }
-        IntegratorKind::AmbientOcclusion => {
-            let mut limited = options.ao_distance > 0.0;
-            ui.checkbox(&mut limited, "Distance limit").on_hover_text(
-                "Occluders farther than this fraction of the scene's size do not count",
-            );
-            if !limited {
-                options.ao_distance = 0.0;
-            } else {
-                if options.ao_distance == 0.0 {
-                    options.ao_distance = 0.1;
-                }
-                ui.add(
-                    egui::Slider::new(&mut options.ao_distance, 0.001..=1.0)
-                        .logarithmic(true)
-                        .text("Distance (of the scene's diagonal)"),
-                );
-            }
-        }
-        IntegratorKind::Radiosity => {
-            ui.horizontal(|ui| {
-                ui.label("Solver");
-                for solver in RadiositySolver::ALL {
-                    ui.radio_value(&mut options.radiosity_solver, solver, solver.name());
-                }
-            });
-            if options.radiosity_solver == RadiositySolver::Progressive {
-                ui.checkbox(&mut options.radiosity_ambient, "Ambient term");
-            }
-            if options.radiosity_solver == RadiositySolver::Hierarchical {
-                ui.add(
-                    egui::Slider::new(&mut options.radiosity_epsilon, 1e-7..=1e-2)
-                        .logarithmic(true)
-                        .text("Epsilon (share of the emitted power)"),
-                );
-            }
-            ui.add(
-                // Hierarchical: the smallest element, which goes well below
-                // the matrix solvers' sizes (the Cornell box runs use 0.002).
-                egui::Slider::new(&mut options.patch_size, 0.001..=0.5)
-                    .logarithmic(true)
-                    .text("Patch size (of the scene's diagonal)"),
-            );
-            if options.radiosity_solver != RadiositySolver::Hierarchical {
-                ui.add(
-                    egui::Slider::new(&mut options.adaptive_rounds, 0..=4)
-                        .text("Adaptive subdivision rounds"),
-                );
-                if options.adaptive_rounds > 0 {
-                    ui.add(
-                        egui::Slider::new(&mut options.adaptive_tolerance, 0.05..=2.0)
-                            .logarithmic(true)
-                            .text("Tolerance (of the mean)"),
-                    );
-                }
-            }
-            ui.checkbox(
-                &mut options.radiosity_wireframe,
-                "Wireframe (colour by level)",
-            );
-            ui.checkbox(
-                &mut options.radiosity_discontinuity,
-                "Discontinuity meshing (lines in cyan)",
-            )
-            .on_hover_text(
-                "Split receivers along the umbra and penumbra boundaries of polygonal lights \
-                 before meshing, so that no element straddles a shadow's edge",
-            );
-            ui.horizontal(|ui| {
-                ui.label("Form factors");
-                let before = options.form_factor_method;
-                ui.radio_value(
-                    &mut options.form_factor_method,
-                    FormFactorMethod::Analytic,
-                    "Contour integral",
-                );
-                ui.radio_value(
-                    &mut options.form_factor_method,
-                    FormFactorMethod::RayCast,
-                    "Ray casting",
-                );
-                // Each method starts from the count at which it is accurate.
-                if options.form_factor_method != before {
-                    options.form_factor_samples = options.form_factor_method.default_samples();
-                }
-            });
-            ui.horizontal(|ui| {
-                ui.label("Display");
-                for display in RadiosityDisplay::ALL {
-                    ui.radio_value(&mut options.radiosity_display, display, display.name());
-                }
-            });
-            ui.add(
-                egui::Slider::new(&mut options.form_factor_samples, 1..=1024)
-                    .logarithmic(true)
-                    .text("Samples per pair"),
-            );
-        }
-    }
+    super::controls::technique(ui, options);
     ui.horizontal_wrapped(|ui| {
         ui.label("Sampler");
         ui.radio_value(&mut config.sampler, SamplerKind::Independent, "Independent");
@@ -390,26 +202,6 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
         let label = ui.label("Seed");
         ui.add(egui::DragValue::new(&mut config.seed))
             .labelled_by(label.id);
-    });
-}
-
-fn mis_heuristic(ui: &mut egui::Ui, mis: &mut MisHeuristic) {
-    if *mis == MisHeuristic::None {
-        *mis = MisHeuristic::Power;
-    }
-    ui.horizontal(|ui| {
-        ui.label("MIS");
-        ui.radio_value(mis, MisHeuristic::Balance, "Balance");
-        ui.radio_value(mis, MisHeuristic::Power, "Power");
-    });
-}
-
-fn roulette(ui: &mut egui::Ui, on: &mut bool, depth: &mut u32) {
-    ui.horizontal(|ui| {
-        ui.checkbox(on, "Russian roulette");
-        if *on {
-            ui.add(egui::DragValue::new(depth).range(0..=64).prefix("from "));
-        }
     });
 }
 
@@ -550,17 +342,4 @@ fn export_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
             app.export_sheet();
         }
     });
-}
-
-/// The first merge radius and how fast it shrinks (SPPM, VCM).
-fn merge_radius(ui: &mut egui::Ui, options: &mut crate::integrator::IntegratorOptions) {
-    ui.add(
-        egui::Slider::new(&mut options.photon_radius, 1e-4..=0.05)
-            .logarithmic(true)
-            .text("First radius (of the scene's diagonal)"),
-    );
-    ui.add(
-        egui::Slider::new(&mut options.photon_alpha, 0.05..=1.0)
-            .text("Alpha (1: fixed radius, biased)"),
-    );
 }

@@ -51,19 +51,19 @@ impl Config {
     pub fn label(&self) -> String {
         let i = &self.integrator;
         let estimator = match i.kind {
-            IntegratorKind::Whitted => format!("whitted d{}", i.max_depth),
+            IntegratorKind::Whitted => format!("whitted d{}", i.whitted.max_depth),
             IntegratorKind::Mcrt => format!(
                 "mcrt d{} n{} m{}",
-                i.max_depth, i.shadow_rays, i.glossy_rays
+                i.mcrt.max_depth, i.mcrt.shadow_rays, i.mcrt.glossy_rays
             ),
             IntegratorKind::Path => {
-                format!("path d{} {:?}", i.max_depth, i.strategy).to_lowercase()
+                format!("path d{} {:?}", i.path.length.max_depth, i.path.strategy).to_lowercase()
             }
-            IntegratorKind::Light => format!("light d{}", i.max_depth),
+            IntegratorKind::Light => format!("light d{}", i.light.length.max_depth),
             IntegratorKind::Radiosity => format!(
                 "radiosity {} {}",
-                i.radiosity_solver.name(),
-                i.radiosity_display.name()
+                i.radiosity.solver.name(),
+                i.radiosity.display.name()
             ),
             // Techniques without a label of their own.
             #[allow(unreachable_patterns)]
@@ -93,7 +93,7 @@ impl Config {
         };
         // Lookup displays of radiosity antialias with Sobol points.
         let lookup = i.kind == IntegratorKind::Radiosity
-            && i.radiosity_display != crate::integrator::radiosity::RadiosityDisplay::Gather;
+            && i.radiosity.display != crate::integrator::radiosity::RadiosityDisplay::Gather;
         let sampler = if lookup {
             SamplerKind::Sobol
         } else {

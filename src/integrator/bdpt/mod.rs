@@ -30,7 +30,7 @@
 //! own pixel is multiplied by W H.
 
 use super::light::{importance_weight, sample_particle, sees_lens, shading_correction};
-use super::{IntegratorOptions, MisHeuristic, RayCounts, Splat, SplattingEstimator, Technique};
+use super::{MisHeuristic, PathLength, RayCounts, Settings, Splat, SplattingEstimator, Technique};
 use crate::accel::NO_LIGHT;
 use crate::math::{Ray, Rgb, ray_between};
 use crate::sampling::{Domain, Sampler};
@@ -50,6 +50,41 @@ pub const MAX_BOUNCES: u32 = 32;
 const MAX_VERTICES: usize = MAX_BOUNCES as usize + 2;
 
 /// Settings of the bidirectional path tracer.
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct BdptSettings {
+    /// Depth at most [`MAX_BOUNCES`].
+    #[serde(flatten)]
+    pub length: PathLength,
+    /// How the strategies combine (`None` reads as power).
+    pub mis: MisHeuristic,
+}
+
+impl Settings for BdptSettings {
+    fn validate(&self) -> Result<(), String> {
+        if self.length.max_depth > MAX_BOUNCES {
+            return Err(format!(
+                "max depth {} is more than bidirectional path tracing's {MAX_BOUNCES}",
+                self.length.max_depth
+            ));
+        }
+        Ok(())
+    }
+
+    fn max_depth_mut(&mut self) -> Option<&mut u32> {
+        Some(&mut self.length.max_depth)
+    }
+
+    fn length_mut(&mut self) -> Option<&mut PathLength> {
+        Some(&mut self.length)
+    }
+
+    fn mis_mut(&mut self) -> Option<&mut MisHeuristic> {
+        Some(&mut self.mis)
+    }
+}
+
+/// The bidirectional path tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bdpt {
     /// Bounces of a full path (1 = direct lighting), as for path tracing;
@@ -81,12 +116,14 @@ impl Technique for Bdpt {
     const SUMMARY: &'static str = "Bidirectional path tracing: camera and light subpaths joined by \
          every strategy, weighted by multiple importance sampling.";
 
-    fn from_options(options: &IntegratorOptions) -> Self {
+    type Settings = BdptSettings;
+
+    fn new(settings: &BdptSettings) -> Self {
         Bdpt {
-            max_depth: options.max_depth.min(MAX_BOUNCES),
-            rr_depth: options.rr_depth,
-            russian_roulette: options.russian_roulette,
-            mis: options.combining_heuristic(),
+            max_depth: settings.length.max_depth.min(MAX_BOUNCES),
+            rr_depth: settings.length.rr_depth,
+            russian_roulette: settings.length.russian_roulette,
+            mis: super::options::combining(settings.mis),
             faulty_strategy: None,
         }
     }

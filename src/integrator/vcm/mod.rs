@@ -28,7 +28,7 @@
 
 use super::light::{importance_weight, sample_particle};
 use super::photon_map::{self, PhotonMap, Stored};
-use super::{IntegratorOptions, MisHeuristic, MultiPassEstimator, RayCounts, Technique};
+use super::{MisHeuristic, MultiPassEstimator, PathLength, RayCounts, Settings, Technique};
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::film::splats::{PendingSplats, SplatBuffer};
 use crate::math::{Frame, Ray, Rgb};
@@ -49,6 +49,49 @@ mod strategies;
 pub const MAX_LIGHT_PATHS: u32 = 1 << 20;
 
 /// Settings of vertex connection and merging.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct VcmSettings {
+    #[serde(flatten)]
+    pub length: PathLength,
+    /// How the strategies combine (`None` reads as power).
+    pub mis: MisHeuristic,
+    /// The first iteration's merge radius, a fraction of the scene's diagonal.
+    pub radius: f32,
+    /// r_i^2 = r_1^2 i^(alpha - 1): 0 < alpha <= 1.
+    pub alpha: f32,
+}
+
+impl Default for VcmSettings {
+    fn default() -> Self {
+        VcmSettings {
+            length: PathLength::default(),
+            mis: MisHeuristic::Power,
+            radius: 0.002,
+            alpha: 2.0 / 3.0,
+        }
+    }
+}
+
+impl Settings for VcmSettings {
+    fn validate(&self) -> Result<(), String> {
+        super::sppm::check_radius(self.radius, self.alpha)
+    }
+
+    fn max_depth_mut(&mut self) -> Option<&mut u32> {
+        Some(&mut self.length.max_depth)
+    }
+
+    fn length_mut(&mut self) -> Option<&mut PathLength> {
+        Some(&mut self.length)
+    }
+
+    fn mis_mut(&mut self) -> Option<&mut MisHeuristic> {
+        Some(&mut self.mis)
+    }
+}
+
+/// Vertex connection and merging.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Vcm {
     /// Bounces of a full path, as for path tracing.
@@ -83,14 +126,16 @@ impl Technique for Vcm {
          progressive photon mapping in one estimator, every strategy weighted by multiple \
          importance sampling.";
 
-    fn from_options(options: &IntegratorOptions) -> Self {
+    type Settings = VcmSettings;
+
+    fn new(settings: &VcmSettings) -> Self {
         Vcm {
-            max_depth: options.max_depth,
-            rr_depth: options.rr_depth,
-            russian_roulette: options.russian_roulette,
-            mis: options.combining_heuristic(),
-            radius: options.photon_radius,
-            alpha: options.photon_alpha,
+            max_depth: settings.length.max_depth,
+            rr_depth: settings.length.rr_depth,
+            russian_roulette: settings.length.russian_roulette,
+            mis: super::options::combining(settings.mis),
+            radius: settings.radius,
+            alpha: settings.alpha,
         }
     }
 

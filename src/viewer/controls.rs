@@ -1,0 +1,259 @@
+//! Each technique's controls, one function per settings struct: the
+//! viewer's side of the settings that each technique owns in its own file.
+
+use crate::integrator::ambient_occlusion::AoSettings;
+use crate::integrator::bdpt::BdptSettings;
+use crate::integrator::light::LightSettings;
+use crate::integrator::mcrt::McrtSettings;
+use crate::integrator::path::PathSettings;
+use crate::integrator::photon::PhotonSettings;
+use crate::integrator::radiosity::{Radiosity, RadiosityDisplay};
+use crate::integrator::sppm::SppmSettings;
+use crate::integrator::vcm::VcmSettings;
+use crate::integrator::whitted::WhittedSettings;
+use crate::integrator::{
+    GlassShadows, IntegratorKind, IntegratorOptions, MisHeuristic, PathLength, Strategy,
+};
+use crate::radiosity::{FormFactorMethod, RadiositySolver};
+use eframe::egui::{self, RichText};
+
+/// The chosen technique's controls.
+pub fn technique(ui: &mut egui::Ui, options: &mut IntegratorOptions) {
+    match options.kind {
+        IntegratorKind::Whitted => whitted(ui, &mut options.whitted),
+        IntegratorKind::Mcrt => mcrt(ui, &mut options.mcrt),
+        IntegratorKind::Path => path(ui, &mut options.path),
+        IntegratorKind::AmbientOcclusion => ambient_occlusion(ui, &mut options.ao),
+        IntegratorKind::Light => light(ui, &mut options.light),
+        IntegratorKind::Bdpt => bdpt(ui, &mut options.bdpt),
+        IntegratorKind::Photon => photon(ui, &mut options.photon),
+        IntegratorKind::Sppm => sppm(ui, &mut options.sppm),
+        IntegratorKind::Vcm => vcm(ui, &mut options.vcm),
+        IntegratorKind::Radiosity => radiosity(ui, &mut options.radiosity),
+    }
+}
+
+fn whitted(ui: &mut egui::Ui, s: &mut WhittedSettings) {
+    ui.add(egui::Slider::new(&mut s.max_depth, 0..=32).text("Max specular depth"));
+    ui.add(egui::Slider::new(&mut s.ambient, 0.0..=0.5).text("Ambient"));
+    ui.horizontal(|ui| {
+        ui.label("Glass shadows");
+        ui.radio_value(&mut s.glass_shadows, GlassShadows::Opaque, "Opaque");
+        ui.radio_value(&mut s.glass_shadows, GlassShadows::Tinted, "Tinted");
+    });
+}
+
+fn mcrt(ui: &mut egui::Ui, s: &mut McrtSettings) {
+    max_depth(ui, &mut s.max_depth);
+    ui.add(egui::Slider::new(&mut s.shadow_rays, 0..=16).text("Shadow rays N"));
+    ui.add(egui::Slider::new(&mut s.glossy_rays, 0..=16).text("Glossy rays M"));
+    if s.shadow_rays + s.glossy_rays == 0 {
+        s.shadow_rays = 1;
+    }
+    mis_heuristic(ui, &mut s.mis);
+    seen_emitters(ui, &mut s.exact_seen_emitters);
+    let rays = u64::from(s.glossy_rays).pow(s.max_depth.clamp(1, 17) - 1);
+    if rays > 100_000 {
+        ui.label(
+            RichText::new(format!("M^(D-1) = {rays} rays per sample: slow"))
+                .color(egui::Color32::YELLOW),
+        );
+    }
+}
+
+fn path(ui: &mut egui::Ui, s: &mut PathSettings) {
+    max_depth(ui, &mut s.length.max_depth);
+    ui.horizontal(|ui| {
+        ui.label("Strategy");
+        ui.radio_value(&mut s.strategy, Strategy::Bsdf, "BSDF");
+        ui.radio_value(&mut s.strategy, Strategy::Light, "Light");
+        ui.radio_value(&mut s.strategy, Strategy::Mis, "MIS");
+    });
+    if s.strategy == Strategy::Mis {
+        mis_heuristic(ui, &mut s.mis);
+    }
+    roulette(ui, &mut s.length);
+    seen_emitters(ui, &mut s.exact_seen_emitters);
+}
+
+fn ambient_occlusion(ui: &mut egui::Ui, s: &mut AoSettings) {
+    let mut limited = s.distance > 0.0;
+    ui.checkbox(&mut limited, "Distance limit")
+        .on_hover_text("Occluders farther than this fraction of the scene's size do not count");
+    if !limited {
+        s.distance = 0.0;
+    } else {
+        if s.distance == 0.0 {
+            s.distance = 0.1;
+        }
+        ui.add(
+            egui::Slider::new(&mut s.distance, 0.001..=1.0)
+                .logarithmic(true)
+                .text("Distance (of the scene's diagonal)"),
+        );
+    }
+}
+
+fn light(ui: &mut egui::Ui, s: &mut LightSettings) {
+    max_depth(ui, &mut s.length.max_depth);
+    roulette(ui, &mut s.length);
+}
+
+fn bdpt(ui: &mut egui::Ui, s: &mut BdptSettings) {
+    max_depth(ui, &mut s.length.max_depth);
+    mis_heuristic(ui, &mut s.mis);
+    roulette(ui, &mut s.length);
+}
+
+fn photon(ui: &mut egui::Ui, s: &mut PhotonSettings) {
+    max_depth(ui, &mut s.max_depth);
+    ui.add(
+        egui::Slider::new(&mut s.photons, 0..=4_000_000)
+            .logarithmic(true)
+            .text("Photons per map (0: one per pixel)"),
+    );
+    ui.add(egui::Slider::new(&mut s.k, 1..=256).text("k (photons per estimate)"));
+    ui.add(
+        egui::Slider::new(&mut s.gather_radius, 1e-3..=0.2)
+            .logarithmic(true)
+            .text("Largest radius (of the scene's diagonal)"),
+    );
+}
+
+fn sppm(ui: &mut egui::Ui, s: &mut SppmSettings) {
+    max_depth(ui, &mut s.max_depth);
+    ui.add(
+        egui::Slider::new(&mut s.photons, 0..=4_000_000)
+            .logarithmic(true)
+            .text("Photons per iteration (0: one per pixel)"),
+    );
+    merge_radius(ui, &mut s.radius, &mut s.alpha);
+}
+
+fn vcm(ui: &mut egui::Ui, s: &mut VcmSettings) {
+    max_depth(ui, &mut s.length.max_depth);
+    mis_heuristic(ui, &mut s.mis);
+    roulette(ui, &mut s.length);
+    merge_radius(ui, &mut s.radius, &mut s.alpha);
+}
+
+fn radiosity(ui: &mut egui::Ui, s: &mut Radiosity) {
+    ui.horizontal(|ui| {
+        ui.label("Solver");
+        for solver in RadiositySolver::ALL {
+            ui.radio_value(&mut s.solver, solver, solver.name());
+        }
+    });
+    if s.solver == RadiositySolver::Progressive {
+        ui.checkbox(&mut s.ambient, "Ambient term");
+    }
+    if s.solver == RadiositySolver::Hierarchical {
+        ui.add(
+            egui::Slider::new(&mut s.epsilon, 1e-7..=1e-2)
+                .logarithmic(true)
+                .text("Epsilon (share of the emitted power)"),
+        );
+    }
+    ui.add(
+        // Hierarchical: the smallest element, which goes well below the
+        // matrix solvers' sizes (the Cornell box runs use 0.002).
+        egui::Slider::new(&mut s.patch_size, 0.001..=0.5)
+            .logarithmic(true)
+            .text("Patch size (of the scene's diagonal)"),
+    );
+    if s.solver != RadiositySolver::Hierarchical {
+        ui.add(
+            egui::Slider::new(&mut s.adaptive_rounds, 0..=4).text("Adaptive subdivision rounds"),
+        );
+        if s.adaptive_rounds > 0 {
+            ui.add(
+                egui::Slider::new(&mut s.adaptive_tolerance, 0.05..=2.0)
+                    .logarithmic(true)
+                    .text("Tolerance (of the mean)"),
+            );
+        }
+    }
+    ui.checkbox(&mut s.wireframe, "Wireframe (colour by level)");
+    ui.checkbox(
+        &mut s.discontinuity,
+        "Discontinuity meshing (lines in cyan)",
+    )
+    .on_hover_text(
+        "Split receivers along the umbra and penumbra boundaries of polygonal lights \
+             before meshing, so that no element straddles a shadow's edge",
+    );
+    ui.horizontal(|ui| {
+        ui.label("Form factors");
+        let before = s.form_factors;
+        ui.radio_value(
+            &mut s.form_factors,
+            FormFactorMethod::Analytic,
+            "Contour integral",
+        );
+        ui.radio_value(
+            &mut s.form_factors,
+            FormFactorMethod::RayCast,
+            "Ray casting",
+        );
+        // Each method starts from the count at which it is accurate.
+        if s.form_factors != before {
+            s.form_factor_samples = s.form_factors.default_samples();
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.label("Display");
+        for display in RadiosityDisplay::ALL {
+            ui.radio_value(&mut s.display, display, display.name());
+        }
+    });
+    ui.add(
+        egui::Slider::new(&mut s.form_factor_samples, 1..=1024)
+            .logarithmic(true)
+            .text("Samples per pair"),
+    );
+}
+
+fn max_depth(ui: &mut egui::Ui, depth: &mut u32) {
+    ui.add(egui::Slider::new(depth, 0..=32).text("Max depth (bounces)"));
+}
+
+fn mis_heuristic(ui: &mut egui::Ui, mis: &mut MisHeuristic) {
+    if *mis == MisHeuristic::None {
+        *mis = MisHeuristic::Power;
+    }
+    ui.horizontal(|ui| {
+        ui.label("MIS");
+        ui.radio_value(mis, MisHeuristic::Balance, "Balance");
+        ui.radio_value(mis, MisHeuristic::Power, "Power");
+    });
+}
+
+fn roulette(ui: &mut egui::Ui, length: &mut PathLength) {
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut length.russian_roulette, "Russian roulette");
+        if length.russian_roulette {
+            ui.add(
+                egui::DragValue::new(&mut length.rr_depth)
+                    .range(0..=64)
+                    .prefix("from "),
+            );
+        }
+    });
+}
+
+fn seen_emitters(ui: &mut egui::Ui, exact: &mut bool) {
+    ui.checkbox(exact, "Lights seen directly: exact per pixel")
+        .on_hover_text(
+            "A light seen through a pixel adds its exact share of the pixel's area \
+             instead of being hit or missed by each camera ray: no noise on its rim",
+        );
+}
+
+fn merge_radius(ui: &mut egui::Ui, radius: &mut f32, alpha: &mut f32) {
+    ui.add(
+        egui::Slider::new(radius, 1e-4..=0.05)
+            .logarithmic(true)
+            .text("First radius (of the scene's diagonal)"),
+    );
+    ui.add(egui::Slider::new(alpha, 0.05..=1.0).text("Alpha (1: fixed radius, biased)"));
+}
