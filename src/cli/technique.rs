@@ -97,12 +97,16 @@ impl TechniqueFlags {
     /// integrator block asks for (`hints`), then the flags; checked.
     pub fn options(&self, hints: &RenderHints) -> Result<IntegratorOptions> {
         let mut options = IntegratorOptions::default();
+        // A technique named here wins over the file's, and takes its depth.
         let kind = self.integrator.map(integrator_kind);
-        options
-            .take_hints(hints, kind.is_some())
-            .map_err(Error::new)?;
         if let Some(kind) = kind {
             options.kind = kind;
+        }
+        let taken = options
+            .take_hints(hints, kind.is_some())
+            .map_err(Error::new)?;
+        if !taken.is_empty() {
+            eprintln!("from the scene file: {}", taken.join(", "));
         }
         self.apply(&mut options)?;
         options.validate().map_err(Error::new)?;

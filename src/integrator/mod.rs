@@ -417,6 +417,16 @@ macro_rules! register_techniques {
                 }
             }
 
+            /// [`Settings::deepest`] of the chosen technique.
+            pub fn deepest(&self) -> u32 {
+                match self.kind {
+                    $(IntegratorKind::$cv => self.$cf.deepest(),)*
+                    $(IntegratorKind::$sv => self.$sf.deepest(),)*
+                    $(IntegratorKind::$mv => self.$mf.deepest(),)*
+                    $(IntegratorKind::$xv => self.$xf.deepest(),)*
+                }
+            }
+
             /// [`Settings::length_mut`] of the chosen technique.
             pub fn length_mut(&mut self) -> Option<&mut PathLength> {
                 match self.kind {

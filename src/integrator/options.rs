@@ -65,6 +65,10 @@ pub trait Settings:
     fn max_depth_mut(&mut self) -> Option<&mut u32> {
         None
     }
+    /// The deepest paths the technique can make.
+    fn deepest(&self) -> u32 {
+        u32::MAX
+    }
     /// Depth and roulette, where the technique has both.
     fn length_mut(&mut self) -> Option<&mut PathLength> {
         None
@@ -127,9 +131,19 @@ impl IntegratorOptions {
                 .ok_or_else(|| format!("the scene asks for an unknown technique \"{name}\""))?;
             taken.push(self.kind.label().to_string());
         }
+        let (deepest, label) = (self.deepest(), self.kind.label());
         if let (Some(d), Some(depth)) = (hints.max_depth, self.max_depth_mut()) {
-            *depth = d;
-            taken.push(format!("max depth {d}"));
+            *depth = d.min(deepest);
+            taken.push(if d > deepest {
+                let asked = if d == crate::scene::UNBOUNDED_DEPTH {
+                    "no limit".to_string()
+                } else {
+                    d.to_string()
+                };
+                format!("max depth {deepest}, the most of {label} (the file asks for {asked})")
+            } else {
+                format!("max depth {d}")
+            });
         }
         if let (Some(d), Some(length)) = (hints.rr_depth, self.length_mut()) {
             length.rr_depth = d;
@@ -164,6 +178,16 @@ mod tests {
         // Ambient occlusion has no depth: nothing is set, nothing said.
         let mut ao = IntegratorOptions::of(IntegratorKind::AmbientOcclusion);
         assert_eq!(ao.take_hints(&hints, true).unwrap(), Vec::<String>::new());
+        // An unbounded depth (Mitsuba's -1) is BDPT's deepest, said.
+        let unbounded = RenderHints {
+            max_depth: Some(crate::scene::UNBOUNDED_DEPTH),
+            ..RenderHints::default()
+        };
+        let mut bdpt = IntegratorOptions::of(IntegratorKind::Bdpt);
+        let said = bdpt.take_hints(&unbounded, true).unwrap();
+        assert_eq!(bdpt.max_depth(), Some(crate::integrator::bdpt::MAX_BOUNCES));
+        assert!(said[0].contains("the file asks for no limit"), "{said:?}");
+        assert!(bdpt.validate().is_ok());
         let unknown = RenderHints {
             integrator: Some("volpath2".into()),
             ..RenderHints::default()

@@ -75,6 +75,10 @@ impl Settings for BdptSettings {
         Some(&mut self.length.max_depth)
     }
 
+    fn deepest(&self) -> u32 {
+        MAX_BOUNCES
+    }
+
     fn length_mut(&mut self) -> Option<&mut PathLength> {
         Some(&mut self.length)
     }
