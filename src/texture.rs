@@ -23,14 +23,30 @@ pub enum Filter {
     Bilinear,
 }
 
-/// Linear RGB texels, row 0 at the top of the image file: v = 0 reads the
-/// top row, as Mitsuba's bitmap (OBJ files' v, which counts from the
-/// bottom, is flipped at load, as Mitsuba does).
+/// RGB texels, row 0 at the top of the image file: v = 0 reads the top
+/// row, as Mitsuba's bitmap (OBJ files' v, which counts from the bottom,
+/// is flipped at load, as Mitsuba does).
 #[derive(Debug)]
 pub struct Bitmap {
     pub width: usize,
     pub height: usize,
-    pub texels: Vec<Rgb>,
+    texels: Texels,
+}
+
+/// How texels are kept. 8-bit images stay 8-bit, 3 bytes a texel, and are
+/// decoded through a table of 256 values when read (pbrt-v4 keeps them
+/// so too): a 4096² JPEG takes 48 MiB instead of 256 MiB as linear floats,
+/// and loading it costs no per-texel transfer function.
+#[derive(Debug)]
+enum Texels {
+    /// Three bytes per texel and what each byte value means (sRGB-decoded
+    /// colour, or raw data divided by 255).
+    Bytes {
+        bytes: Vec<u8>,
+        decode: Box<[f32; 256]>,
+    },
+    /// Linear values (float and 16-bit images).
+    Floats(Vec<[f32; 3]>),
 }
 
 /// The affine map from a surface's texture coordinates to the texture's:
@@ -128,7 +144,8 @@ impl Texture {
     pub fn mean(&self) -> Rgb {
         match self {
             Texture::Bitmap { image, .. } => {
-                image.texels.iter().copied().sum::<Rgb>() / image.texels.len().max(1) as f32
+                let n = image.width * image.height;
+                (0..n).map(|i| image.at_index(i)).sum::<Rgb>() / n.max(1) as f32
             }
             Texture::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
         }
@@ -176,9 +193,47 @@ impl Bitmap {
                     None if a.is_finite() => a.clamp(0.0, 1.0),
                     None => 0.0,
                 };
-                Rgb::splat(a)
+                [a; 3]
             })
             .collect();
+        Ok(Bitmap {
+            width,
+            height,
+            texels: Texels::Floats(texels),
+        })
+    }
+
+    fn from_image(image: image::DynamicImage, raw: bool) -> Result<Bitmap, String> {
+        use image::ColorType;
+        let (width, height) = (image.width() as usize, image.height() as usize);
+        if width == 0 || height == 0 {
+            return Err("the image is empty".into());
+        }
+        let texels = match image.color() {
+            ColorType::L8 | ColorType::La8 | ColorType::Rgb8 | ColorType::Rgba8 => {
+                let decode: Box<[f32; 256]> = Box::new(std::array::from_fn(|i| {
+                    let c = i as f32 / 255.0;
+                    if raw { c } else { srgb_to_linear(c) }
+                }));
+                Texels::Bytes {
+                    bytes: image.into_rgb8().into_raw(),
+                    decode,
+                }
+            }
+            colour => {
+                let linear = matches!(colour, ColorType::Rgb32F | ColorType::Rgba32F);
+                let decode = |c: f32| {
+                    let c = if c.is_finite() { c.max(0.0) } else { 0.0 };
+                    if linear || raw { c } else { srgb_to_linear(c) }
+                };
+                let rgb = image.into_rgb32f();
+                Texels::Floats(
+                    rgb.pixels()
+                        .map(|p| [decode(p[0]), decode(p[1]), decode(p[2])])
+                        .collect(),
+                )
+            }
+        };
         Ok(Bitmap {
             width,
             height,
@@ -186,29 +241,41 @@ impl Bitmap {
         })
     }
 
-    fn from_image(image: image::DynamicImage, raw: bool) -> Result<Bitmap, String> {
-        let float = matches!(
-            image.color(),
-            image::ColorType::Rgb32F | image::ColorType::Rgba32F
-        );
-        let rgb = image.to_rgb32f();
-        let (width, height) = (rgb.width() as usize, rgb.height() as usize);
-        if width == 0 || height == 0 {
-            return Err("the image is empty".into());
-        }
-        let decode = |c: f32| {
-            let c = if c.is_finite() { c.max(0.0) } else { 0.0 };
-            if float || raw { c } else { srgb_to_linear(c) }
-        };
-        let texels = rgb
-            .pixels()
-            .map(|p| Rgb::new(decode(p[0]), decode(p[1]), decode(p[2])))
-            .collect();
-        Ok(Bitmap {
+    /// Linear texels given as values (for tests and generated maps).
+    pub fn from_texels(width: usize, height: usize, texels: &[Rgb]) -> Bitmap {
+        assert_eq!(texels.len(), width * height, "{width}x{height} texels");
+        Bitmap {
             width,
             height,
-            texels,
-        })
+            texels: Texels::Floats(texels.iter().map(|t| t.to_array()).collect()),
+        }
+    }
+
+    /// Texel number `i` (row-major from the top row), linear.
+    #[inline]
+    pub fn at_index(&self, i: usize) -> Rgb {
+        match &self.texels {
+            Texels::Bytes { bytes, decode } => Rgb::new(
+                decode[bytes[3 * i] as usize],
+                decode[bytes[3 * i + 1] as usize],
+                decode[bytes[3 * i + 2] as usize],
+            ),
+            Texels::Floats(texels) => Rgb::from_array(texels[i]),
+        }
+    }
+
+    /// The texel in column `x` of row `y` (from the top), linear.
+    #[inline]
+    pub fn at(&self, x: usize, y: usize) -> Rgb {
+        self.at_index(y * self.width + x)
+    }
+
+    /// Bytes the texels take.
+    pub fn memory_bytes(&self) -> usize {
+        match &self.texels {
+            Texels::Bytes { bytes, .. } => bytes.len() + 1024,
+            Texels::Floats(texels) => 12 * texels.len(),
+        }
     }
 
     #[inline]
@@ -225,7 +292,7 @@ impl Bitmap {
             };
             i as usize
         };
-        self.texels[map(y, self.height) * self.width + map(x, self.width)]
+        self.at(map(x, self.width), map(y, self.height))
     }
 
     /// The bitmap at texture coordinates `uv` (texel centres at
@@ -305,21 +372,21 @@ pub fn read_pfm(bytes: &[u8]) -> Result<Bitmap, String> {
         };
         if v.is_finite() { v.max(0.0) } else { 0.0 }
     };
-    let mut texels = vec![Rgb::ZERO; width * height];
+    let mut texels = vec![[0.0f32; 3]; width * height];
     for y in 0..height {
         for x in 0..width {
             let i = ((height - 1 - y) * width + x) * channels;
             texels[y * width + x] = if channels == 3 {
-                Rgb::new(value(i), value(i + 1), value(i + 2))
+                [value(i), value(i + 1), value(i + 2)]
             } else {
-                Rgb::splat(value(i))
+                [value(i); 3]
             };
         }
     }
     Ok(Bitmap {
         width,
         height,
-        texels,
+        texels: Texels::Floats(texels),
     })
 }
 
@@ -337,16 +404,16 @@ mod tests {
     use super::*;
 
     fn two_by_two() -> Bitmap {
-        Bitmap {
-            width: 2,
-            height: 2,
-            texels: vec![
+        Bitmap::from_texels(
+            2,
+            2,
+            &[
                 Rgb::splat(0.0),
                 Rgb::splat(1.0),
                 Rgb::splat(2.0),
                 Rgb::splat(3.0),
             ],
-        }
+        )
     }
 
     #[test]
@@ -414,9 +481,27 @@ mod tests {
         }
         let b = read_pfm(&bytes).unwrap();
         assert_eq!((b.width, b.height), (2, 1));
-        assert_eq!(b.texels[1], Rgb::new(4.0, 5.0, 6.0));
+        assert_eq!(b.at(1, 0), Rgb::new(4.0, 5.0, 6.0));
         assert!(read_pfm(b"PF\n2 1\n-1.0\n").is_err());
         assert!(read_pfm(b"P6\n2 1\n255\n").is_err());
+    }
+
+    #[test]
+    fn eight_bit_images_stay_eight_bit_and_decode_by_their_table() {
+        let bytes = vec![0u8, 128, 255, 10, 20, 30];
+        let image = || {
+            image::DynamicImage::ImageRgb8(image::RgbImage::from_raw(2, 1, bytes.clone()).unwrap())
+        };
+        let colour = Bitmap::from_image(image(), false).unwrap();
+        let data = Bitmap::from_image(image(), true).unwrap();
+        for (i, &b) in bytes.iter().enumerate() {
+            let (texel, channel) = (i / 3, i % 3);
+            let c = f32::from(b) / 255.0;
+            assert_eq!(colour.at(texel, 0)[channel], srgb_to_linear(c));
+            assert_eq!(data.at(texel, 0)[channel], c);
+        }
+        // Three bytes a texel (and the table), not sixteen.
+        assert_eq!(colour.memory_bytes(), 6 + 1024);
     }
 
     #[test]

@@ -53,7 +53,7 @@ impl Environment {
                             let yy = (y as i64 + dy).clamp(0, h as i64 - 1) as usize;
                             for dx in -1i64..=1 {
                                 let xx = (x as i64 + dx).rem_euclid(w as i64) as usize;
-                                m = m.max(luminance(map.texels[yy * w + xx]));
+                                m = m.max(luminance(map.at(xx, yy)));
                             }
                         }
                         weights[y * w + x] = m * sin_theta;
@@ -143,7 +143,7 @@ impl Environment {
                 for y in 0..h {
                     let sin_theta = ((y as f32 + 0.5) / h as f32 * PI).sin() as f64;
                     for x in 0..w {
-                        sum += luminance(map.texels[y * w + x]) as f64 * sin_theta;
+                        sum += luminance(map.at(x, y)) as f64 * sin_theta;
                     }
                 }
                 (sum * 2.0 * PI as f64 * PI as f64 / (w * h) as f64) as f32
@@ -186,7 +186,7 @@ fn lookup(map: &Bitmap, uv: Vec2) -> Rgb {
     let x0 = (x0 as i64).rem_euclid(w as i64) as usize;
     let x1 = (x0 + 1) % w;
     let (y0, y1) = ((y0 as usize).min(h - 1), (y0 as usize + 1).min(h - 1));
-    let t = |x: usize, y: usize| map.texels[y * w + x];
+    let t = |x: usize, y: usize| map.at(x, y);
     (t(x0, y0) * (1.0 - fx) + t(x1, y0) * fx) * (1.0 - fy)
         + (t(x0, y1) * (1.0 - fx) + t(x1, y1) * fx) * fy
 }

@@ -443,7 +443,8 @@ impl<'a> Importer<'a> {
                 let _ = p.string(quiet)?;
             }
         }
-        let filter = match p.objects("rfilter")?.first() {
+        // Mitsuba 0.5 files name it (`<rfilter name="rfilter" ...>`).
+        let filter = match p.any_objects("rfilter")?.first() {
             // Mitsuba's default: a Gaussian of standard deviation 0.5.
             None => PixelFilter::Gaussian {
                 stddev: 0.5,

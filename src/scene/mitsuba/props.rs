@@ -159,8 +159,6 @@ impl<'a> Props<'a> {
         }
     }
 
-    /// The unnamed child plugins with tag `tag` (nested or referenced),
-    /// marked used.
     /// Every nested `tag` element, named or not (a `bumpmap`'s texture
     /// goes by any name).
     pub fn any_objects(&self, tag: &str) -> Result<Vec<&'a Element>> {
@@ -178,6 +176,8 @@ impl<'a> Props<'a> {
         Ok(out)
     }
 
+    /// The unnamed child plugins with tag `tag` (nested or referenced),
+    /// marked used.
     pub fn objects(&self, tag: &str) -> Result<Vec<&'a Element>> {
         let mut out = Vec::new();
         for (i, c) in self.element.children.iter().enumerate() {
