@@ -392,9 +392,12 @@ impl<'a> Importer<'a> {
                         &format!("gamma {g} ignored: 8-bit images are read as sRGB"),
                     );
                 }
-                let image = Bitmap::read(&path, raw).map_err(|m| e.loc.error(m))?;
+                let image = match self.prefetched.bitmap(&path, raw) {
+                    Some(image) => image,
+                    None => Arc::new(Bitmap::read(&path, raw).map_err(|m| e.loc.error(m))?),
+                };
                 Texture::Bitmap {
-                    image: Arc::new(image),
+                    image,
                     wrap,
                     filter,
                     to_uv,

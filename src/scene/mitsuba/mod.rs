@@ -5,6 +5,7 @@
 //! was done instead, and `strict` makes the first one an error.
 
 mod bsdfs;
+mod prefetch;
 mod props;
 mod shapes;
 mod spectrum;
@@ -45,6 +46,7 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         lights: Vec::new(),
         environment: None,
         hints: RenderHints::default(),
+        prefetched: prefetch::Prefetched::new(&doc, &ids),
     };
     let camera = importer.scene()?;
     options.check_strict(&importer.warnings)?;
@@ -94,6 +96,8 @@ pub(super) struct Importer<'a> {
     lights: Vec<Light>,
     environment: Option<Environment>,
     hints: RenderHints,
+    /// Meshes and bitmaps decoded ahead, in parallel.
+    prefetched: prefetch::Prefetched,
 }
 
 impl<'a> Importer<'a> {
@@ -276,8 +280,13 @@ impl<'a> Importer<'a> {
                         .string("filename")?
                         .ok_or_else(|| bad("needs `filename`"))?;
                     let path = self.doc.resolve(file, &e.loc)?;
-                    let map = Bitmap::read(&path, false).map_err(|m| e.loc.error(m))?;
-                    Radiance::Map(std::sync::Arc::new(map))
+                    let map = match self.prefetched.bitmap(&path, false) {
+                        Some(map) => map,
+                        None => std::sync::Arc::new(
+                            Bitmap::read(&path, false).map_err(|m| e.loc.error(m))?,
+                        ),
+                    };
+                    Radiance::Map(map)
                 };
                 let scale = p.float_or("scale", 1.0)?;
                 if !(scale >= 0.0 && scale.is_finite()) {
