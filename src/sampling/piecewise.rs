@@ -4,18 +4,26 @@
 
 use glam::Vec2;
 
+/// One cell of a [`Piecewise1D`].
+#[derive(Clone, Copy, Debug, Default)]
+struct Cell {
+    /// ∫_0^{i/n} f / ∫_0^1 f.
+    cdf: f32,
+    func: f32,
+    /// The last cell whose cdf start is <= i / n (a guide table, Chen and
+    /// Asau 1974): where the search for u in [i/n, (i+1)/n) starts.
+    guide: u32,
+}
+
 /// A density proportional to `func` over n equal cells of [0, 1).
 #[derive(Clone, Debug)]
 pub struct Piecewise1D {
-    func: Vec<f32>,
-    /// cdf[i] = ∫_0^{i/n} f / ∫_0^1 f; n + 1 entries.
-    cdf: Vec<f32>,
-    /// guide[k]: the last cell whose cdf start is <= k / n (a guide table,
-    /// Chen and Asau 1974), where the search for u in [k/n, (k+1)/n)
-    /// starts. A binary search over a random row of a 2048-wide
-    /// environment map missed the cache at every step: 31% of path
-    /// tracing's time on Bitterli's living room (docs/performance.md).
-    guide: Vec<u32>,
+    /// n + 1 entries, the last holding only the cdf's end. Interleaved, so
+    /// that a sample's guide entry, cdf and value share cache lines: a
+    /// binary search over a random row of a 2048-wide environment map
+    /// missed the cache at every step (31% of path tracing's time on
+    /// Bitterli's living room, docs/performance.md).
+    cells: Vec<Cell>,
     /// ∫_0^1 func.
     pub integral: f32,
 }
@@ -34,7 +42,7 @@ impl Piecewise1D {
         } else {
             (0..=n).map(|i| i as f32 / n as f32).collect()
         };
-        let func = if integral > 0.0 {
+        let func: Vec<f32> = if integral > 0.0 {
             func.iter().map(|f| f.max(0.0)).collect()
         } else {
             vec![1.0; n]
@@ -48,22 +56,28 @@ impl Piecewise1D {
             }
             guide.push(i as u32);
         }
+        let mut cells: Vec<Cell> = (0..=n)
+            .map(|i| Cell {
+                cdf: cdf[i],
+                func: func.get(i).copied().unwrap_or(0.0),
+                guide: guide.get(i).copied().unwrap_or(0),
+            })
+            .collect();
+        cells[n].func = 0.0;
         Piecewise1D {
-            func,
-            cdf,
-            guide,
+            cells,
             integral: if integral > 0.0 { integral as f32 } else { 1.0 },
         }
     }
 
     /// Cells.
     pub fn len(&self) -> usize {
-        self.func.len()
+        self.cells.len() - 1
     }
 
     /// True for no cells (never: `new` makes at least one).
     pub fn is_empty(&self) -> bool {
-        self.func.is_empty()
+        self.len() == 0
     }
 
     /// A point x with its density and cell.
@@ -71,30 +85,31 @@ impl Piecewise1D {
     pub fn sample(&self, u: f32) -> (f32, f32, usize) {
         // The last cell whose cdf start is <= u, from the guide's start
         // (a step back where u * n rounded up into the next entry).
-        let n = self.func.len();
+        let c = &self.cells;
+        let n = self.len();
         let k = ((u * n as f32) as usize).min(n - 1);
-        let mut i = self.guide[k] as usize;
-        while i > 0 && self.cdf[i] > u {
+        let mut i = c[k].guide as usize;
+        while i > 0 && c[i].cdf > u {
             i -= 1;
         }
-        while i + 1 < n && self.cdf[i + 1] <= u {
+        while i + 1 < n && c[i + 1].cdf <= u {
             i += 1;
         }
-        let width = self.cdf[i + 1] - self.cdf[i];
+        let width = c[i + 1].cdf - c[i].cdf;
         let t = if width > 0.0 {
-            ((u - self.cdf[i]) / width).clamp(0.0, 1.0)
+            ((u - c[i].cdf) / width).clamp(0.0, 1.0)
         } else {
             0.5
         };
         let x = ((i as f32 + t) / n as f32).min(1.0 - f32::EPSILON);
-        (x, self.func[i] / self.integral, i)
+        (x, c[i].func / self.integral, i)
     }
 
     /// The density at x.
     #[inline]
     pub fn pdf(&self, x: f32) -> f32 {
-        let i = ((x * self.func.len() as f32) as usize).min(self.func.len() - 1);
-        self.func[i] / self.integral
+        let i = ((x * self.len() as f32) as usize).min(self.len() - 1);
+        self.cells[i].func / self.integral
     }
 }
 
@@ -146,11 +161,12 @@ mod tests {
             })
             .collect();
         let d = Piecewise1D::new(&func);
-        let mut us: Vec<f32> = d.cdf.clone();
+        let cdf: Vec<f32> = d.cells.iter().map(|c| c.cdf).collect();
+        let mut us: Vec<f32> = cdf.clone();
         us.extend((0..10_000).map(|j| j as f32 / 10_000.0));
         us.push(1.0 - f32::EPSILON);
         for u in us.into_iter().filter(|u| *u < 1.0) {
-            let expected = d.cdf.partition_point(|&c| c <= u).clamp(1, func.len()) - 1;
+            let expected = cdf.partition_point(|&c| c <= u).clamp(1, func.len()) - 1;
             assert_eq!(d.sample(u).2, expected, "u {u}");
         }
     }
