@@ -259,6 +259,14 @@ fn bidirectional_and_photon_settings_are_checked() {
         1,
         &["--shadow-rays or --glossy-rays is not a setting of light"],
     );
+    // The viewer takes the same flags, with --integrator; alone, a
+    // setting would silently change nothing it shows.
+    #[cfg(feature = "viewer")]
+    assert_fails(
+        &tracelab(&["view", "--max-depth", "3"]),
+        1,
+        &["the viewer takes a technique's settings with --integrator"],
+    );
     let vcm = dir.join("vcm.exr");
     let o = tracelab(&[
         "render",

@@ -81,8 +81,10 @@ impl ValueEnum for IntegratorArg {
 struct ViewArgs {
     /// Scene file (TOML); default: the last one, or the Cornell box.
     scene: Option<PathBuf>,
-    #[arg(long, value_enum)]
-    integrator: Option<IntegratorArg>,
+    /// The technique and its settings, as `render` takes them; without
+    /// `--integrator` the viewer's saved technique and settings are kept.
+    #[command(flatten)]
+    technique: technique::TechniqueFlags,
     /// Target samples per pixel.
     #[arg(long)]
     spp: Option<u32>,
@@ -119,9 +121,6 @@ struct ViewArgs {
     /// Open BDPT's live strategy images (with --integrator bdpt).
     #[arg(long)]
     strategy_grid: bool,
-    /// Radiosity's settings, used with --integrator radiosity.
-    #[command(flatten)]
-    radiosity: radiosity::RadiosityFlags,
     /// Mitsuba XML: set a parameter `$name` (as Mitsuba's -D).
     #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = render::parse_define)]
     define: Vec<(String, String)>,
@@ -176,8 +175,16 @@ fn view(args: ViewArgs) -> Result<()> {
     if let Some(shot) = &args.screenshot {
         tracelab::image::check_writable(shot)?;
     }
-    let radiosity = args.radiosity.settings()?;
-    let launch_kind = args.integrator.map(integrator_kind);
+    let launch_kind = args.technique.integrator.map(integrator_kind);
+    let technique = match launch_kind {
+        Some(_) => Some(args.technique.options(&Default::default())?),
+        None if args.technique.any_given() => {
+            return Err(Error::new(
+                "the viewer takes a technique's settings with --integrator (else it keeps its saved ones)",
+            ));
+        }
+        None => None,
+    };
     tracelab::viewer::run(tracelab::viewer::Launch {
         scene: args.scene,
         integrator: launch_kind,
@@ -199,7 +206,8 @@ fn view(args: ViewArgs) -> Result<()> {
         lab: args.lab.map(|e| e.0),
         strategy_grid: args.strategy_grid,
         export_dir: args.export_dir,
-        radiosity: (launch_kind == Some(IntegratorKind::Radiosity)).then_some(radiosity),
+        technique,
+        depth_given: args.technique.depth_given(),
         defines: args.define,
         strict: args.strict,
     })

@@ -99,6 +99,23 @@ pub struct RadiosityFlags {
 }
 
 impl RadiosityFlags {
+    /// True when any of these flags was given.
+    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
+    pub fn any_given(&self) -> bool {
+        self.solver.is_some()
+            || self.ambient_term
+            || self.iterations.is_some()
+            || self.patch_size.is_some()
+            || self.epsilon.is_some()
+            || self.ff_rays.is_some()
+            || self.display.is_some()
+            || self.ff_method.is_some()
+            || self.adaptive_rounds.is_some()
+            || self.adaptive_tolerance.is_some()
+            || self.wireframe
+            || self.discontinuity_meshing
+    }
+
     /// `settings` with the flags given applied, checked.
     pub fn apply(&self, settings: &mut Radiosity) -> Result<()> {
         if let Some(solver) = self.solver {

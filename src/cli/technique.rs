@@ -93,6 +93,36 @@ pub struct TechniqueFlags {
 }
 
 impl TechniqueFlags {
+    /// True when a setting's flag was given (not counting `--integrator`).
+    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
+    pub fn any_given(&self) -> bool {
+        self.max_depth.is_some()
+            || self.rr_depth.is_some()
+            || self.no_rr
+            || self.no_nee
+            || self.strategy.is_some()
+            || self.mis.is_some()
+            || self.shadow_rays.is_some()
+            || self.glossy_rays.is_some()
+            || self.ao_distance.is_some()
+            || self.photons.is_some()
+            || self.radius.is_some()
+            || self.alpha.is_some()
+            || self.k.is_some()
+            || self.gather_radius.is_some()
+            || self.general
+            || self.seen_emitters.is_some()
+            || self.ambient.is_some()
+            || self.glass_shadows.is_some()
+            || self.radiosity.any_given()
+    }
+
+    /// True when `--max-depth` was given.
+    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
+    pub fn depth_given(&self) -> bool {
+        self.max_depth.is_some()
+    }
+
     /// The technique's settings: its defaults, then what the scene file's
     /// integrator block asks for (`hints`), then the flags; checked.
     pub fn options(&self, hints: &RenderHints) -> Result<IntegratorOptions> {

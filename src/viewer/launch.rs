@@ -2,8 +2,7 @@
 //! a test), the settings they give, and where scene files are found.
 
 use super::settings::{Config, Settings, Tab, ViewMode, load_settings, settings_file};
-use crate::integrator::IntegratorKind;
-use crate::integrator::radiosity::Radiosity;
+use crate::integrator::{IntegratorKind, IntegratorOptions};
 use crate::lab::Experiment;
 use std::path::{Path, PathBuf};
 
@@ -34,8 +33,11 @@ pub struct Launch {
     pub strategy_grid: bool,
     /// Open the Monte Carlo lab on this experiment.
     pub lab: Option<Experiment>,
-    /// Radiosity's settings from the command line (with `--integrator radiosity`).
-    pub radiosity: Option<Radiosity>,
+    /// The technique's settings from the command line (with
+    /// `--integrator`): view A starts with them.
+    pub technique: Option<IntegratorOptions>,
+    /// The command line set the depth: a scene file's does not replace it.
+    pub depth_given: bool,
     /// Mitsuba XML: values for the file's `$name`s (`-D name=value`).
     pub defines: Vec<(String, String)>,
     /// Warnings about a scene file are errors.
@@ -53,11 +55,11 @@ impl Launch {
         if let Some(scene) = &self.scene {
             settings.scene_path = scene.to_string_lossy().into_owned();
         }
+        if let Some(options) = self.technique {
+            settings.a.integrator = options;
+        }
         if let Some(kind) = self.integrator {
             settings.a.integrator.kind = kind;
-        }
-        if let Some(r) = self.radiosity {
-            settings.a.integrator.radiosity = r;
         }
         if let Some(spp) = self.target_spp {
             settings.target_spp = spp.max(1);
@@ -140,7 +142,11 @@ impl super::app::ViewerApp {
     pub(super) fn apply_hints(&mut self, hints: &crate::scene::RenderHints) {
         // A technique named on the command line wins over the file's.
         let keep_kind = self.launch.integrator.is_some();
-        let said = match self.settings.a.integrator.take_hints(hints, keep_kind) {
+        let mut hints = hints.clone();
+        if self.launch.depth_given {
+            hints.max_depth = None;
+        }
+        let said = match self.settings.a.integrator.take_hints(&hints, keep_kind) {
             Ok(said) => said,
             Err(e) => vec![e],
         };
