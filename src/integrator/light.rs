@@ -34,10 +34,6 @@ pub struct LightSettings {
 }
 
 impl Settings for LightSettings {
-    fn max_depth_mut(&mut self) -> Option<&mut u32> {
-        Some(&mut self.length.max_depth)
-    }
-
     fn length_mut(&mut self) -> Option<&mut PathLength> {
         Some(&mut self.length)
     }

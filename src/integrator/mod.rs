@@ -19,6 +19,7 @@
 
 pub mod ambient_occlusion;
 pub mod bdpt;
+mod camera_ray;
 pub mod light;
 pub mod mcrt;
 pub mod mis;
@@ -33,6 +34,7 @@ pub mod vcm;
 pub mod whitted;
 
 pub use bdpt::Bdpt;
+pub use camera_ray::{camera_ray, sample_time};
 pub use light::{LightTracer, Splat};
 pub use mcrt::McRayTracer;
 pub use mis::MisHeuristic;
@@ -40,12 +42,10 @@ pub use options::{PathLength, Settings, Strategy};
 pub use path::PathTracer;
 pub use whitted::{GlassShadows, WhittedTracer};
 
-use crate::filter::PixelFilter;
 use crate::math::{Ray, Rgb};
-use crate::sampling::{Domain, Sampler};
+use crate::sampling::Sampler;
 use crate::scene::Scene;
 use crate::shortcuts::{PrimaryPixel, ShortcutsUsed};
-use glam::Vec2;
 
 /// Rays cast, by kind; kept per thread and summed after each tile. For light
 /// tracing, `camera` counts the rays leaving the lights (the primary rays)
@@ -79,53 +79,6 @@ pub(crate) fn survives_roulette(beta: &mut Rgb, scale: f32, u: f32) -> bool {
     }
     *beta /= q;
     true
-}
-
-/// The time of a path: uniform over the shutter interval when something
-/// moves while the shutter is open, else the shutter's opening without
-/// consuming a dimension (a static scene has no time dimension). `always`
-/// draws the time anyway, as a renderer without feature detection would.
-#[inline]
-pub fn sample_time(scene: &Scene, sampler: &mut Sampler, always: bool) -> f32 {
-    if scene.features.motion || always {
-        scene.camera.time(sampler.next_1d_for(Domain::Time))
-    } else {
-        scene.camera.shutter_open
-    }
-}
-
-/// The camera ray of the sample the sampler was started at, for pixel
-/// (`x`, `y`): film position, lens point and time in this order, so that a
-/// replay draws the same numbers. `deterministic` estimators shoot through
-/// the pixel and lens centres at mid-exposure.
-#[inline(always)]
-pub fn camera_ray(
-    scene: &Scene,
-    sampler: &mut Sampler,
-    x: u32,
-    y: u32,
-    deterministic: bool,
-    general: bool,
-) -> Ray {
-    let u_pixel = sampler.next_2d_for(Domain::Pixel);
-    // Filter importance sampling; the box keeps its exact arithmetic.
-    let mut film_point = match scene.camera.filter {
-        PixelFilter::Box => Vec2::new(x as f32, y as f32) + u_pixel,
-        filter => Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + filter.sample(u_pixel),
-    };
-    let lens_dim = sampler.skip();
-    let mut lens = if scene.camera.aperture_radius > 0.0 {
-        sampler.get_2d_for(lens_dim, Domain::Lens)
-    } else {
-        Vec2::splat(0.5)
-    };
-    let mut time = sample_time(scene, sampler, general);
-    if deterministic {
-        film_point = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-        lens = Vec2::splat(0.5);
-        time = scene.camera.time(0.5);
-    }
-    scene.camera.generate_ray(film_point, lens).at_time(time)
 }
 
 /// What every technique has, whatever its kind.

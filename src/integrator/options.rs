@@ -61,9 +61,10 @@ pub trait Settings:
     fn validate(&self) -> Result<(), String> {
         Ok(())
     }
-    /// The maximum depth, where the technique has one.
+    /// The maximum depth, where the technique has one (its path length's,
+    /// where it has that).
     fn max_depth_mut(&mut self) -> Option<&mut u32> {
-        None
+        self.length_mut().map(|length| &mut length.max_depth)
     }
     /// The deepest paths the technique can make.
     fn deepest(&self) -> u32 {

@@ -126,10 +126,6 @@ impl Default for PathSettings {
 }
 
 impl Settings for PathSettings {
-    fn max_depth_mut(&mut self) -> Option<&mut u32> {
-        Some(&mut self.length.max_depth)
-    }
-
     fn length_mut(&mut self) -> Option<&mut PathLength> {
         Some(&mut self.length)
     }

@@ -23,7 +23,7 @@
 //!   first bounce with the mesh's solution in place of the rest, so it
 //!   agrees with path tracing up to the mesh's error in the indirect term.
 
-use super::{RayCounts, Settings, Solver, SolverProgress, Technique};
+use super::{RayCounts, Solver, SolverProgress, Technique};
 use crate::math::{Frame, Ray, Rgb};
 use crate::radiosity::mesh::back_twins;
 use crate::radiosity::{
@@ -38,6 +38,7 @@ use lookup::{LINE_COLOUR, facing_surface, gather, level_colour, on_edge, on_line
 
 mod lookup;
 mod meshed;
+mod settings;
 pub use meshed::Meshed;
 use meshed::discontinuity_mesh;
 
@@ -78,46 +79,6 @@ pub struct Radiosity {
     /// Split receivers along the shadows' discontinuities first
     /// ([`crate::radiosity::discontinuity`]).
     pub discontinuity: bool,
-}
-
-impl Default for Radiosity {
-    fn default() -> Self {
-        Radiosity {
-            solver: RadiositySolver::GaussSeidel,
-            patch_size: 0.1,
-            form_factors: FormFactorMethod::Analytic,
-            form_factor_samples: FormFactorMethod::Analytic.default_samples(),
-            ambient: true,
-            iterations: 0,
-            display: RadiosityDisplay::Gather,
-            epsilon: 1e-4,
-            adaptive_rounds: 0,
-            adaptive_tolerance: 0.5,
-            wireframe: false,
-            discontinuity: false,
-        }
-    }
-}
-
-impl Settings for Radiosity {
-    fn validate(&self) -> Result<(), String> {
-        if !(self.epsilon > 0.0 && self.epsilon.is_finite()) {
-            return Err(format!("epsilon must be positive, got {}", self.epsilon));
-        }
-        if !(self.adaptive_tolerance > 0.0 && self.adaptive_tolerance.is_finite()) {
-            return Err(format!(
-                "adaptive tolerance must be positive, got {}",
-                self.adaptive_tolerance
-            ));
-        }
-        if !(self.patch_size > 0.0 && self.patch_size <= 1.0) || self.form_factor_samples == 0 {
-            return Err(format!(
-                "patch size must be in (0, 1] (got {}) and form factor samples at least 1 (got {})",
-                self.patch_size, self.form_factor_samples
-            ));
-        }
-        Ok(())
-    }
 }
 
 /// How the solution is shown.

@@ -71,10 +71,6 @@ impl Settings for BdptSettings {
         Ok(())
     }
 
-    fn max_depth_mut(&mut self) -> Option<&mut u32> {
-        Some(&mut self.length.max_depth)
-    }
-
     fn deepest(&self) -> u32 {
         MAX_BOUNCES
     }

@@ -78,10 +78,6 @@ impl Settings for VcmSettings {
         super::sppm::check_radius(self.radius, self.alpha)
     }
 
-    fn max_depth_mut(&mut self) -> Option<&mut u32> {
-        Some(&mut self.length.max_depth)
-    }
-
     fn length_mut(&mut self) -> Option<&mut PathLength> {
         Some(&mut self.length)
     }

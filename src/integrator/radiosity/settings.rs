@@ -1,0 +1,46 @@
+//! Radiosity's defaults and the checks of its settings (the technique's
+//! struct is its settings).
+
+use super::{Radiosity, RadiosityDisplay};
+use crate::integrator::Settings;
+use crate::radiosity::{FormFactorMethod, RadiositySolver};
+
+impl Default for Radiosity {
+    fn default() -> Self {
+        Radiosity {
+            solver: RadiositySolver::GaussSeidel,
+            patch_size: 0.1,
+            form_factors: FormFactorMethod::Analytic,
+            form_factor_samples: FormFactorMethod::Analytic.default_samples(),
+            ambient: true,
+            iterations: 0,
+            display: RadiosityDisplay::Gather,
+            epsilon: 1e-4,
+            adaptive_rounds: 0,
+            adaptive_tolerance: 0.5,
+            wireframe: false,
+            discontinuity: false,
+        }
+    }
+}
+
+impl Settings for Radiosity {
+    fn validate(&self) -> Result<(), String> {
+        if !(self.epsilon > 0.0 && self.epsilon.is_finite()) {
+            return Err(format!("epsilon must be positive, got {}", self.epsilon));
+        }
+        if !(self.adaptive_tolerance > 0.0 && self.adaptive_tolerance.is_finite()) {
+            return Err(format!(
+                "adaptive tolerance must be positive, got {}",
+                self.adaptive_tolerance
+            ));
+        }
+        if !(self.patch_size > 0.0 && self.patch_size <= 1.0) || self.form_factor_samples == 0 {
+            return Err(format!(
+                "patch size must be in (0, 1] (got {}) and form factor samples at least 1 (got {})",
+                self.patch_size, self.form_factor_samples
+            ));
+        }
+        Ok(())
+    }
+}
