@@ -262,6 +262,24 @@ mod tests {
         triangles.into_iter().map(element).collect()
     }
 
+    /// The largest difference between the vertex values and `field` there.
+    fn worst_error(
+        elements: &[Element],
+        vertices: &[[Rgb; 3]],
+        field: impl Fn(Vec3A) -> f32,
+    ) -> f32 {
+        elements
+            .iter()
+            .zip(vertices)
+            .flat_map(|(e, v)| {
+                e.vertices
+                    .iter()
+                    .zip(v)
+                    .map(|(p, l)| (l.x - field(*p)).abs())
+            })
+            .fold(0.0f32, f32::max)
+    }
+
     #[test]
     fn a_linear_field_is_reconstructed_exactly_up_to_the_edges() {
         // Radiance 0.2 + 0.5 x + 0.3 y: the element averages are its values
@@ -299,16 +317,7 @@ mod tests {
         };
         let worst = |lines: &[LineEdge]| {
             let vertices = vertex_radiance(elements.iter().zip(values.iter().copied()), lines);
-            elements
-                .iter()
-                .zip(&vertices)
-                .flat_map(|(e, v)| {
-                    e.vertices
-                        .iter()
-                        .zip(v)
-                        .map(|(p, l)| (l.x - field(*p)).abs())
-                })
-                .fold(0.0f32, f32::max)
+            worst_error(&elements, &vertices, field)
         };
         assert!(worst(&[line]) < 1e-5, "{}", worst(&[line]));
         assert!(worst(&[]) > 1e-2, "{}", worst(&[]));
@@ -333,16 +342,7 @@ mod tests {
                 })
                 .collect();
             let vertices = vertex_radiance(elements.iter().zip(values.iter().copied()), &[]);
-            elements
-                .iter()
-                .zip(&vertices)
-                .flat_map(|(e, v)| {
-                    e.vertices
-                        .iter()
-                        .zip(v)
-                        .map(|(p, l)| (l.x - field(*p)).abs())
-                })
-                .fold(0.0f32, f32::max)
+            worst_error(&elements, &vertices, field)
         };
         let (coarse, fine) = (error(2), error(3));
         assert!(coarse / fine > 3.0, "{coarse} {fine}");
