@@ -109,6 +109,14 @@ pub fn transform(mut input: SceneInput, scale: f32, translate: Vec3A) -> SceneIn
         }
         m.velocity *= scale;
     }
+    let placed = glam::Affine3A::from_scale_rotation_translation(
+        glam::Vec3::splat(scale),
+        glam::Quat::IDENTITY,
+        translate.into(),
+    );
+    for (_, to_world) in &mut input.instances.placements {
+        *to_world = placed * *to_world;
+    }
     for l in &mut input.point_lights {
         if let Light::Point {
             position,
@@ -315,7 +323,7 @@ pub fn render(scene: &Scene, spp: u32, seed: u64) -> Result<(Image, u64)> {
 /// `direction`, is the surface the ray left: a triangle is flat, and a ray
 /// leaving a sphere outwards cannot meet it again.
 fn is_self_hit(from: &SurfaceHit, direction: Vec3A, next: &SurfaceHit) -> bool {
-    next.primitive == from.primitive
+    next.primitive == from.primitive && next.instance == from.instance
         && (next.normal == from.normal || direction.dot(from.normal) > 0.0)
 }
 

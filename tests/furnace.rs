@@ -63,6 +63,7 @@ fn sphere_furnace() -> Scene {
         }],
         point_lights: vec![],
         moving: vec![],
+        instances: Default::default(),
         sphere_sampling: LightSampling::SolidAngle,
         triangle_sampling: LightSampling::Area,
     })
@@ -113,6 +114,7 @@ fn cube_furnace() -> Scene {
         spheres: vec![],
         point_lights: vec![],
         moving: vec![],
+        instances: Default::default(),
         sphere_sampling: LightSampling::SolidAngle,
         triangle_sampling: LightSampling::Area,
     })

@@ -181,8 +181,17 @@ fn every_element_lands_where_mitsuba_puts_it() {
         "{:?}",
         camera.right
     );
-    // Triangles: light 2 + ply 2 + serialized 1 + cube 12 + two instances 2 each.
-    assert_eq!(scene.geometry.triangle_count(), 2 + 2 + 1 + 12 + 4);
+    // Triangles: light 2 + ply 2 + serialized 1 + cube 12, and two
+    // instances of the group's 2, stored once.
+    assert_eq!(scene.geometry.triangle_count(), 2 + 2 + 1 + 12);
+    assert_eq!(scene.geometry.instance_count(), 2);
+    assert_eq!(scene.geometry.triangles_drawn(), 2 + 2 + 1 + 12 + 4);
+    // Each instance's rectangle lies at z = -3, facing +z, at x = ±5.
+    for x in [5.0, -5.0] {
+        let ray = tracelab::math::Ray::new(Vec3A::new(x, 0.0, 0.0), -Vec3A::Z);
+        let hit = scene.geometry.intersect(&ray).expect("an instance is hit");
+        assert!((hit.t - 3.0).abs() < 1e-5 && (hit.normal - Vec3A::Z).length() < 1e-5);
+    }
     // The included light: rotated about x by 90 degrees, then lifted to y = 4,
     // facing down (Mitsuba's rectangle faces +z; +z rotated about x is -y).
     let lights = scene.lights.as_slice();

@@ -53,7 +53,7 @@ pub(super) fn build_wide_bvh(triangles: &[[Vec3A; 3]]) -> Option<(WideBvh, Vec<u
 /// A CWBVH over `aabbs` (spheres), or None when it would be too deep to
 /// traverse. The steps of obvhs's `build_cwbvh`, without its debug-build
 /// validation, which panics on such a tree where this returns None.
-fn build_shallow_cwbvh(aabbs: &[Aabb]) -> Option<CwBvh> {
+pub(super) fn build_shallow_cwbvh(aabbs: &[Aabb]) -> Option<CwBvh> {
     let params = build_params();
     let bvh2 = build_bvh2(aabbs);
     let bvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
@@ -197,6 +197,7 @@ impl Geometry {
             offset: self.offset,
             bvh_too_deep: self.bvh_too_deep,
             masks: self.masks.clone(),
+            instances: self.instances.clone(),
             ..Geometry::default()
         };
         let order = geometry.store_triangles(&inputs, inputs.len() <= SOUP_MAX_TRIANGLES);
@@ -205,6 +206,83 @@ impl Geometry {
             geometry.tri_shading[slot].light = self.tri_shading[old as usize].light;
         }
         (geometry, from)
+    }
+
+    /// Places the prototypes: `placements` lists (prototype index, to
+    /// world) pairs. A prototype holds triangles only, none of them a light
+    /// (lights are sampled where they are), and every placement keeps
+    /// orientation (a mirrored one flips the winding that the geometric
+    /// normal follows): the loaders copy what breaks these rules.
+    pub fn add_instances(&mut self, prototypes: Vec<Geometry>, placements: &[(u32, Affine3A)]) {
+        debug_assert!(prototypes.iter().all(|p| {
+            p.spheres.is_empty()
+                && p.moving.is_empty()
+                && p.instances.is_empty()
+                && p.tri_shading.iter().all(|s| s.light == NO_LIGHT)
+        }));
+        debug_assert!(placements.iter().all(|(_, m)| m.matrix3.determinant() > 0.0));
+        self.bvh_too_deep |= prototypes.iter().any(|p| p.bvh_too_deep);
+        self.instances = instance::Instances::new(
+            prototypes.into_iter().map(Arc::new).collect(),
+            placements,
+        );
+    }
+
+    /// Surface area of the triangles drawn, instances' included.
+    pub fn triangle_area(&self) -> f32 {
+        let own: f64 = self
+            .tri_vertices
+            .iter()
+            .map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length() as f64)
+            .sum();
+        (own + self.instances.area()) as f32
+    }
+
+    /// Number of instances.
+    pub fn instance_count(&self) -> usize {
+        self.instances.len()
+    }
+
+    /// Triangles drawn: the geometry's own and every instance's.
+    pub fn triangles_drawn(&self) -> usize {
+        self.tri_vertices.len() + self.instances.triangles_drawn()
+    }
+
+    /// A copy in which every instance's triangles are the geometry's own,
+    /// in world space: for what reads triangles one by one (radiosity's
+    /// patches, the shortcuts' occluder lists). Lights keep their ids.
+    pub fn flattened(&self) -> Geometry {
+        if self.instances.is_empty() {
+            return self.clone();
+        }
+        let (mut inputs, mut lights) = (Vec::new(), Vec::new());
+        for (i, v) in self.tri_vertices.iter().enumerate() {
+            inputs.push(TriangleInput {
+                vertices: *v,
+                material: self.tri_shading[i].material,
+                uvs: self.tri_uvs.get(i).copied(),
+                normals: self.tri_normals.get(i).copied(),
+            });
+            lights.push(self.tri_shading[i].light);
+        }
+        inputs.extend(self.instances.flattened());
+        lights.resize(inputs.len(), NO_LIGHT);
+        let mut geometry = Geometry {
+            keep_uvs: self.keep_uvs,
+            keep_normals: inputs.iter().any(|t| t.normals.is_some()),
+            sphere_bvh: self.sphere_bvh.clone(),
+            spheres: self.spheres.clone(),
+            moving: self.moving.clone(),
+            offset: self.offset,
+            masks: self.masks.clone(),
+            ..Geometry::default()
+        };
+        let order = geometry.store_triangles(&inputs, inputs.len() <= SOUP_MAX_TRIANGLES);
+        geometry.bvh_too_deep |= self.bvh_too_deep;
+        for (slot, &k) in order.iter().enumerate() {
+            geometry.tri_shading[slot].light = lights[k];
+        }
+        geometry
     }
 
     fn store_in_order(&mut self, triangles: &[TriangleInput], order: &[usize]) {

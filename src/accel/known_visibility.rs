@@ -18,6 +18,7 @@ impl Geometry {
             && self.spheres.is_empty()
             && self.moving.is_empty()
             && self.masks.is_none()
+            && self.instances.is_empty()
     }
 
     /// For a static soup ([`Geometry::is_static_soup`]): its box, and the

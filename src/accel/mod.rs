@@ -9,6 +9,7 @@
 
 mod block;
 mod build;
+mod instance;
 mod known_visibility;
 pub mod mask;
 mod soup;
@@ -17,7 +18,9 @@ pub(crate) mod triangle;
 mod wide_bvh;
 
 use crate::math::{OffsetMode, Ray, gamma};
-use glam::{Vec2, Vec3A};
+use glam::{Affine3A, Vec2, Vec3A};
+pub use instance::NO_INSTANCE;
+use instance::Instances;
 use mask::Masks;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
@@ -102,6 +105,9 @@ pub struct SurfaceHit {
     /// sphere's index (within one object, for diagnostics such as counting
     /// self-intersections).
     pub primitive: u32,
+    /// Which instance the primitive belongs to, or [`NO_INSTANCE`]
+    /// (it fits in the record's padding).
+    pub instance: u32,
 }
 
 impl SurfaceHit {
@@ -202,6 +208,9 @@ pub struct Geometry {
     /// Opacity masks, where some material has one: queries then pass
     /// through the hits a mask drops.
     masks: Option<Arc<Masks>>,
+    /// Shared geometry placed by transforms; a scene without pays one
+    /// empty-list check per query.
+    instances: Instances,
 }
 
 /// Geometry translated by `velocity * time`: at time t it is hit where the
@@ -281,6 +290,7 @@ impl Geometry {
                 .iter()
                 .map(|m| m.geometry.memory_bytes())
                 .sum::<usize>()
+            + self.instances.memory_bytes()
     }
 
     /// Triangle vertices in BVH order.
@@ -330,6 +340,7 @@ impl Geometry {
                 s.center + Vec3A::splat(s.radius),
             ));
         }
+        b = b.union(&self.instances.bounds());
         for m in &self.moving {
             // Swept over the unit time interval.
             let at_rest = m.geometry.bounds();
@@ -347,14 +358,20 @@ impl Geometry {
     /// Moving objects shade with their geometric normals.
     #[inline(always)]
     pub fn shading_normal(&self, hit: &SurfaceHit) -> Vec3A {
-        match self.tri_normals.get(hit.primitive as usize) {
-            Some([n0, n1, n2]) => {
-                let (b1, b2) = (hit.barycentric.x, hit.barycentric.y);
-                let n = ((1.0 - b1 - b2) * *n0 + b1 * *n1 + b2 * *n2).normalize_or_zero();
-                if n == Vec3A::ZERO { hit.normal } else { n }
-            }
-            None => hit.normal,
+        if hit.instance != NO_INSTANCE {
+            return self.instances.shading_normal(hit);
         }
+        self.local_shading_normal(hit).unwrap_or(hit.normal)
+    }
+
+    /// The interpolated vertex normal at a hit on this geometry's own
+    /// triangles, in its space; None where they have none.
+    #[inline(always)]
+    fn local_shading_normal(&self, hit: &SurfaceHit) -> Option<Vec3A> {
+        let [n0, n1, n2] = self.tri_normals.get(hit.primitive as usize)?;
+        let (b1, b2) = (hit.barycentric.x, hit.barycentric.y);
+        let n = ((1.0 - b1 - b2) * *n0 + b1 * *n1 + b2 * *n2).normalize_or_zero();
+        (n != Vec3A::ZERO).then_some(n)
     }
 
     /// Texture coordinates at `hit`: interpolated from its triangle's (the
@@ -362,6 +379,14 @@ impl Geometry {
     /// Mitsuba's.
     #[inline]
     pub fn uv(&self, hit: &SurfaceHit) -> Vec2 {
+        if hit.instance != NO_INSTANCE {
+            return self.instances.uv(hit);
+        }
+        self.local_uv(hit)
+    }
+
+    #[inline]
+    fn local_uv(&self, hit: &SurfaceHit) -> Vec2 {
         let i = hit.primitive as usize;
         if let Some([t0, t1, t2]) = self.tri_uvs.get(i) {
             let (b1, b2) = (hit.barycentric.x, hit.barycentric.y);
@@ -388,6 +413,14 @@ impl Geometry {
     /// θ / π). `None` where uv is degenerate.
     #[inline]
     pub fn uv_derivatives(&self, hit: &SurfaceHit) -> Option<(Vec3A, Vec3A)> {
+        if hit.instance != NO_INSTANCE {
+            return self.instances.uv_derivatives(hit);
+        }
+        self.local_uv_derivatives(hit)
+    }
+
+    #[inline]
+    fn local_uv_derivatives(&self, hit: &SurfaceHit) -> Option<(Vec3A, Vec3A)> {
         let i = hit.primitive as usize;
         if let Some([t0, t1, t2]) = self.tri_uvs.get(i) {
             let [p0, p1, p2] = self.tri_vertices[i];
@@ -421,7 +454,9 @@ impl Geometry {
 
     /// True when some triangle shades with interpolated vertex normals.
     pub fn has_shading_normals(&self) -> bool {
-        !self.tri_normals.is_empty() || self.moving.iter().any(|m| m.geometry.has_shading_normals())
+        !self.tri_normals.is_empty()
+            || self.moving.iter().any(|m| m.geometry.has_shading_normals())
+            || self.instances.has_shading_normals()
     }
 
     /// Sets how rays spawned at hits leave the surface.
@@ -458,6 +493,9 @@ impl Geometry {
     #[inline(always)]
     fn intersect_all(&self, ray: &Ray) -> Option<SurfaceHit> {
         let mut best = self.intersect_static(ray);
+        if !self.instances.is_empty() {
+            best = self.instances.closest(ray, best);
+        }
         if self.moving.is_empty() {
             return best;
         }
@@ -573,6 +611,7 @@ impl Geometry {
                 light: s.light,
                 time: ray.time,
                 primitive: self.tri_vertices.len() as u32 + best_sphere,
+                instance: NO_INSTANCE,
             });
         }
         if best_tri == u32::MAX {
@@ -608,6 +647,7 @@ impl Geometry {
             light: shading.light,
             time: ray.time,
             primitive: index,
+            instance: NO_INSTANCE,
         }
     }
 
@@ -616,6 +656,7 @@ impl Geometry {
     #[inline(always)]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let blocked = self.occluded_static(ray)
+            || (!self.instances.is_empty() && self.instances.any(ray))
             || self.moving.iter().any(|m| {
                 m.geometry.occluded_static(&Ray {
                     origin: ray.origin - ray.time * m.velocity,

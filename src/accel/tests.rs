@@ -1,6 +1,7 @@
 //! Unit tests of the ray queries.
 
 use super::*;
+use glam::Affine3A;
 
 fn quad_mesh() -> Vec<TriangleInput> {
     // Two triangles sharing the diagonal of the unit square at z = 1.
@@ -143,4 +144,115 @@ fn tiny_far_sphere_is_hit() {
     let ray = Ray::new(Vec3A::ZERO, Vec3A::X);
     let t = intersect_sphere(ray.origin, ray.direction, c, 1e-3, f32::INFINITY).unwrap();
     assert!((t - (1e4 - 1e-3)).abs() < 1e-2);
+}
+
+/// A bumpy 12 × 12 grid over the unit square (288 triangles: a BVH), with
+/// vertex normals and uvs.
+fn bumpy_grid() -> Vec<TriangleInput> {
+    let n = 12;
+    let at = |i: usize, j: usize| {
+        let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+        let z = 0.1 * (6.0 * u).sin() * (5.0 * v).cos();
+        let dzdu = 0.6 * (6.0 * u).cos() * (5.0 * v).cos();
+        let dzdv = -0.5 * (6.0 * u).sin() * (5.0 * v).sin();
+        let normal = Vec3A::new(-dzdu, -dzdv, 1.0).normalize();
+        (Vec3A::new(u, v, z), normal, Vec2::new(u, v))
+    };
+    let mut out = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let corners = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+            for [a, b, c] in [[0, 1, 2], [0, 2, 3]] {
+                let pick = [corners[a], corners[b], corners[c]];
+                out.push(TriangleInput {
+                    vertices: pick.map(|p| p.0),
+                    material: (i + j) as u32 % 3,
+                    uvs: Some(pick.map(|p| p.2)),
+                    normals: Some(pick.map(|p| p.1)),
+                });
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn instances_answer_as_their_copies_do() {
+    let grid = bumpy_grid();
+    // 4 × 4 placements, rotated, scaled (unevenly on some) and spread out:
+    // more than the list holds, so the top-level BVH is searched.
+    let mut placements = Vec::new();
+    for k in 0..16 {
+        let angle = k as f32 * 0.7;
+        let scale = glam::Vec3::new(1.0 + 0.1 * k as f32, 1.0, 1.0 + 0.05 * (k % 3) as f32);
+        let rotation = glam::Quat::from_axis_angle(glam::Vec3::new(1.0, 2.0, 0.5).normalize(), angle);
+        let offset = glam::Vec3::new((k % 4) as f32 * 2.5, (k / 4) as f32 * 2.5, 0.3 * k as f32);
+        placements.push((0, Affine3A::from_scale_rotation_translation(scale, rotation, offset)));
+    }
+    let copies: Vec<TriangleInput> = placements
+        .iter()
+        .flat_map(|(_, m)| crate::scene::InstancesInput::copy(&grid, *m))
+        .collect();
+    let flat = Geometry::build_full(&copies, vec![], AccelChoice::Auto, true);
+    let mut shared = Geometry::default();
+    let prototype = Geometry::build_full(&grid, vec![], AccelChoice::Auto, true);
+    shared.add_instances(vec![prototype], &placements);
+    assert_eq!(shared.triangles_drawn(), flat.triangle_count());
+    assert!(shared.memory_bytes() * 8 < flat.memory_bytes());
+    assert!((shared.triangle_area() - flat.triangle_area()).abs() < 1e-4 * flat.triangle_area());
+    let (a, b) = (shared.bounds(), flat.bounds());
+    // Conservative: each instance's box is its prototype's box moved.
+    assert!(Vec3A::from(a.min).cmple(Vec3A::from(b.min) + 1e-5).all());
+    assert!(Vec3A::from(a.max).cmpge(Vec3A::from(b.max) - 1e-5).all());
+
+    // Rays from around the field towards random points in it.
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut random = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let (mut hits, mut disagreements) = (0, 0);
+    let rays = 4000;
+    for _ in 0..rays {
+        let origin = Vec3A::new(random() * 16.0 - 4.0, random() * 16.0 - 4.0, 8.0 * random() - 4.0);
+        let target = Vec3A::new(random() * 9.0, random() * 9.0, random() * 5.0);
+        let ray = Ray::new(origin, (target - origin).normalize());
+        let (s, f) = (shared.intersect(&ray), flat.intersect(&ray));
+        assert_eq!(shared.occluded(&ray), flat.occluded(&ray));
+        let (Some(s), Some(f)) = (s, f) else {
+            // Grazing rays may fall on either side of an edge or silhouette.
+            disagreements += usize::from(s.is_some() != f.is_some());
+            continue;
+        };
+        hits += 1;
+        if (s.t - f.t).abs() > 1e-4 * f.t {
+            // A ray through a shared edge meets the other triangle.
+            disagreements += 1;
+            continue;
+        }
+        assert_ne!(s.instance, NO_INSTANCE);
+        assert!((s.point - f.point).length() < 1e-4 * (1.0 + f.point.length()));
+        // The moved point's rounding bound keeps a ray spawned there off
+        // its own triangle.
+        let back = s.spawn_ray(-ray.direction);
+        let again = shared.intersect(&back);
+        assert!(!again.is_some_and(|h| h.primitive == s.primitive && h.instance == s.instance));
+        if s.material == f.material {
+            assert!((s.normal - f.normal).length() < 1e-4, "{:?} {:?}", s.normal, f.normal);
+            assert!((shared.uv(&s) - flat.uv(&f)).length() < 1e-4);
+            // Vertex normals: interpolated before the transform rather than
+            // after, which differs slightly under uneven scales.
+            let (ns, nf) = (shared.shading_normal(&s), flat.shading_normal(&f));
+            assert!((ns - nf).length() < 2e-2, "{ns:?} {nf:?}");
+            let (ds, df) = (shared.uv_derivatives(&s).unwrap(), flat.uv_derivatives(&f).unwrap());
+            assert!((ds.0 - df.0).length() < 1e-3 * df.0.length());
+            assert!((ds.1 - df.1).length() < 1e-3 * df.1.length());
+        }
+    }
+    assert!(hits > rays / 8, "{hits} hits");
+    assert!(disagreements * 200 < rays, "{disagreements} disagreements");
+    // Flattening gives the copies back.
+    assert_eq!(shared.flattened().triangle_count(), flat.triangle_count());
 }

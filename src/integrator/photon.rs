@@ -130,12 +130,7 @@ impl Technique for PhotonMap2Pass {
         // search out to the largest radius everywhere visited thousands of
         // photons per lookup (Cornell box, 200 000 photons: 127 s for 64
         // iterations).
-        let area: f32 = scene
-            .geometry
-            .triangles()
-            .iter()
-            .map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length())
-            .sum::<f32>()
+        let area: f32 = scene.geometry.triangle_area()
             + scene
                 .geometry
                 .spheres()

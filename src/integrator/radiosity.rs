@@ -442,7 +442,10 @@ impl Radiosity {
 
     /// The model: a mesh and its form factors, or the hierarchy.
     fn build(&self, scene: &Scene) -> crate::Result<RadiosityState> {
+        // Patches are triangles of the scene's own: instances are copied.
+        let flat = scene.flattened();
         let (meshed, mut notes) = if self.discontinuity {
+            let scene = flat.as_ref().unwrap_or(scene);
             // The matrix solvers' elements are the pieces; the hierarchy
             // subdivides its own.
             let size = self.solver.matrix().map(|_| {
@@ -451,6 +454,12 @@ impl Radiosity {
             });
             let (meshed, notes) = discontinuity_mesh(scene, size);
             (Some(meshed), notes)
+        } else if let Some(flat) = flat {
+            let note = format!(
+                "instances copied for radiosity: {} triangles",
+                flat.geometry.triangle_count()
+            );
+            (Some(Meshed::whole(flat)), vec![note])
         } else {
             (None, Vec::new())
         };

@@ -84,6 +84,7 @@ pub fn bare_mesh(path: &Path, limits: &Limits) -> Result<SceneInput> {
         spheres: Vec::new(),
         point_lights: Vec::new(),
         moving: Vec::new(),
+        instances: Default::default(),
         sphere_sampling: LightSampling::SolidAngle,
         triangle_sampling: LightSampling::Area,
         warnings: vec![format!(

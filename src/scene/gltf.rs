@@ -106,6 +106,7 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         spheres: Vec::new(),
         point_lights: importer.lights,
         moving: Vec::new(),
+        instances: Default::default(),
         sphere_sampling: LightSampling::SolidAngle,
         triangle_sampling: LightSampling::Area,
         warnings: importer.warnings,

@@ -400,6 +400,7 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         spheres,
         point_lights,
         moving,
+        instances: Default::default(),
         sphere_sampling: file.lights.sphere_sampling,
         triangle_sampling: file.lights.triangle_sampling,
         warnings: Vec::new(),

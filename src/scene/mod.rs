@@ -26,7 +26,7 @@ use crate::math::OffsetMode;
 use crate::shortcuts::{NotApplied, PrimaryCandidates, Shortcuts, ShortcutsUsed};
 use crate::texture::Texture;
 use emitters::EmitterShape;
-use glam::Vec3A;
+use glam::{Affine3A, Vec3A};
 use light::{Light, LightSampling, Lights, PlanarEmitter};
 use material::{Bsdf, Material, Opacity};
 use std::path::Path;
@@ -124,6 +124,8 @@ pub struct SceneInput {
     pub point_lights: Vec<Light>,
     /// Objects in linear motion.
     pub moving: Vec<MovingInput>,
+    /// Shared geometry placed several times.
+    pub instances: InstancesInput,
     pub sphere_sampling: LightSampling,
     pub triangle_sampling: LightSampling,
     /// What the file asked for and did not get exactly (file:line: what).
@@ -137,6 +139,32 @@ pub struct MovingInput {
     pub triangles: Vec<TriangleInput>,
     pub spheres: Vec<Sphere>,
     pub velocity: Vec3A,
+}
+
+/// Shared geometry placed several times (Mitsuba's `shapegroup` and
+/// `instance`): each prototype's triangles are stored and searched once.
+#[derive(Clone, Debug, Default)]
+pub struct InstancesInput {
+    /// Each prototype's triangles, in its own space.
+    pub prototypes: Vec<Vec<TriangleInput>>,
+    /// (prototype, to world) per instance. A transform must be invertible
+    /// and keep orientation (loaders copy a mirrored instance instead).
+    pub placements: Vec<(u32, Affine3A)>,
+}
+
+impl InstancesInput {
+    /// The prototype's triangles placed by `to_world`, as copies.
+    pub fn copy(prototype: &[TriangleInput], to_world: Affine3A) -> Vec<TriangleInput> {
+        let normals = to_world.matrix3.inverse().transpose();
+        prototype
+            .iter()
+            .map(|t| TriangleInput {
+                vertices: t.vertices.map(|v| to_world.transform_point3a(v)),
+                normals: t.normals.map(|n| n.map(|n| (normals * n).normalize())),
+                ..*t
+            })
+            .collect()
+    }
 }
 
 /// What a scene uses, detected at load, so that estimators can run a hot
@@ -285,6 +313,65 @@ impl Dropped {
     }
 }
 
+/// Checks the instances and keeps what can be shared: prototypes without
+/// degenerate triangles, placed by transforms in range. A prototype with
+/// an emitter is copied into `triangles` at each placement (a light is
+/// sampled where it is), as is each mirrored placement (see
+/// [`InstancesInput`]). Returns the prototypes and the shared placements.
+#[allow(clippy::type_complexity)]
+fn instances(
+    input: InstancesInput,
+    materials: &[Material],
+    triangles: &mut Vec<TriangleInput>,
+    dropped: &mut Dropped,
+) -> Result<(Vec<Vec<TriangleInput>>, Vec<(u32, Affine3A)>)> {
+    let prototypes: Vec<Vec<TriangleInput>> = input
+        .prototypes
+        .into_iter()
+        .map(|p| dropped.triangles(p))
+        .collect();
+    let bounds: Vec<(Vec3A, Vec3A)> = prototypes
+        .iter()
+        .map(|p| {
+            p.iter().flat_map(|t| t.vertices).fold(
+                (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
+                |(lo, hi), v| (lo.min(v), hi.max(v)),
+            )
+        })
+        .collect();
+    let mut placements = Vec::new();
+    for (prototype, to_world) in input.placements {
+        let Some(local) = prototypes.get(prototype as usize) else {
+            return Err(Error::new(format!("internal: an instance of prototype {prototype}")));
+        };
+        if local.iter().any(|t| materials.get(t.material as usize).is_none()) {
+            return Err(Error::new("internal: a prototype's triangle refers to no material"));
+        }
+        let det = to_world.matrix3.determinant();
+        if !(to_world.is_finite() && det.is_normal()) {
+            return Err(Error::new("an instance's transform is singular or not finite"));
+        }
+        let (lo, hi) = bounds[prototype as usize];
+        let corners = (0..8).map(|c: u32| {
+            let pick = |axis: u32, lo: f32, hi: f32| if c >> axis & 1 == 0 { lo } else { hi };
+            Vec3A::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z))
+        });
+        let reach = |p: Vec3A| in_range(p) && in_range(to_world.transform_point3a(p));
+        if !local.is_empty() && !corners.into_iter().all(reach) {
+            return Err(Error::new(format!(
+                "an instance reaches beyond ±{MAX_COORDINATE:e} (or is not finite): areas and distances would overflow"
+            )));
+        }
+        let emits = local.iter().any(|t| materials[t.material as usize].is_emissive());
+        if emits || det < 0.0 {
+            triangles.extend(InstancesInput::copy(local, to_world));
+        } else if !local.is_empty() {
+            placements.push((prototype, to_world));
+        }
+    }
+    Ok((prototypes, placements))
+}
+
 /// A scene ready to render.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -349,8 +436,9 @@ impl Scene {
         let mut warnings = input.warnings;
         let hints = input.hints;
         let mut dropped = Dropped::default();
-        let triangles = dropped.triangles(input.triangles);
+        let mut triangles = dropped.triangles(input.triangles);
         let spheres = dropped.spheres(input.spheres);
+        let (prototypes, placements) = instances(input.instances, &input.materials, &mut triangles, &mut dropped)?;
         let moving: Vec<(Vec<TriangleInput>, Vec<Sphere>, Vec3A)> = input
             .moving
             .into_iter()
@@ -423,6 +511,13 @@ impl Scene {
             if !(triangles.is_empty() && spheres.is_empty()) {
                 geometry.add_moving(Geometry::build(&triangles, spheres), velocity);
             }
+        }
+        if !placements.is_empty() {
+            let prototypes = prototypes
+                .iter()
+                .map(|p| Geometry::build_full(p, Vec::new(), AccelChoice::Auto, textured))
+                .collect();
+            geometry.add_instances(prototypes, &placements);
         }
         if geometry.bvh_too_deep() {
             warnings.push(
@@ -538,6 +633,26 @@ impl Scene {
             hints: self.hints.clone(),
         };
         (scene, from)
+    }
+
+    /// The scene with every instance's triangles copied into the
+    /// geometry's own (see [`Geometry::flattened`]), where it has instances.
+    pub fn flattened(&self) -> Option<Scene> {
+        if self.geometry.instance_count() == 0 {
+            return None;
+        }
+        let geometry = self.geometry.flattened();
+        Some(Scene {
+            camera: self.camera.clone(),
+            features: Features::detect(&self.materials, &geometry, &self.lights, &self.camera),
+            shortcuts: Shortcuts::new(&geometry, &flat_light_corners(&self.lights)),
+            geometry: Arc::new(geometry),
+            materials: self.materials.clone(),
+            textures: self.textures.clone(),
+            lights: self.lights.clone(),
+            warnings: self.warnings.clone(),
+            hints: self.hints.clone(),
+        })
     }
 
     /// What radiosity makes of material `m` (see

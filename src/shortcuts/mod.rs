@@ -58,6 +58,8 @@ pub enum NotApplied {
     Masks,
     /// More triangles than a soup holds: the BVH already tests few.
     ManyTriangles(usize),
+    /// Instanced geometry: the lists name the geometry's own triangles.
+    Instances,
     /// A thin lens: camera rays leave from anywhere on the lens.
     ThinLens,
     /// A pixel filter wider than the pixel: camera rays leave its square.
@@ -83,6 +85,7 @@ impl fmt::Display for NotApplied {
             NotApplied::Spheres => write!(f, "the scene has spheres"),
             NotApplied::Motion => write!(f, "something moves"),
             NotApplied::Masks => write!(f, "the scene has opacity masks"),
+            NotApplied::Instances => write!(f, "the scene has instances"),
             NotApplied::ManyTriangles(n) => write!(
                 f,
                 "{n} triangles, more than {SOUP_MAX_TRIANGLES}: the BVH decides"
@@ -195,6 +198,8 @@ fn static_soup(geometry: &Geometry) -> Result<(), NotApplied> {
         Err(NotApplied::Motion)
     } else if geometry.has_masks() {
         Err(NotApplied::Masks)
+    } else if geometry.instance_count() > 0 {
+        Err(NotApplied::Instances)
     } else if !geometry.is_static_soup() {
         Err(NotApplied::ManyTriangles(geometry.triangle_count()))
     } else {

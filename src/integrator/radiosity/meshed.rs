@@ -13,6 +13,15 @@ pub struct Meshed {
 }
 
 impl Meshed {
+    /// `scene` as it is, no edge on a line.
+    pub fn whole(scene: Scene) -> Meshed {
+        Meshed {
+            on_line: vec![[false; 3]; scene.geometry.triangle_count()],
+            scene: std::sync::Arc::new(scene),
+            lines: 0,
+        }
+    }
+
     /// The pieces' edges that lie on discontinuity lines, for the smooth
     /// display's one-sided fits.
     pub fn line_edges(&self) -> Vec<crate::radiosity::reconstruct::LineEdge> {

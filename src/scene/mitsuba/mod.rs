@@ -43,6 +43,8 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         texture_ids: HashMap::new(),
         triangles: Vec::new(),
         spheres: Vec::new(),
+        instances: Default::default(),
+        groups: HashMap::new(),
         lights: Vec::new(),
         environment: None,
         hints: RenderHints::default(),
@@ -59,6 +61,7 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         spheres: importer.spheres,
         point_lights: importer.lights,
         moving: Vec::new(),
+        instances: importer.instances,
         // Mitsuba samples spheres by solid angle and triangles by area.
         sphere_sampling: LightSampling::SolidAngle,
         triangle_sampling: LightSampling::Area,
@@ -93,6 +96,10 @@ pub(super) struct Importer<'a> {
     texture_ids: HashMap<*const Element, u32>,
     triangles: Vec<TriangleInput>,
     spheres: Vec<Sphere>,
+    instances: crate::scene::InstancesInput,
+    /// Per shapegroup, its prototype, or None where it must be copied
+    /// (it holds a sphere).
+    groups: HashMap<*const Element, Option<u32>>,
     lights: Vec<Light>,
     environment: Option<Environment>,
     hints: RenderHints,
@@ -128,10 +135,13 @@ impl<'a> Importer<'a> {
             Some(s) => self.sensor(s),
             None => {
                 self.warn(&root.loc, "no sensor: a default camera frames the scene");
-                Ok(super::framing::default_camera(
-                    &self.triangles,
-                    &self.spheres,
-                ))
+                let mut triangles = self.triangles.clone();
+                let instances = &self.instances;
+                for &(p, to_world) in &instances.placements {
+                    let local = &instances.prototypes[p as usize];
+                    triangles.extend(crate::scene::InstancesInput::copy(local, to_world));
+                }
+                Ok(super::framing::default_camera(&triangles, &self.spheres))
             }
         }
     }

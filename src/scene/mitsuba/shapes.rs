@@ -32,9 +32,7 @@ impl<'a> Importer<'a> {
                 if group.plugin() != "shapegroup" {
                     return Err(e.loc.error("an instance refers to a shapegroup"));
                 }
-                for child in group.children.iter().filter(|c| c.tag == "shape") {
-                    self.shape(child, to_world)?;
-                }
+                self.instance(e, group, to_world)?;
             }
             return Ok(());
         }
@@ -163,6 +161,61 @@ impl<'a> Importer<'a> {
         self.push_triangles(e, out)?;
         debug_assert!(self.triangles.len() >= start);
         p.unused(&mut self.warnings);
+        Ok(())
+    }
+
+    /// One instance of `group`: shared where the group is triangles only,
+    /// copied where it holds a sphere (spheres are not instanced) or the
+    /// transform mirrors (see `InstancesInput`). The group is read once,
+    /// on its first instance; a copy reads it again, its warnings not
+    /// repeated. Emitters in the group are copied when the scene is built.
+    fn instance(&mut self, e: &'a Element, group: &'a Element, to_world: Mat4) -> Result<()> {
+        let key = group as *const Element;
+        let prototype = match self.groups.get(&key) {
+            Some(&p) => p,
+            None => {
+                let triangles = std::mem::take(&mut self.triangles);
+                let spheres = self.spheres.len();
+                for child in group.children.iter().filter(|c| c.tag == "shape") {
+                    self.shape(child, Mat4::IDENTITY)?;
+                }
+                let local = std::mem::replace(&mut self.triangles, triangles);
+                let p = if self.spheres.len() == spheres {
+                    let shared = &mut self.instances.prototypes;
+                    shared.push(local);
+                    Some(shared.len() as u32 - 1)
+                } else {
+                    self.spheres.truncate(spheres);
+                    None
+                };
+                self.groups.insert(key, p);
+                p
+            }
+        };
+        let affine = glam::Affine3A::from_mat4(to_world);
+        let shared = prototype.filter(|_| to_world.determinant() > 0.0);
+        match shared {
+            Some(p) => {
+                if !(affine.is_finite() && affine.matrix3.determinant().is_normal()) {
+                    return Err(e.loc.error("the instance's to_world is singular or not finite"));
+                }
+                let drawn: usize = self.instances.prototypes.iter().map(Vec::len).sum();
+                if self.triangles.len() + drawn > self.limits.max_triangles {
+                    return Err(e.loc.error(format!(
+                        "more than {} triangles (raise the limit with --max-triangles)",
+                        self.limits.max_triangles
+                    )));
+                }
+                self.instances.placements.push((p, affine));
+            }
+            None => {
+                let warnings = self.warnings.len();
+                for child in group.children.iter().filter(|c| c.tag == "shape") {
+                    self.shape(child, to_world)?;
+                }
+                self.warnings.truncate(warnings);
+            }
+        }
         Ok(())
     }
 
