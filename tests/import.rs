@@ -519,3 +519,80 @@ fn smooth_angle_gives_a_faceted_sphere_smooth_normals() {
         .to_string();
     assert!(e.contains("bad.toml:") && e.contains("smooth_angle"), "{e}");
 }
+
+/// Shapegroups are stored once and placed by each instance; what cannot be
+/// shared (a group that emits, a mirrored placement) is copied; and the
+/// image is the one of the copies: path tracing, BDPT and light tracing
+/// each render the scene and its flattened copy with one seed, and their
+/// means agree within 4 standard errors of the difference (the two
+/// renders' errors combined as if independent, which over-covers: they
+/// share their random numbers).
+#[test]
+fn instances_render_as_their_copies() {
+    let dir = temp_dir("instances");
+    std::fs::write(dir.join("ball.obj"), crate::common::uv_sphere_obj(24, 12, true)).unwrap();
+    let xml = r##"<scene version="3.0.0">
+  <sensor type="perspective"><float name="fov" value="50"/>
+    <transform name="to_world"><lookat origin="0, 3, 9" target="0, 0.5, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="40"/><integer name="height" value="30"/></film>
+  </sensor>
+  <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="-90"/><scale value="8"/></transform>
+    <bsdf type="diffuse"/></shape>
+  <shape type="shapegroup" id="thing">
+    <shape type="obj"><string name="filename" value="ball.obj"/>
+      <transform name="to_world"><translate y="1"/></transform>
+      <bsdf type="roughplastic"><float name="alpha" value="0.2"/></bsdf></shape>
+    <shape type="rectangle"><transform name="to_world"><rotate y="1" angle="30"/><translate z="-1.2" y="1"/></transform>
+      <bsdf type="twosided"><bsdf type="diffuse"><texture type="checkerboard" name="reflectance">
+        <transform name="to_uv"><scale value="4"/></transform></texture></bsdf></bsdf></shape>
+  </shape>
+  <shape type="shapegroup" id="lamp">
+    <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="90"/><scale value="0.6"/><translate y="5"/></transform>
+      <emitter type="area"><rgb name="radiance" value="12"/></emitter></shape>
+  </shape>
+  <shape type="instance"><ref id="thing"/><transform name="to_world"><translate x="-2.5"/></transform></shape>
+  <shape type="instance"><ref id="thing"/><transform name="to_world"><rotate y="1" angle="70"/><scale x="0.8" y="1.3" z="1"/></transform></shape>
+  <shape type="instance"><ref id="thing"/><transform name="to_world"><scale x="-1"/><translate x="2.5"/></transform></shape>
+  <shape type="instance"><ref id="lamp"/><transform name="to_world"><translate x="-1"/></transform></shape>
+  <shape type="instance"><ref id="lamp"/><transform name="to_world"><translate x="1.5" z="1"/></transform></shape>
+</scene>"##;
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, xml).unwrap();
+    let scene = Scene::load_with(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    // The sphere's poles are degenerate, counted once for the prototype.
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert!(scene.warnings[0].starts_with("dropped 48 degenerate"));
+    // Two placements shared; the mirrored one and both lamps copied.
+    assert_eq!(scene.geometry.instance_count(), 2);
+    let lights = scene.lights.as_slice().len();
+    assert_eq!(lights, 2);
+    let flat = scene.flattened().expect("the scene has instances");
+    assert_eq!(flat.geometry.instance_count(), 0);
+    assert_eq!(flat.geometry.triangle_count(), scene.geometry.triangles_drawn());
+    use tracelab::integrator::{Bdpt, LightTracer};
+    for (name, integrator) in [
+        ("path", Integrator::from(PathTracer::default())),
+        ("bdpt", Integrator::from(Bdpt::default())),
+        ("light", Integrator::from(LightTracer::default())),
+    ] {
+        let render = |scene: &Scene| {
+            let (snapshot, stats) = crate::common::render_with(
+                scene.clone(),
+                integrator.clone(),
+                SamplerKind::Independent,
+                64,
+                7,
+                0,
+                16,
+            );
+            assert_eq!(stats.non_finite, 0);
+            crate::common::mean_and_standard_error(&snapshot)
+        };
+        let ((a, sa), (b, sb)) = (render(&scene), render(&flat));
+        for c in 0..3 {
+            let tolerance = 4.0 * (sa[c] * sa[c] + sb[c] * sb[c]).sqrt();
+            assert!(a[c] > 0.01, "{name}: {a:?}");
+            assert!((a[c] - b[c]).abs() <= tolerance, "{name}: {a:?} against {b:?} (± {tolerance})");
+        }
+    }
+}
