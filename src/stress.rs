@@ -323,7 +323,8 @@ pub fn render(scene: &Scene, spp: u32, seed: u64) -> Result<(Image, u64)> {
 /// `direction`, is the surface the ray left: a triangle is flat, and a ray
 /// leaving a sphere outwards cannot meet it again.
 fn is_self_hit(from: &SurfaceHit, direction: Vec3A, next: &SurfaceHit) -> bool {
-    next.primitive == from.primitive && next.instance == from.instance
+    next.primitive == from.primitive
+        && next.instance == from.instance
         && (next.normal == from.normal || direction.dot(from.normal) > 0.0)
 }
 

@@ -1,6 +1,7 @@
 //! A glTF asset as tools export them: a floor with a base-colour texture
 //! and a normal map (PNG images in the binary buffer), a punctual light and
-//! a camera. It loads without a warning, reads both textures, and path
+//! a camera, and the same quad again as a tilted panel (one mesh, two
+//! nodes: an instance). It loads without a warning, reads both textures, and path
 //! tracing, BDPT and light tracing agree on it (block z-test of
 //! `strategies.rs`).
 
@@ -52,11 +53,12 @@ fn a_textured_normal_mapped_gltf_renders_and_bdpt_agrees() {
   "extensionsUsed": ["KHR_lights_punctual"],
   "extensions": {{"KHR_lights_punctual": {{"lights": [{{"type": "point", "color": [1, 0.9, 0.8], "intensity": 20}}]}}}},
   "scene": 0,
-  "scenes": [{{"nodes": [0, 1, 2]}}],
+  "scenes": [{{"nodes": [0, 1, 2, 3]}}],
   "nodes": [
     {{"mesh": 0, "rotation": [-0.70710678, 0, 0, 0.70710678], "scale": [3, 3, 3]}},
     {{"camera": 0, "translation": [0, 2, 4], "rotation": [-0.2588190, 0, 0, 0.9659258]}},
-    {{"translation": [0.5, 1.5, 0.5], "extensions": {{"KHR_lights_punctual": {{"light": 0}}}}}}
+    {{"translation": [0.5, 1.5, 0.5], "extensions": {{"KHR_lights_punctual": {{"light": 0}}}}}},
+    {{"mesh": 0, "translation": [-0.8, 0.7, -0.6], "rotation": [-0.3826834, 0.3, 0, 0.9238795], "scale": [0.5, 0.7, 0.5]}}
   ],
   "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.9, "aspectRatio": 1.0, "znear": 0.1}}}}],
   "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}}, "indices": 3, "material": 0}}]}}],
@@ -92,6 +94,10 @@ fn a_textured_normal_mapped_gltf_renders_and_bdpt_agrees() {
     std::fs::write(dir.join("scene.gltf"), json).unwrap();
     let mut scene = Scene::load(&dir.join("scene.gltf")).unwrap_or_else(|e| panic!("{e}"));
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    // Two nodes use the quad: it is stored once, placed twice (the second
+    // a tilted panel over the floor, unevenly scaled).
+    assert_eq!(scene.geometry.instance_count(), 2);
+    assert_eq!(scene.geometry.triangles_drawn(), 4);
     let floor = &scene.materials[0];
     assert!(floor.textures.diffuse.is_some(), "{floor:?}");
     assert!(floor.normal_map.is_some(), "{floor:?}");

@@ -530,7 +530,11 @@ fn smooth_angle_gives_a_faceted_sphere_smooth_normals() {
 #[test]
 fn instances_render_as_their_copies() {
     let dir = temp_dir("instances");
-    std::fs::write(dir.join("ball.obj"), crate::common::uv_sphere_obj(24, 12, true)).unwrap();
+    std::fs::write(
+        dir.join("ball.obj"),
+        crate::common::uv_sphere_obj(24, 12, true),
+    )
+    .unwrap();
     let xml = r##"<scene version="3.0.0">
   <sensor type="perspective"><float name="fov" value="50"/>
     <transform name="to_world"><lookat origin="0, 3, 9" target="0, 0.5, 0" up="0, 1, 0"/></transform>
@@ -568,7 +572,10 @@ fn instances_render_as_their_copies() {
     assert_eq!(lights, 2);
     let flat = scene.flattened().expect("the scene has instances");
     assert_eq!(flat.geometry.instance_count(), 0);
-    assert_eq!(flat.geometry.triangle_count(), scene.geometry.triangles_drawn());
+    assert_eq!(
+        flat.geometry.triangle_count(),
+        scene.geometry.triangles_drawn()
+    );
     use tracelab::integrator::{Bdpt, LightTracer};
     for (name, integrator) in [
         ("path", Integrator::from(PathTracer::default())),
@@ -592,7 +599,10 @@ fn instances_render_as_their_copies() {
         for c in 0..3 {
             let tolerance = 4.0 * (sa[c] * sa[c] + sb[c] * sb[c]).sqrt();
             assert!(a[c] > 0.01, "{name}: {a:?}");
-            assert!((a[c] - b[c]).abs() <= tolerance, "{name}: {a:?} against {b:?} (± {tolerance})");
+            assert!(
+                (a[c] - b[c]).abs() <= tolerance,
+                "{name}: {a:?} against {b:?} (± {tolerance})"
+            );
         }
     }
 }

@@ -220,12 +220,14 @@ impl Geometry {
                 && p.instances.is_empty()
                 && p.tri_shading.iter().all(|s| s.light == NO_LIGHT)
         }));
-        debug_assert!(placements.iter().all(|(_, m)| m.matrix3.determinant() > 0.0));
-        self.bvh_too_deep |= prototypes.iter().any(|p| p.bvh_too_deep);
-        self.instances = instance::Instances::new(
-            prototypes.into_iter().map(Arc::new).collect(),
-            placements,
+        debug_assert!(
+            placements
+                .iter()
+                .all(|(_, m)| m.matrix3.determinant() > 0.0)
         );
+        self.bvh_too_deep |= prototypes.iter().any(|p| p.bvh_too_deep);
+        self.instances =
+            instance::Instances::new(prototypes.into_iter().map(Arc::new).collect(), placements);
     }
 
     /// Surface area of the triangles drawn, instances' included.

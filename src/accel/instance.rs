@@ -68,7 +68,9 @@ impl Instances {
         if list.len() > INSTANCE_LIST_MAX {
             let bounds: Vec<Aabb> = list
                 .iter()
-                .map(|i| transformed_bounds(&prototypes[i.prototype as usize].bounds(), &i.to_world))
+                .map(|i| {
+                    transformed_bounds(&prototypes[i.prototype as usize].bounds(), &i.to_world)
+                })
                 .collect();
             // Too deep to traverse (many coincident instances): tested one by one.
             if let Some(tree) = build_shallow_cwbvh(&bounds) {
@@ -110,7 +112,10 @@ impl Instances {
             .map(|p| p.memory_bytes())
             .sum::<usize>()
             + std::mem::size_of_val(&self.list[..])
-            + self.bvh.as_ref().map_or(0, |b| std::mem::size_of_val(&b.nodes[..]))
+            + self
+                .bvh
+                .as_ref()
+                .map_or(0, |b| std::mem::size_of_val(&b.nodes[..]))
     }
 
     pub(super) fn bounds(&self) -> Aabb {
@@ -155,7 +160,10 @@ impl Instances {
                     vertices: p.tri_vertices[t].map(|v| i.to_world.transform_point3a(v)),
                     material: p.tri_shading[t].material,
                     uvs: p.tri_uvs.get(t).copied(),
-                    normals: p.tri_normals.get(t).map(|n| n.map(|n| (i.normal_to_world * n).normalize())),
+                    normals: p
+                        .tri_normals
+                        .get(t)
+                        .map(|n| n.map(|n| (i.normal_to_world * n).normalize())),
                 });
             }
         }

@@ -19,8 +19,8 @@ mod wide_bvh;
 
 use crate::math::{OffsetMode, Ray, gamma};
 use glam::{Affine3A, Vec2, Vec3A};
-pub use instance::NO_INSTANCE;
 use instance::Instances;
+pub use instance::NO_INSTANCE;
 use mask::Masks;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;

@@ -185,9 +185,13 @@ fn instances_answer_as_their_copies_do() {
     for k in 0..16 {
         let angle = k as f32 * 0.7;
         let scale = glam::Vec3::new(1.0 + 0.1 * k as f32, 1.0, 1.0 + 0.05 * (k % 3) as f32);
-        let rotation = glam::Quat::from_axis_angle(glam::Vec3::new(1.0, 2.0, 0.5).normalize(), angle);
+        let rotation =
+            glam::Quat::from_axis_angle(glam::Vec3::new(1.0, 2.0, 0.5).normalize(), angle);
         let offset = glam::Vec3::new((k % 4) as f32 * 2.5, (k / 4) as f32 * 2.5, 0.3 * k as f32);
-        placements.push((0, Affine3A::from_scale_rotation_translation(scale, rotation, offset)));
+        placements.push((
+            0,
+            Affine3A::from_scale_rotation_translation(scale, rotation, offset),
+        ));
     }
     let copies: Vec<TriangleInput> = placements
         .iter()
@@ -216,7 +220,11 @@ fn instances_answer_as_their_copies_do() {
     let (mut hits, mut disagreements) = (0, 0);
     let rays = 4000;
     for _ in 0..rays {
-        let origin = Vec3A::new(random() * 16.0 - 4.0, random() * 16.0 - 4.0, 8.0 * random() - 4.0);
+        let origin = Vec3A::new(
+            random() * 16.0 - 4.0,
+            random() * 16.0 - 4.0,
+            8.0 * random() - 4.0,
+        );
         let target = Vec3A::new(random() * 9.0, random() * 9.0, random() * 5.0);
         let ray = Ray::new(origin, (target - origin).normalize());
         let (s, f) = (shared.intersect(&ray), flat.intersect(&ray));
@@ -240,13 +248,21 @@ fn instances_answer_as_their_copies_do() {
         let again = shared.intersect(&back);
         assert!(!again.is_some_and(|h| h.primitive == s.primitive && h.instance == s.instance));
         if s.material == f.material {
-            assert!((s.normal - f.normal).length() < 1e-4, "{:?} {:?}", s.normal, f.normal);
+            assert!(
+                (s.normal - f.normal).length() < 1e-4,
+                "{:?} {:?}",
+                s.normal,
+                f.normal
+            );
             assert!((shared.uv(&s) - flat.uv(&f)).length() < 1e-4);
             // Vertex normals: interpolated before the transform rather than
             // after, which differs slightly under uneven scales.
             let (ns, nf) = (shared.shading_normal(&s), flat.shading_normal(&f));
             assert!((ns - nf).length() < 2e-2, "{ns:?} {nf:?}");
-            let (ds, df) = (shared.uv_derivatives(&s).unwrap(), flat.uv_derivatives(&f).unwrap());
+            let (ds, df) = (
+                shared.uv_derivatives(&s).unwrap(),
+                flat.uv_derivatives(&f).unwrap(),
+            );
             assert!((ds.0 - df.0).length() < 1e-3 * df.0.length());
             assert!((ds.1 - df.1).length() < 1e-3 * df.1.length());
         }

@@ -62,6 +62,10 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         textures: Vec::new(),
         texture_ids: HashMap::new(),
         triangles: Vec::new(),
+        uses: HashMap::new(),
+        prototypes: HashMap::new(),
+        instances: Default::default(),
+        drawn: 0,
         lights: Vec::new(),
         camera: None,
         max_triangles: options.limits.max_triangles,
@@ -71,6 +75,7 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         .default_scene()
         .or_else(|| gltf.document.scenes().next())
         .ok_or_else(|| err("the file has no scene".into()))?;
+    count_uses(scene.nodes(), &mut importer.uses, 0).map_err(err)?;
     for node in scene.nodes() {
         importer.node(&node, Mat4::IDENTITY)?;
     }
@@ -78,7 +83,13 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         Some(c) => c,
         None => {
             importer.warn("no camera: a default one frames the scene".into());
-            super::framing::default_camera(&importer.triangles, &[])
+            let mut triangles = importer.triangles.clone();
+            let instances = &importer.instances;
+            for &(p, to_world) in &instances.placements {
+                let local = &instances.prototypes[p as usize];
+                triangles.extend(super::InstancesInput::copy(local, to_world));
+            }
+            super::framing::default_camera(&triangles, &[])
         }
     };
     options
@@ -106,12 +117,32 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         spheres: Vec::new(),
         point_lights: importer.lights,
         moving: Vec::new(),
-        instances: Default::default(),
+        instances: importer.instances,
         sphere_sampling: LightSampling::SolidAngle,
         triangle_sampling: LightSampling::Area,
         warnings: importer.warnings,
         hints: Default::default(),
     })
+}
+
+/// Counts, per mesh, the nodes under `nodes` that use it. glTF's nodes
+/// form a forest (a node has one parent), but a malformed file may not:
+/// a depth beyond any real file's is an error rather than a stack overflow.
+fn count_uses<'a>(
+    nodes: impl Iterator<Item = gltf::Node<'a>>,
+    uses: &mut HashMap<usize, usize>,
+    depth: usize,
+) -> std::result::Result<(), String> {
+    if depth > 256 {
+        return Err("the node tree is deeper than 256 levels (a cycle?)".into());
+    }
+    for node in nodes {
+        if let Some(mesh) = node.mesh() {
+            *uses.entry(mesh.index()).or_default() += 1;
+        }
+        count_uses(node.children(), uses, depth + 1)?;
+    }
+    Ok(())
 }
 
 /// A buffer or image URI: a file relative to the scene, or base64 data.
@@ -182,6 +213,14 @@ struct Importer<'a> {
     textures: Vec<Texture>,
     texture_ids: HashMap<(usize, bool), u32>,
     triangles: Vec<TriangleInput>,
+    /// How many nodes of the scene use each mesh: those used more than
+    /// once are instanced.
+    uses: HashMap<usize, usize>,
+    /// Per instanced mesh, its prototype.
+    prototypes: HashMap<usize, u32>,
+    instances: super::InstancesInput,
+    /// Triangles in the prototypes.
+    drawn: usize,
     lights: Vec<Light>,
     camera: Option<Camera>,
     max_triangles: usize,
@@ -206,7 +245,7 @@ impl Importer<'_> {
             )));
         }
         if let Some(mesh) = node.mesh() {
-            self.mesh(&mesh, to_world)?;
+            self.place(&mesh, to_world)?;
         }
         if let Some(camera) = node.camera() {
             self.camera(&camera, to_world);
@@ -220,7 +259,51 @@ impl Importer<'_> {
         Ok(())
     }
 
-    fn mesh(&mut self, mesh: &gltf::Mesh, to_world: Mat4) -> Result<()> {
+    /// A mesh where a node puts it: shared by an instance where several
+    /// nodes use it, copied where one does or the placement mirrors (see
+    /// [`super::InstancesInput`]).
+    fn place(&mut self, mesh: &gltf::Mesh, to_world: Mat4) -> Result<()> {
+        let shared = self.uses.get(&mesh.index()).is_some_and(|&n| n > 1);
+        if !shared || to_world.determinant() <= 0.0 {
+            let out = self.mesh(mesh, to_world)?;
+            return self.push(out);
+        }
+        let prototype = match self.prototypes.get(&mesh.index()) {
+            Some(&p) => p,
+            None => {
+                let local = self.mesh(mesh, Mat4::IDENTITY)?;
+                self.drawn += local.len();
+                self.check_count(0)?;
+                self.instances.prototypes.push(local);
+                let p = self.instances.prototypes.len() as u32 - 1;
+                self.prototypes.insert(mesh.index(), p);
+                p
+            }
+        };
+        let affine = glam::Affine3A::from_mat4(to_world);
+        self.instances.placements.push((prototype, affine));
+        Ok(())
+    }
+
+    fn check_count(&self, more: usize) -> Result<()> {
+        if self.triangles.len() + self.drawn + more > self.max_triangles {
+            return Err(self.error(format!(
+                "more than {} triangles (raise the limit with --max-triangles)",
+                self.max_triangles
+            )));
+        }
+        Ok(())
+    }
+
+    fn push(&mut self, out: Vec<TriangleInput>) -> Result<()> {
+        self.check_count(out.len())?;
+        self.triangles.extend(out);
+        Ok(())
+    }
+
+    /// A mesh's triangle primitives placed by `to_world`.
+    fn mesh(&mut self, mesh: &gltf::Mesh, to_world: Mat4) -> Result<Vec<TriangleInput>> {
+        let mut all = Vec::new();
         let name = mesh.name().unwrap_or("").to_string();
         for primitive in mesh.primitives() {
             if primitive.mode() != gltf::mesh::Mode::Triangles {
@@ -265,21 +348,16 @@ impl Importer<'_> {
                 material,
                 &mut out,
             );
-            if self.triangles.len() + out.len() > self.max_triangles {
-                return Err(self.error(format!(
-                    "more than {} triangles (raise the limit with --max-triangles)",
-                    self.max_triangles
-                )));
-            }
+            self.check_count(all.len() + out.len())?;
             if !out.iter().all(|t| t.vertices.iter().all(|&v| in_range(v))) {
                 return Err(self.error(format!(
                     "mesh {} `{name}`: coordinates out of range",
                     mesh.index()
                 )));
             }
-            self.triangles.extend(out);
+            all.extend(out);
         }
-        Ok(())
+        Ok(all)
     }
 
     fn camera(&mut self, camera: &gltf::Camera, to_world: Mat4) {

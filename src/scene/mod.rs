@@ -342,19 +342,32 @@ fn instances(
     let mut placements = Vec::new();
     for (prototype, to_world) in input.placements {
         let Some(local) = prototypes.get(prototype as usize) else {
-            return Err(Error::new(format!("internal: an instance of prototype {prototype}")));
+            return Err(Error::new(format!(
+                "internal: an instance of prototype {prototype}"
+            )));
         };
-        if local.iter().any(|t| materials.get(t.material as usize).is_none()) {
-            return Err(Error::new("internal: a prototype's triangle refers to no material"));
+        if local
+            .iter()
+            .any(|t| materials.get(t.material as usize).is_none())
+        {
+            return Err(Error::new(
+                "internal: a prototype's triangle refers to no material",
+            ));
         }
         let det = to_world.matrix3.determinant();
         if !(to_world.is_finite() && det.is_normal()) {
-            return Err(Error::new("an instance's transform is singular or not finite"));
+            return Err(Error::new(
+                "an instance's transform is singular or not finite",
+            ));
         }
         let (lo, hi) = bounds[prototype as usize];
         let corners = (0..8).map(|c: u32| {
             let pick = |axis: u32, lo: f32, hi: f32| if c >> axis & 1 == 0 { lo } else { hi };
-            Vec3A::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z))
+            Vec3A::new(
+                pick(0, lo.x, hi.x),
+                pick(1, lo.y, hi.y),
+                pick(2, lo.z, hi.z),
+            )
         });
         let reach = |p: Vec3A| in_range(p) && in_range(to_world.transform_point3a(p));
         if !local.is_empty() && !corners.into_iter().all(reach) {
@@ -362,7 +375,9 @@ fn instances(
                 "an instance reaches beyond ±{MAX_COORDINATE:e} (or is not finite): areas and distances would overflow"
             )));
         }
-        let emits = local.iter().any(|t| materials[t.material as usize].is_emissive());
+        let emits = local
+            .iter()
+            .any(|t| materials[t.material as usize].is_emissive());
         if emits || det < 0.0 {
             triangles.extend(InstancesInput::copy(local, to_world));
         } else if !local.is_empty() {
@@ -438,7 +453,12 @@ impl Scene {
         let mut dropped = Dropped::default();
         let mut triangles = dropped.triangles(input.triangles);
         let spheres = dropped.spheres(input.spheres);
-        let (prototypes, placements) = instances(input.instances, &input.materials, &mut triangles, &mut dropped)?;
+        let (prototypes, placements) = instances(
+            input.instances,
+            &input.materials,
+            &mut triangles,
+            &mut dropped,
+        )?;
         let moving: Vec<(Vec<TriangleInput>, Vec<Sphere>, Vec3A)> = input
             .moving
             .into_iter()

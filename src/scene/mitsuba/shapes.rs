@@ -197,7 +197,9 @@ impl<'a> Importer<'a> {
         match shared {
             Some(p) => {
                 if !(affine.is_finite() && affine.matrix3.determinant().is_normal()) {
-                    return Err(e.loc.error("the instance's to_world is singular or not finite"));
+                    return Err(e
+                        .loc
+                        .error("the instance's to_world is singular or not finite"));
                 }
                 let drawn: usize = self.instances.prototypes.iter().map(Vec::len).sum();
                 if self.triangles.len() + drawn > self.limits.max_triangles {
