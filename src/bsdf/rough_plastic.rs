@@ -222,18 +222,35 @@ fn coating_tables(microfacet: Microfacet, eta: f32) -> &'static CoatingTables {
         microfacet.alpha_v.to_bits(),
         eta.to_bits(),
     );
-    let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some(&(_, tables)) = cache.iter().find(|(k, _)| *k == key) {
+    let cached = |cache: &[(Key, &'static CoatingTables)]| {
+        cache.iter().find(|(k, _)| *k == key).map(|&(_, t)| t)
+    };
+    // Not locked while computing: a rayon worker waiting on the loop below
+    // may run another task that asks for tables.
+    if let Some(tables) = cached(&CACHE.lock().unwrap_or_else(|e| e.into_inner())) {
         return tables;
     }
-    let mut external_transmittance = [0.0; TABLE_SIZE];
-    let mut internal = 0.0;
-    for (k, t) in external_transmittance.iter_mut().enumerate() {
-        let cos = k as f32 / (TABLE_SIZE - 1) as f32;
-        *t = coating_transmittance(&microfacet, cos, eta);
-        // Mitsuba's estimate of 2 ∫ R_int(μ) μ dμ: twice the mean over the
-        // same 64 points, kept for agreement with its images.
-        internal += specular_albedo(&microfacet, cos, 1.0 / eta) * cos;
+    // Each cosine's two integrals on its own core: a few materials' tables
+    // were a seventh of loading a textured interior.
+    use rayon::prelude::*;
+    let rows: Vec<(f32, f32)> = (0..TABLE_SIZE)
+        .into_par_iter()
+        .map(|k| {
+            let cos = k as f32 / (TABLE_SIZE - 1) as f32;
+            // Mitsuba's estimate of 2 ∫ R_int(μ) μ dμ: twice the mean over
+            // the same 64 points, kept for agreement with its images.
+            (
+                coating_transmittance(&microfacet, cos, eta),
+                specular_albedo(&microfacet, cos, 1.0 / eta) * cos,
+            )
+        })
+        .collect();
+    let external_transmittance = std::array::from_fn(|k| rows[k].0);
+    let internal: f32 = rows.iter().map(|r| r.1).sum();
+    let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    // Another thread may have made the same tables meanwhile: keep one.
+    if let Some(first) = cached(&cache) {
+        return first;
     }
     let tables: &'static CoatingTables = Box::leak(Box::new(CoatingTables {
         external_transmittance,
