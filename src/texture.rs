@@ -203,6 +203,59 @@ impl Bitmap {
         })
     }
 
+    /// One channel of an image held in memory (0 red, 1 green, 2 blue),
+    /// read raw and mapped by `map`, as a grey bitmap: glTF's packed
+    /// metallic-roughness maps. 8-bit images stay 8-bit, `map` applied
+    /// through the decode table.
+    pub fn decode_channel(
+        bytes: &[u8],
+        channel: usize,
+        map: impl Fn(f32) -> f32,
+    ) -> Result<Bitmap, String> {
+        use image::ColorType;
+        let image = image::load_from_memory(bytes).map_err(|e| e.to_string())?;
+        let (width, height) = (image.width() as usize, image.height() as usize);
+        if width == 0 || height == 0 {
+            return Err("the image is empty".into());
+        }
+        let clean = |c: f32| {
+            let v = map(c);
+            if v.is_finite() { v.max(0.0) } else { 0.0 }
+        };
+        let texels = match image.color() {
+            ColorType::L8 | ColorType::La8 | ColorType::Rgb8 | ColorType::Rgba8 => {
+                let rgb = image.into_rgb8();
+                Texels::Bytes {
+                    bytes: rgb.pixels().flat_map(|p| [p[channel]; 3]).collect(),
+                    decode: Box::new(std::array::from_fn(|i| clean(i as f32 / 255.0))),
+                }
+            }
+            _ => Texels::Floats(
+                image
+                    .into_rgb32f()
+                    .pixels()
+                    .map(|p| [clean(p[channel]); 3])
+                    .collect(),
+            ),
+        };
+        Ok(Bitmap {
+            width,
+            height,
+            texels,
+        })
+    }
+
+    /// The smallest, largest and mean texel value of the first channel.
+    pub fn first_channel_range(&self) -> (f32, f32, f32) {
+        let n = self.width * self.height;
+        let (mut lo, mut hi, mut sum) = (f32::INFINITY, f32::NEG_INFINITY, 0.0f64);
+        for i in 0..n {
+            let v = self.at_index(i).x;
+            (lo, hi, sum) = (lo.min(v), hi.max(v), sum + f64::from(v));
+        }
+        (lo, hi, (sum / n.max(1) as f64) as f32)
+    }
+
     fn from_image(image: image::DynamicImage, raw: bool) -> Result<Bitmap, String> {
         use image::ColorType;
         let (width, height) = (image.width() as usize, image.height() as usize);

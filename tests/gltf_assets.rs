@@ -39,8 +39,11 @@ fn a_textured_normal_mapped_gltf_renders_and_bdpt_agrees() {
         let n = glam::Vec3::new(lean, 0.0, 1.0).normalize();
         [n.x, n.y, n.z].map(|c| ((c + 1.0) * 0.5 * 255.0).round() as u8)
     });
+    // Roughness (green) in bands along v, 0.39 and 1 (times the factor
+    // 0.6); metallic (blue) 0: a plastic with a roughness map.
+    let roughness = png(16, |_, y| [0, if (y / 4) % 2 == 0 { 100 } else { 255 }, 0]);
     let mut views = Vec::new();
-    for image in [&checks, &normals] {
+    for image in [&checks, &normals, &roughness] {
         views.push((buffer.len(), image.len()));
         buffer.extend_from_slice(image);
         while buffer.len() % 4 != 0 {
@@ -63,16 +66,17 @@ fn a_textured_normal_mapped_gltf_renders_and_bdpt_agrees() {
   "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.9, "aspectRatio": 1.0, "znear": 0.1}}}}],
   "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}}, "indices": 3, "material": 0}}]}}],
   "materials": [{{"name": "floor", "doubleSided": true,
-    "pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "metallicFactor": 0, "roughnessFactor": 0.6}},
+    "pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "metallicRoughnessTexture": {{"index": 2}}, "metallicFactor": 1, "roughnessFactor": 0.6}},
     "normalTexture": {{"index": 1, "scale": 1.0}}}}],
-  "textures": [{{"source": 0}}, {{"source": 1}}],
-  "images": [{{"bufferView": 4, "mimeType": "image/png"}}, {{"bufferView": 5, "mimeType": "image/png"}}],
+  "textures": [{{"source": 0}}, {{"source": 1}}, {{"source": 2}}],
+  "images": [{{"bufferView": 4, "mimeType": "image/png"}}, {{"bufferView": 5, "mimeType": "image/png"}}, {{"bufferView": 6, "mimeType": "image/png"}}],
   "buffers": [{{"byteLength": {}, "uri": "floor.bin"}}],
   "bufferViews": [
     {{"buffer": 0, "byteOffset": 0, "byteLength": 48}},
     {{"buffer": 0, "byteOffset": 48, "byteLength": 48}},
     {{"buffer": 0, "byteOffset": 96, "byteLength": 32}},
     {{"buffer": 0, "byteOffset": 128, "byteLength": 12}},
+    {{"buffer": 0, "byteOffset": {}, "byteLength": {}}},
     {{"buffer": 0, "byteOffset": {}, "byteLength": {}}},
     {{"buffer": 0, "byteOffset": {}, "byteLength": {}}}
   ],
@@ -87,7 +91,9 @@ fn a_textured_normal_mapped_gltf_renders_and_bdpt_agrees() {
         views[0].0,
         views[0].1,
         views[1].0,
-        views[1].1
+        views[1].1,
+        views[2].0,
+        views[2].1
     );
     let dir = temp_dir("gltf-asset");
     std::fs::write(dir.join("floor.bin"), &buffer).unwrap();
@@ -101,6 +107,25 @@ fn a_textured_normal_mapped_gltf_renders_and_bdpt_agrees() {
     let floor = &scene.materials[0];
     assert!(floor.textures.diffuse.is_some(), "{floor:?}");
     assert!(floor.normal_map.is_some(), "{floor:?}");
+    // Metallic 1 × blue 0 everywhere: a plastic, its α from the green
+    // channel, with coating tables by roughness.
+    assert!(
+        matches!(floor.bsdf, tracelab::bsdf::Bsdf::RoughPlastic { .. }),
+        "{:?}",
+        floor.bsdf
+    );
+    let alpha = floor.textures.alpha.expect("a roughness map");
+    assert!(floor.textures.coating.is_some());
+    let texels = |uv: glam::Vec2| scene.textures[alpha as usize].eval(uv).x;
+    let (smooth, rough) = (
+        texels(glam::Vec2::new(0.5, 0.1)),
+        texels(glam::Vec2::new(0.5, 0.4)),
+    );
+    assert!(
+        (smooth - (0.6f32 * 100.0 / 255.0).powi(2)).abs() < 1e-4,
+        "{smooth}"
+    );
+    assert!((rough - 0.36).abs() < 1e-4, "{rough}");
     assert!(scene.features.normal_maps);
     scene.set_resolution(64, 64);
     let path = render(
@@ -121,10 +146,21 @@ fn a_textured_normal_mapped_gltf_renders_and_bdpt_agrees() {
     );
     assert_agree("glTF asset, light / path", &light, &path);
     // The normal map shows: without it the floor's shading differs.
+    let scene_for_roughness = scene.clone();
     let mut smooth = scene;
     smooth.materials[0].normal_map = None;
     smooth.features.normal_maps = false;
     let flat = render(smooth, Integrator::from(PathTracer::default()), 256, 63);
     let worst = crate::strategies::largest_block_z(&flat, &path);
     assert!(worst > 4.5, "the normal map changes nothing (z {worst:.2})");
+    // So does the roughness map: without it the floor is rough throughout.
+    let mut even = scene_for_roughness;
+    even.materials[0].textures.alpha = None;
+    even.materials[0].textures.coating = None;
+    let even = render(even, Integrator::from(PathTracer::default()), 256, 65);
+    let worst = crate::strategies::largest_block_z(&even, &path);
+    assert!(
+        worst > 4.5,
+        "the roughness map changes nothing (z {worst:.2})"
+    );
 }

@@ -210,12 +210,16 @@ pub(super) fn material_textures(
     let alpha = id(
         "alpha_texture",
         &d.alpha_texture,
-        matches!(d.kind, K::RoughConductor | K::RoughDielectric),
+        matches!(
+            d.kind,
+            K::RoughConductor | K::RoughDielectric | K::RoughPlastic
+        ),
     )?;
     Ok(MaterialTextures {
         diffuse: albedo.or(diffuse),
         specular,
         alpha,
+        coating: None,
     })
 }
 

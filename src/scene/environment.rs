@@ -67,7 +67,9 @@ impl Environment {
                     let sin_theta = ((y as f32 + 0.5) / h as f32 * PI).sin();
                     let (up, down) = (y.saturating_sub(1), (y + 1).min(h - 1));
                     for (x, m) in row.iter_mut().enumerate() {
-                        let a = across[up * w + x].max(across[y * w + x]).max(across[down * w + x]);
+                        let a = across[up * w + x]
+                            .max(across[y * w + x])
+                            .max(across[down * w + x]);
                         *m = a * sin_theta;
                     }
                 });

@@ -7,7 +7,8 @@
 //! (rough where roughness > 0) of the KHR_materials_ior index, else
 //! metallic ≥ ½ a conductor whose reflectance is the base colour at every
 //! angle, else a plastic (a dielectric coat of IOR 1.5 over the base colour);
-//! GGX with α = roughness². glTF's single-sided materials are one-sided.
+//! GGX with α = roughness² (a roughness map read at each hit; a metallic
+//! map decides by its mean). glTF's single-sided materials are one-sided.
 //! Punctual lights' intensities are taken as radiometric (W/sr, W/m²).
 
 use super::appearance::build_material;
@@ -450,7 +451,7 @@ impl Importer<'_> {
         let base = pbr.base_color_factor();
         let base_rgb = [base[0], base[1], base[2]];
         let roughness = pbr.roughness_factor().clamp(0.0, 1.0);
-        let metallic = pbr.metallic_factor().clamp(0.0, 1.0);
+        let mut metallic = pbr.metallic_factor().clamp(0.0, 1.0);
         let alpha = roughness * roughness;
         let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
         let mut textures = MaterialTextures::default();
@@ -458,9 +459,41 @@ impl Importer<'_> {
             Some(info) => Some(self.texture(&info.texture(), info.tex_coord(), false, &label)?),
             None => None,
         };
-        if pbr.metallic_roughness_texture().is_some() {
+        // Roughness in green, metallic in blue, each times its factor. The
+        // roughness map becomes an α map (α = roughness²); metallic picks
+        // the model for the whole material, so a map that varies is read
+        // as its mean, with a warning.
+        let mut alpha_texture = None;
+        if let Some(info) = pbr.metallic_roughness_texture() {
+            let t = info.texture();
+            if info.tex_coord() != 0 {
+                self.warn(format!(
+                    "{label}: texture coordinate set {} read as set 0",
+                    info.tex_coord()
+                ));
+            }
+            let bytes = self.image_bytes(&t.source())?;
+            let image = t.source().index();
+            let decode = |channel, map: &dyn Fn(f32) -> f32| {
+                Bitmap::decode_channel(&bytes, channel, map)
+                    .map_err(|m| format!("image {image}: {m}"))
+            };
+            let alphas = decode(1, &|g| (roughness * g).powi(2)).map_err(|m| self.error(m))?;
+            if roughness > 0.0 {
+                alpha_texture = Some(self.push_texture(&t, alphas, &label));
+            }
+            let metal = decode(2, &|b| metallic * b).map_err(|m| self.error(m))?;
+            let (lo, hi, mean) = metal.first_channel_range();
+            if hi > lo {
+                self.warn(format!(
+                    "{label}: metallic varies over its texture ({lo:.2} to {hi:.2}): its mean {mean:.2} decides metal or dielectric"
+                ));
+            }
+            metallic = mean;
+        }
+        if m.occlusion_texture().is_some() {
             self.warn(format!(
-                "{label}: metallic-roughness texture ignored (its factors are used)"
+                "{label}: occlusion texture ignored (light transport finds occlusion itself)"
             ));
         }
         let normal_map = match m.normal_texture() {
@@ -525,6 +558,7 @@ impl Importer<'_> {
                 d.specular_transmittance = Some(base_rgb);
                 d.distribution = Some(crate::bsdf::Distribution::Ggx);
                 d.alpha = Some(alpha);
+                textures.alpha = alpha_texture;
             }
         } else if metallic >= 0.5 {
             d.kind = match alpha > 1e-4 {
@@ -539,6 +573,7 @@ impl Importer<'_> {
             if d.kind == MaterialKind::RoughConductor {
                 d.distribution = Some(crate::bsdf::Distribution::Ggx);
                 d.alpha = Some(alpha);
+                textures.alpha = alpha_texture;
             }
         } else {
             d.kind = match alpha > 1e-4 {
@@ -552,6 +587,7 @@ impl Importer<'_> {
             if d.kind == MaterialKind::RoughPlastic {
                 d.distribution = Some(crate::bsdf::Distribution::Ggx);
                 d.alpha = Some(alpha);
+                textures.alpha = alpha_texture;
             }
         }
         let strength = m.emissive_strength().unwrap_or(1.0);
@@ -567,7 +603,7 @@ impl Importer<'_> {
         }
         let mut material =
             build_material(&name, &d).map_err(|e| self.error(format!("{label}: {e}")))?;
-        material.textures = textures;
+        material.set_textures(textures);
         material.opacity = opacity;
         material.normal_map = normal_map;
         let id = self.materials.len() as u32;

@@ -87,8 +87,10 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
     let mut by_name: HashMap<String, u32> = HashMap::new();
     for (name, desc) in &file.materials {
         let mut m = build_material(name, desc.get_ref()).map_err(|m| at(desc.span(), m))?;
-        m.textures = material_textures(name, desc.get_ref(), &texture_ids)
-            .map_err(|m| at(desc.span(), m))?;
+        m.set_textures(
+            material_textures(name, desc.get_ref(), &texture_ids)
+                .map_err(|m| at(desc.span(), m))?,
+        );
         m.opacity =
             material_opacity(name, desc.get_ref(), &texture_ids).map_err(|m| at(desc.span(), m))?;
         m.normal_map =

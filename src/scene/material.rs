@@ -49,8 +49,12 @@ pub struct MaterialTextures {
     pub diffuse: Option<u32>,
     /// `specular_reflectance`: conductors' and coatings' tint.
     pub specular: Option<u32>,
-    /// `alpha`: a rough conductor's or dielectric's roughness (its first channel).
+    /// `alpha`: a rough conductor's, dielectric's or plastic's roughness
+    /// (its first channel).
     pub alpha: Option<u32>,
+    /// A rough plastic's coating tables by roughness, where `alpha` is
+    /// textured (glTF's roughness maps).
+    pub coating: Option<&'static crate::bsdf::rough_plastic::CoatingLevels>,
 }
 
 impl MaterialTextures {
@@ -62,6 +66,24 @@ impl MaterialTextures {
 }
 
 impl Material {
+    /// Sets the textured parameters, with what they need besides the
+    /// texture: a rough plastic with a roughness texture gets its coating
+    /// tables by roughness.
+    pub fn set_textures(&mut self, textures: MaterialTextures) {
+        self.textures = MaterialTextures {
+            coating: match (&self.bsdf, textures.alpha) {
+                (Bsdf::RoughPlastic { lobe, .. }, Some(_)) => {
+                    Some(crate::bsdf::rough_plastic::CoatingLevels::of(
+                        lobe.microfacet.distribution,
+                        lobe.eta,
+                    ))
+                }
+                _ => None,
+            },
+            ..textures
+        };
+    }
+
     /// The BSDF at a hit with texture coordinates `uv`: the textured
     /// parameters read from `textures`, the rest as stored.
     #[inline]
@@ -84,6 +106,10 @@ impl Material {
             Bsdf::RoughPlastic { lobe, .. } => {
                 lobe.diffuse = diffuse.unwrap_or(lobe.diffuse);
                 lobe.specular = specular.unwrap_or(lobe.specular);
+                if let (Some(a), Some(levels)) = (alpha, t.coating) {
+                    lobe.microfacet = Microfacet::new(lobe.microfacet.distribution, a, a);
+                    lobe.tables = levels.nearest(a);
+                }
             }
             Bsdf::Conductor { lobe, .. } => lobe.tint = specular.unwrap_or(lobe.tint),
             Bsdf::RoughConductor { lobe, .. } => {

@@ -76,7 +76,7 @@ impl<'a> Importer<'a> {
             Some(e) => e.loc.error(m),
             None => crate::error::Error::new(m),
         })?;
-        m.textures = textures;
+        m.set_textures(textures);
         Ok(m)
     }
 
