@@ -62,7 +62,8 @@ impl Environment {
                         *m = l[(x + w - 1) % w].max(l[x]).max(l[(x + 1) % w]);
                     }
                 });
-                let mut weights = vec![0.0f32; w * h];
+                // The luminances are spent: their buffer takes the weights.
+                let mut weights = lum;
                 weights.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
                     let sin_theta = ((y as f32 + 0.5) / h as f32 * PI).sin();
                     let (up, down) = (y.saturating_sub(1), (y + 1).min(h - 1));
