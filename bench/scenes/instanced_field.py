@@ -30,9 +30,10 @@ def sphere_ply(path, nu, nv):
         for i in range(nu):
             a, b = j * nu + i, j * nu + (i + 1) % nu
             c, d = (j + 1) * nu + (i + 1) % nu, (j + 1) * nu + i
-            if j > 0:
-                faces.append((a, d, c))
+            # Rows 0 and nv are the poles: one triangle of each quad there.
             if j < nv - 1:
+                faces.append((a, d, c))
+            if j > 0:
                 faces.append((a, c, b))
     with open(path, "wb") as f:
         f.write(
