@@ -40,7 +40,12 @@ fn a_textured_normal_mapped_gltf_renders_and_bdpt_agrees() {
         [n.x, n.y, n.z].map(|c| ((c + 1.0) * 0.5 * 255.0).round() as u8)
     });
     // Roughness (green) in bands along v, 0.39 and 1 (times the factor
-    // 0.6); metallic (blue) 0: a plastic with a roughness map.
+    // 0.6); metallic (blue) 0: a plastic with a roughness map. Not much
+    // smoother: at α 0.008 light tracing meets the point light's highlight
+    // so rarely that its block's estimated error is far too small (two
+    // seeds of 4096 spp on a plain floor differ there by twice what they
+    // differ from path tracing, and every other block agrees to 1e-3:
+    // docs/validation.md), and the z-test fails without a bias.
     let roughness = png(16, |_, y| [0, if (y / 4) % 2 == 0 { 100 } else { 255 }, 0]);
     let mut views = Vec::new();
     for image in [&checks, &normals, &roughness] {
