@@ -33,6 +33,8 @@ pub(super) struct Instance {
 #[derive(Clone, Debug, Default)]
 pub(super) struct Instances {
     prototypes: Vec<Arc<Geometry>>,
+    /// Each prototype's bounds in its own space, computed once.
+    prototype_bounds: Vec<Aabb>,
     list: Vec<Instance>,
     /// Over `list`'s world bounds, in its order, where there are many.
     bvh: Option<CwBvh>,
@@ -64,13 +66,12 @@ impl Instances {
                 normal_to_world: to_world.matrix3.inverse().transpose(),
             })
             .collect();
+        let prototype_bounds: Vec<Aabb> = prototypes.iter().map(|p| p.bounds()).collect();
         let mut bvh = None;
         if list.len() > INSTANCE_LIST_MAX {
             let bounds: Vec<Aabb> = list
                 .iter()
-                .map(|i| {
-                    transformed_bounds(&prototypes[i.prototype as usize].bounds(), &i.to_world)
-                })
+                .map(|i| transformed_bounds(&prototype_bounds[i.prototype as usize], &i.to_world))
                 .collect();
             // Too deep to traverse (many coincident instances): tested one by one.
             if let Some(tree) = build_shallow_cwbvh(&bounds) {
@@ -84,6 +85,7 @@ impl Instances {
         }
         Instances {
             prototypes,
+            prototype_bounds,
             list,
             bvh,
         }
@@ -121,7 +123,7 @@ impl Instances {
     pub(super) fn bounds(&self) -> Aabb {
         self.list.iter().fold(Aabb::empty(), |b, i| {
             b.union(&transformed_bounds(
-                &self.prototypes[i.prototype as usize].bounds(),
+                &self.prototype_bounds[i.prototype as usize],
                 &i.to_world,
             ))
         })

@@ -339,6 +339,18 @@ fn instances(
             )
         })
         .collect();
+    // Per prototype, once: whether it emits (then it is copied).
+    let mut emits = Vec::with_capacity(prototypes.len());
+    for p in &prototypes {
+        let mut any = false;
+        for t in p {
+            let material = materials.get(t.material as usize).ok_or_else(|| {
+                Error::new("internal: a prototype's triangle refers to no material")
+            })?;
+            any |= material.is_emissive();
+        }
+        emits.push(any);
+    }
     let mut placements = Vec::new();
     for (prototype, to_world) in input.placements {
         let Some(local) = prototypes.get(prototype as usize) else {
@@ -346,14 +358,6 @@ fn instances(
                 "internal: an instance of prototype {prototype}"
             )));
         };
-        if local
-            .iter()
-            .any(|t| materials.get(t.material as usize).is_none())
-        {
-            return Err(Error::new(
-                "internal: a prototype's triangle refers to no material",
-            ));
-        }
         let det = to_world.matrix3.determinant();
         if !(to_world.is_finite() && det.is_normal()) {
             return Err(Error::new(
@@ -375,10 +379,7 @@ fn instances(
                 "an instance reaches beyond ±{MAX_COORDINATE:e} (or is not finite): areas and distances would overflow"
             )));
         }
-        let emits = local
-            .iter()
-            .any(|t| materials[t.material as usize].is_emissive());
-        if emits || det < 0.0 {
+        if emits[prototype as usize] || det < 0.0 {
             triangles.extend(InstancesInput::copy(local, to_world));
         } else if !local.is_empty() {
             placements.push((prototype, to_world));
