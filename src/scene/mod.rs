@@ -5,8 +5,10 @@ mod appearance;
 pub mod description;
 pub mod emitters;
 pub mod environment;
+mod features;
 pub mod framing;
 pub mod gltf;
+mod instances;
 pub mod light;
 pub mod lights;
 pub mod load;
@@ -17,6 +19,9 @@ pub mod obj;
 pub mod ply;
 pub mod serialized;
 mod shading;
+pub use features::Features;
+pub use instances::InstancesInput;
+mod uri;
 
 use crate::accel::mask::Masks;
 use crate::accel::{AccelChoice, Geometry, NO_LIGHT, Sphere, SurfaceHit, TriangleInput};
@@ -26,9 +31,9 @@ use crate::math::OffsetMode;
 use crate::shortcuts::{NotApplied, PrimaryCandidates, Shortcuts, ShortcutsUsed};
 use crate::texture::Texture;
 use emitters::EmitterShape;
-use glam::{Affine3A, Vec3A};
+use glam::Vec3A;
 use light::{Light, LightSampling, Lights, PlanarEmitter};
-use material::{Bsdf, Material, Opacity};
+use material::{Material, Opacity};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -141,132 +146,6 @@ pub struct MovingInput {
     pub velocity: Vec3A,
 }
 
-/// Shared geometry placed several times (Mitsuba's `shapegroup` and
-/// `instance`): each prototype's triangles are stored and searched once.
-#[derive(Clone, Debug, Default)]
-pub struct InstancesInput {
-    /// Each prototype's triangles, in its own space.
-    pub prototypes: Vec<Vec<TriangleInput>>,
-    /// (prototype, to world) per instance. A transform must be invertible
-    /// and keep orientation (loaders copy a mirrored instance instead).
-    pub placements: Vec<(u32, Affine3A)>,
-}
-
-impl InstancesInput {
-    /// The prototype's triangles placed by `to_world`, as copies.
-    pub fn copy(prototype: &[TriangleInput], to_world: Affine3A) -> Vec<TriangleInput> {
-        let normals = to_world.matrix3.inverse().transpose();
-        prototype
-            .iter()
-            .map(|t| TriangleInput {
-                vertices: t.vertices.map(|v| to_world.transform_point3a(v)),
-                normals: t.normals.map(|n| n.map(|n| (normals * n).normalize())),
-                ..*t
-            })
-            .collect()
-    }
-}
-
-/// What a scene uses, detected at load, so that estimators can run a hot
-/// loop specialised for it (no specular branches without mirrors or glass,
-/// Lambertian-only BSDF code when every material is diffuse).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Features {
-    pub mirror: bool,
-    pub dielectric: bool,
-    pub glossy: bool,
-    /// Some surface uses a model added for real scenes (microfacet,
-    /// plastic, conductor, thin glass, Oren–Nayar).
-    pub rich_materials: bool,
-    pub point_lights: bool,
-    pub spheres: bool,
-    pub area_lights: usize,
-    /// Something moves while the shutter is open: camera rays need a time.
-    pub motion: bool,
-    /// Some triangle has vertex normals, or some material a normal map.
-    pub shading_normals: bool,
-    /// Some material has a normal map.
-    pub normal_maps: bool,
-}
-
-impl Features {
-    fn detect(
-        materials: &[Material],
-        geometry: &Geometry,
-        lights: &Lights,
-        camera: &Camera,
-    ) -> Features {
-        let used = |f: &dyn Fn(&Bsdf) -> bool| materials.iter().any(|m| f(&m.bsdf));
-        Features {
-            mirror: used(&|b| matches!(b, Bsdf::Mirror { .. })),
-            dielectric: used(&|b| matches!(b, Bsdf::Dielectric { .. })),
-            glossy: used(&|b| matches!(b, Bsdf::Glossy { .. })),
-            rich_materials: used(&|b| {
-                !matches!(
-                    b,
-                    Bsdf::Diffuse { .. }
-                        | Bsdf::Glossy { .. }
-                        | Bsdf::Mirror { .. }
-                        | Bsdf::Dielectric { .. }
-                )
-            }),
-            point_lights: lights.as_slice().iter().any(|l| {
-                matches!(
-                    l,
-                    Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }
-                )
-            }),
-            spheres: geometry.has_spheres(),
-            area_lights: lights
-                .as_slice()
-                .iter()
-                .filter(|l| {
-                    !matches!(
-                        l,
-                        Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }
-                    )
-                })
-                .count(),
-            motion: geometry.has_motion() && camera.has_shutter_interval(),
-            shading_normals: geometry.has_shading_normals()
-                || materials.iter().any(|m| m.normal_map.is_some()),
-            normal_maps: materials.iter().any(|m| m.normal_map.is_some()),
-        }
-    }
-
-    /// True when some surface is a mirror or glass.
-    pub fn specular(&self) -> bool {
-        self.mirror || self.dielectric
-    }
-
-    /// True when every material is Lambertian.
-    pub fn diffuse_only(&self) -> bool {
-        !self.specular() && !self.glossy && !self.rich_materials
-    }
-
-    /// What the specialised code paths leave out, for render summaries.
-    pub fn skipped(&self) -> Vec<&'static str> {
-        let mut v = Vec::new();
-        if !self.dielectric {
-            v.push("refraction");
-            v.push("transparent-shadow tests");
-        }
-        if self.diffuse_only() {
-            v.push("specular-bounce branches and non-Lambertian BSDF code");
-        }
-        if !self.point_lights {
-            v.push("point lights");
-        }
-        if !self.spheres {
-            v.push("sphere intersection");
-        }
-        if !self.motion {
-            v.push("time dimension (static scene)");
-        }
-        v
-    }
-}
-
 /// The sphere around the geometry's bounding box (unit at the origin
 /// for an empty scene): where light from infinity enters.
 fn bounding_sphere(geometry: &Geometry) -> (Vec3A, f32) {
@@ -311,81 +190,6 @@ impl Dropped {
         self.spheres += total - kept.len();
         kept
     }
-}
-
-/// Checks the instances and keeps what can be shared: prototypes without
-/// degenerate triangles, placed by transforms in range. A prototype with
-/// an emitter is copied into `triangles` at each placement (a light is
-/// sampled where it is), as is each mirrored placement (see
-/// [`InstancesInput`]). Returns the prototypes and the shared placements.
-#[allow(clippy::type_complexity)]
-fn instances(
-    input: InstancesInput,
-    materials: &[Material],
-    triangles: &mut Vec<TriangleInput>,
-    dropped: &mut Dropped,
-) -> Result<(Vec<Vec<TriangleInput>>, Vec<(u32, Affine3A)>)> {
-    let prototypes: Vec<Vec<TriangleInput>> = input
-        .prototypes
-        .into_iter()
-        .map(|p| dropped.triangles(p))
-        .collect();
-    let bounds: Vec<(Vec3A, Vec3A)> = prototypes
-        .iter()
-        .map(|p| {
-            p.iter().flat_map(|t| t.vertices).fold(
-                (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
-                |(lo, hi), v| (lo.min(v), hi.max(v)),
-            )
-        })
-        .collect();
-    // Per prototype, once: whether it emits (then it is copied).
-    let mut emits = Vec::with_capacity(prototypes.len());
-    for p in &prototypes {
-        let mut any = false;
-        for t in p {
-            let material = materials.get(t.material as usize).ok_or_else(|| {
-                Error::new("internal: a prototype's triangle refers to no material")
-            })?;
-            any |= material.is_emissive();
-        }
-        emits.push(any);
-    }
-    let mut placements = Vec::new();
-    for (prototype, to_world) in input.placements {
-        let Some(local) = prototypes.get(prototype as usize) else {
-            return Err(Error::new(format!(
-                "internal: an instance of prototype {prototype}"
-            )));
-        };
-        let det = to_world.matrix3.determinant();
-        if !(to_world.is_finite() && det.is_normal()) {
-            return Err(Error::new(
-                "an instance's transform is singular or not finite",
-            ));
-        }
-        let (lo, hi) = bounds[prototype as usize];
-        let corners = (0..8).map(|c: u32| {
-            let pick = |axis: u32, lo: f32, hi: f32| if c >> axis & 1 == 0 { lo } else { hi };
-            Vec3A::new(
-                pick(0, lo.x, hi.x),
-                pick(1, lo.y, hi.y),
-                pick(2, lo.z, hi.z),
-            )
-        });
-        let reach = |p: Vec3A| in_range(p) && in_range(to_world.transform_point3a(p));
-        if !local.is_empty() && !corners.into_iter().all(reach) {
-            return Err(Error::new(format!(
-                "an instance reaches beyond ±{MAX_COORDINATE:e} (or is not finite): areas and distances would overflow"
-            )));
-        }
-        if emits[prototype as usize] || det < 0.0 {
-            triangles.extend(InstancesInput::copy(local, to_world));
-        } else if !local.is_empty() {
-            placements.push((prototype, to_world));
-        }
-    }
-    Ok((prototypes, placements))
 }
 
 /// A scene ready to render.
@@ -454,7 +258,7 @@ impl Scene {
         let mut dropped = Dropped::default();
         let mut triangles = dropped.triangles(input.triangles);
         let spheres = dropped.spheres(input.spheres);
-        let (prototypes, placements) = instances(
+        let (prototypes, placements) = instances::checked(
             input.instances,
             &input.materials,
             &mut triangles,
@@ -642,7 +446,12 @@ impl Scene {
     /// meshing), and per triangle of the new scene the one it comes from.
     pub fn with_pieces(&self, pieces: &[Vec<[Vec3A; 3]>]) -> (Scene, Vec<u32>) {
         let (geometry, from) = self.geometry.with_pieces(pieces);
-        let scene = Scene {
+        (self.with_geometry(geometry), from)
+    }
+
+    /// This scene over other geometry (of the same materials and lights).
+    fn with_geometry(&self, geometry: Geometry) -> Scene {
+        Scene {
             camera: self.camera.clone(),
             features: Features::detect(&self.materials, &geometry, &self.lights, &self.camera),
             shortcuts: Shortcuts::new(&geometry, &flat_light_corners(&self.lights)),
@@ -652,8 +461,7 @@ impl Scene {
             lights: self.lights.clone(),
             warnings: self.warnings.clone(),
             hints: self.hints.clone(),
-        };
-        (scene, from)
+        }
     }
 
     /// The scene with every instance's triangles copied into the
@@ -662,18 +470,7 @@ impl Scene {
         if self.geometry.instance_count() == 0 {
             return None;
         }
-        let geometry = self.geometry.flattened();
-        Some(Scene {
-            camera: self.camera.clone(),
-            features: Features::detect(&self.materials, &geometry, &self.lights, &self.camera),
-            shortcuts: Shortcuts::new(&geometry, &flat_light_corners(&self.lights)),
-            geometry: Arc::new(geometry),
-            materials: self.materials.clone(),
-            textures: self.textures.clone(),
-            lights: self.lights.clone(),
-            warnings: self.warnings.clone(),
-            hints: self.hints.clone(),
-        })
+        Some(self.with_geometry(self.geometry.flattened()))
     }
 
     /// What radiosity makes of material `m` (see

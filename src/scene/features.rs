@@ -1,0 +1,107 @@
+//! What a scene uses, detected when it is built, so that estimators can
+//! skip what it does not.
+
+use super::light::{Light, Lights};
+use super::material::{Bsdf, Material};
+use crate::accel::Geometry;
+use crate::camera::Camera;
+
+/// What a scene uses, detected at load, so that estimators can run a hot
+/// loop specialised for it (no specular branches without mirrors or glass,
+/// Lambertian-only BSDF code when every material is diffuse).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Features {
+    pub mirror: bool,
+    pub dielectric: bool,
+    pub glossy: bool,
+    /// Some surface uses a model added for real scenes (microfacet,
+    /// plastic, conductor, thin glass, Oren–Nayar).
+    pub rich_materials: bool,
+    pub point_lights: bool,
+    pub spheres: bool,
+    pub area_lights: usize,
+    /// Something moves while the shutter is open: camera rays need a time.
+    pub motion: bool,
+    /// Some triangle has vertex normals, or some material a normal map.
+    pub shading_normals: bool,
+    /// Some material has a normal map.
+    pub normal_maps: bool,
+}
+
+impl Features {
+    pub(super) fn detect(
+        materials: &[Material],
+        geometry: &Geometry,
+        lights: &Lights,
+        camera: &Camera,
+    ) -> Features {
+        let used = |f: &dyn Fn(&Bsdf) -> bool| materials.iter().any(|m| f(&m.bsdf));
+        Features {
+            mirror: used(&|b| matches!(b, Bsdf::Mirror { .. })),
+            dielectric: used(&|b| matches!(b, Bsdf::Dielectric { .. })),
+            glossy: used(&|b| matches!(b, Bsdf::Glossy { .. })),
+            rich_materials: used(&|b| {
+                !matches!(
+                    b,
+                    Bsdf::Diffuse { .. }
+                        | Bsdf::Glossy { .. }
+                        | Bsdf::Mirror { .. }
+                        | Bsdf::Dielectric { .. }
+                )
+            }),
+            point_lights: lights.as_slice().iter().any(|l| {
+                matches!(
+                    l,
+                    Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }
+                )
+            }),
+            spheres: geometry.has_spheres(),
+            area_lights: lights
+                .as_slice()
+                .iter()
+                .filter(|l| {
+                    !matches!(
+                        l,
+                        Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }
+                    )
+                })
+                .count(),
+            motion: geometry.has_motion() && camera.has_shutter_interval(),
+            shading_normals: geometry.has_shading_normals()
+                || materials.iter().any(|m| m.normal_map.is_some()),
+            normal_maps: materials.iter().any(|m| m.normal_map.is_some()),
+        }
+    }
+
+    /// True when some surface is a mirror or glass.
+    pub fn specular(&self) -> bool {
+        self.mirror || self.dielectric
+    }
+
+    /// True when every material is Lambertian.
+    pub fn diffuse_only(&self) -> bool {
+        !self.specular() && !self.glossy && !self.rich_materials
+    }
+
+    /// What the specialised code paths leave out, for render summaries.
+    pub fn skipped(&self) -> Vec<&'static str> {
+        let mut v = Vec::new();
+        if !self.dielectric {
+            v.push("refraction");
+            v.push("transparent-shadow tests");
+        }
+        if self.diffuse_only() {
+            v.push("specular-bounce branches and non-Lambertian BSDF code");
+        }
+        if !self.point_lights {
+            v.push("point lights");
+        }
+        if !self.spheres {
+            v.push("sphere intersection");
+        }
+        if !self.motion {
+            v.push("time dimension (static scene)");
+        }
+        v
+    }
+}
