@@ -606,3 +606,34 @@ fn instances_render_as_their_copies() {
         }
     }
 }
+
+/// A shapegroup holding an instance of another: the inner one is copied
+/// into the outer prototype, which is then shared, each placement
+/// composing both transforms.
+#[test]
+fn nested_instances_compose_their_transforms() {
+    let xml = r##"<scene version="3.0.0">
+  <shape type="shapegroup" id="tile">
+    <shape type="rectangle"><transform name="to_world"><scale value="0.5"/></transform></shape>
+  </shape>
+  <shape type="shapegroup" id="pair">
+    <shape type="rectangle"><transform name="to_world"><scale value="0.5"/></transform></shape>
+    <shape type="instance"><ref id="tile"/><transform name="to_world"><translate x="2"/></transform></shape>
+  </shape>
+  <shape type="instance"><ref id="pair"/><transform name="to_world"><translate z="-3"/></transform></shape>
+  <shape type="instance"><ref id="pair"/><transform name="to_world"><translate y="5" z="-4"/></transform></shape>
+  <emitter type="constant"/>
+</scene>"##;
+    let scene = load("nested", xml, &[], false).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.geometry.instance_count(), 2);
+    assert_eq!(scene.geometry.triangles_drawn(), 8);
+    // The inner tile of each placement: x = 2, at the placement's y and z.
+    for (y, z) in [(0.0, -3.0), (5.0, -4.0)] {
+        let ray = tracelab::math::Ray::new(Vec3A::new(2.0, y, 0.0), -Vec3A::Z);
+        let hit = scene
+            .geometry
+            .intersect(&ray)
+            .expect("the nested tile is hit");
+        assert!((hit.t + z).abs() < 1e-5, "{} at y {y}", hit.t);
+    }
+}

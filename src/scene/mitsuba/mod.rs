@@ -45,6 +45,7 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         spheres: Vec::new(),
         instances: Default::default(),
         groups: HashMap::new(),
+        reading_group: false,
         lights: Vec::new(),
         environment: None,
         hints: RenderHints::default(),
@@ -100,6 +101,8 @@ pub(super) struct Importer<'a> {
     /// Per shapegroup, its prototype, or None where it must be copied
     /// (it holds a sphere).
     groups: HashMap<*const Element, Option<u32>>,
+    /// A shapegroup is being read into a prototype.
+    reading_group: bool,
     lights: Vec<Light>,
     environment: Option<Environment>,
     hints: RenderHints,

@@ -168,21 +168,36 @@ impl<'a> Importer<'a> {
     /// copied where it holds a sphere (spheres are not instanced) or the
     /// transform mirrors (see `InstancesInput`). The group is read once,
     /// on its first instance; a copy reads it again, its warnings not
-    /// repeated. Emitters in the group are copied when the scene is built.
+    /// repeated. Emitters in the group are copied when the scene is built;
+    /// an instance within a group is copied into the group's triangles.
     fn instance(&mut self, e: &'a Element, group: &'a Element, to_world: Mat4) -> Result<()> {
         let key = group as *const Element;
         let prototype = match self.groups.get(&key) {
+            // An instance inside a group being read is copied into it.
+            _ if self.reading_group => None,
             Some(&p) => p,
             None => {
                 let triangles = std::mem::take(&mut self.triangles);
                 let spheres = self.spheres.len();
-                for child in group.children.iter().filter(|c| c.tag == "shape") {
-                    self.shape(child, Mat4::IDENTITY)?;
-                }
+                self.reading_group = true;
+                let read: Result<()> = group
+                    .children
+                    .iter()
+                    .filter(|c| c.tag == "shape")
+                    .try_for_each(|child| self.shape(child, Mat4::IDENTITY));
+                self.reading_group = false;
+                read?;
                 let local = std::mem::replace(&mut self.triangles, triangles);
                 let p = if self.spheres.len() == spheres {
                     let shared = &mut self.instances.prototypes;
                     shared.push(local);
+                    let stored: usize = shared.iter().map(Vec::len).sum();
+                    if self.triangles.len() + stored > self.limits.max_triangles {
+                        return Err(e.loc.error(format!(
+                            "more than {} triangles (raise the limit with --max-triangles)",
+                            self.limits.max_triangles
+                        )));
+                    }
                     Some(shared.len() as u32 - 1)
                 } else {
                     self.spheres.truncate(spheres);
@@ -201,21 +216,17 @@ impl<'a> Importer<'a> {
                         .loc
                         .error("the instance's to_world is singular or not finite"));
                 }
-                let drawn: usize = self.instances.prototypes.iter().map(Vec::len).sum();
-                if self.triangles.len() + drawn > self.limits.max_triangles {
-                    return Err(e.loc.error(format!(
-                        "more than {} triangles (raise the limit with --max-triangles)",
-                        self.limits.max_triangles
-                    )));
-                }
                 self.instances.placements.push((p, affine));
             }
             None => {
-                let warnings = self.warnings.len();
+                // Warnings were given when the group was first read.
+                let (warnings, read) = (self.warnings.len(), self.groups.contains_key(&key));
                 for child in group.children.iter().filter(|c| c.tag == "shape") {
                     self.shape(child, to_world)?;
                 }
-                self.warnings.truncate(warnings);
+                if read {
+                    self.warnings.truncate(warnings);
+                }
             }
         }
         Ok(())
