@@ -471,6 +471,18 @@ fn gltf_nodes_meshes_camera_materials_and_lights_land_where_the_file_puts_them()
             floor.bsdf
         );
     }
+    // Nodes reached twice (a cycle; a node under two parents) are an error
+    // before anything is placed, not a hang.
+    for children in ["[4, 3]", "[4, 4]"] {
+        let json = gltf_json(Some("quad.bin"))
+            .replace(r#""children": [4]"#, &format!(r#""children": {children}"#));
+        std::fs::write(dir.join("bad.gltf"), json).unwrap();
+        let e = Scene::load(&dir.join("bad.gltf"))
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(e.contains("bad.gltf") && e.contains("not a tree"), "{e}");
+    }
     // A missing buffer file is an error naming the file.
     std::fs::remove_file(dir.join("quad.bin")).unwrap();
     let e = Scene::load(&dir.join("scene.gltf"))

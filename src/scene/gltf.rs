@@ -77,7 +77,8 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         .default_scene()
         .or_else(|| gltf.document.scenes().next())
         .ok_or_else(|| err("the file has no scene".into()))?;
-    count_uses(scene.nodes(), &mut importer.uses, 0).map_err(err)?;
+    let mut left = gltf.document.nodes().len();
+    count_uses(scene.nodes(), &mut importer.uses, &mut left, 0).map_err(err)?;
     for node in scene.nodes() {
         importer.node(&node, Mat4::IDENTITY)?;
     }
@@ -128,21 +129,32 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
 }
 
 /// Counts, per mesh, the nodes under `nodes` that use it. glTF's nodes
-/// form a forest (a node has one parent), but a malformed file may not:
-/// a depth beyond any real file's is an error rather than a stack overflow.
+/// form a forest (each node has at most one parent); a malformed file
+/// whose nodes are reached more than once (a cycle, or a node listed under
+/// two parents, which may multiply the walk exponentially) is an error
+/// before the walk that places meshes, rather than a hang or a stack
+/// overflow. `left` counts the visits a forest allows: one per node; a
+/// tree deeper than 256 levels is refused too (no real file comes near).
 fn count_uses<'a>(
     nodes: impl Iterator<Item = gltf::Node<'a>>,
     uses: &mut HashMap<usize, usize>,
+    left: &mut usize,
     depth: usize,
 ) -> std::result::Result<(), String> {
     if depth > 256 {
-        return Err("the node tree is deeper than 256 levels (a cycle?)".into());
+        return Err("the node hierarchy is deeper than 256 levels".into());
     }
     for node in nodes {
+        *left = left.checked_sub(1).ok_or_else(|| {
+            format!(
+                "node {} is reached twice: the node hierarchy is not a tree",
+                node.index()
+            )
+        })?;
         if let Some(mesh) = node.mesh() {
             *uses.entry(mesh.index()).or_default() += 1;
         }
-        count_uses(node.children(), uses, depth + 1)?;
+        count_uses(node.children(), uses, left, depth + 1)?;
     }
     Ok(())
 }
