@@ -155,61 +155,85 @@ impl RoughPlastic {
     }
 }
 
-/// The mean of `term(wo, m)` over the normals visible from the direction
-/// at incident cosine `cos` (in the xz-plane), by a 64 × 64 midpoint rule
-/// in the sampler's unit square, where the integrand is smooth at any
-/// roughness.
-fn visible_normal_mean(
+/// The means of the `K` values of `term(wo, m)` over the normals visible
+/// from the direction at incident cosine `cos` (in the xz-plane), by a
+/// 64 × 64 midpoint rule in the sampler's unit square, where the
+/// integrand is smooth at any roughness. Integrals that share a direction
+/// share its samples, which are most of the cost (Beckmann's especially).
+fn visible_normal_means<const K: usize>(
     microfacet: &Microfacet,
     cos: f32,
-    term: impl Fn(Vec3A, Vec3A) -> f32,
-) -> f32 {
+    term: impl Fn(Vec3A, Vec3A) -> [f32; K],
+) -> [f32; K] {
     const N: usize = 64;
     let wo = Vec3A::new((1.0 - cos * cos).max(0.0).sqrt(), 0.0, cos);
-    let mut sum = 0.0f64;
+    let mut sums = [0.0f64; K];
     for i in 0..N {
         for j in 0..N {
             let u = Vec2::new((i as f32 + 0.5) / N as f32, (j as f32 + 0.5) / N as f32);
-            sum += f64::from(term(wo, microfacet.sample_visible(wo, u)));
+            let values = term(wo, microfacet.sample_visible(wo, u));
+            for (sum, v) in sums.iter_mut().zip(values) {
+                *sum += f64::from(v);
+            }
         }
     }
-    (sum / (N * N) as f64) as f32
+    sums.map(|sum| (sum / (N * N) as f64) as f32)
 }
 
-/// Directional albedo of the coating's specular reflection (Fresnel at
-/// relative IOR `eta`) at incident cosine `cos`: E[F(wo·m) G1(wi)] over
-/// visible normals.
-fn specular_albedo(microfacet: &Microfacet, cos: f32, eta: f32) -> f32 {
-    visible_normal_mean(microfacet, cos.max(1e-4), |wo, m| {
-        let dot = wo.dot(m);
-        let wi = 2.0 * dot * m - wo;
-        if wi.z > 0.0 && dot > 0.0 {
-            fresnel_dielectric(dot, eta).reflectance * microfacet.g1(wi, m)
-        } else {
-            0.0
-        }
-    })
+/// The integrand of the coating's specular albedo (Fresnel at relative
+/// IOR `eta`): E[F(wo·m) G1(wi)] over visible normals is the directional
+/// albedo of its reflection.
+fn reflected(microfacet: &Microfacet, wo: Vec3A, m: Vec3A, eta: f32) -> f32 {
+    let dot = wo.dot(m);
+    let wi = 2.0 * dot * m - wo;
+    if wi.z > 0.0 && dot > 0.0 {
+        fresnel_dielectric(dot, eta).reflectance * microfacet.g1(wi, m)
+    } else {
+        0.0
+    }
 }
 
-/// Directional transmittance of the coating at incident cosine `cos` into
-/// a medium of relative IOR `eta`: E[(1 − F(wo·m)) G1(wt, m)] over visible
-/// normals, wt the direction refracted through m (Mitsuba 3's
-/// `eval_transmittance`; the refracted ray's shadowing makes it fall
-/// faster towards grazing than 1 − the reflectance).
-fn coating_transmittance(microfacet: &Microfacet, cos: f32, eta: f32) -> f32 {
-    visible_normal_mean(microfacet, cos.max(1e-6), |wo, m| {
-        let dot = wo.dot(m);
-        let sin2_t = (1.0 - dot * dot).max(0.0) / (eta * eta);
-        if dot <= 0.0 || sin2_t >= 1.0 {
-            return 0.0;
-        }
-        let wt = -wo / eta + m * (dot / eta - (1.0 - sin2_t).sqrt());
-        if wt.z < 0.0 {
-            (1.0 - fresnel_dielectric(dot, eta).reflectance) * microfacet.g1(wt, m)
-        } else {
-            0.0
-        }
-    })
+/// The integrand of the coating's directional transmittance into a medium
+/// of relative IOR `eta`: E[(1 − F(wo·m)) G1(wt, m)] over visible normals,
+/// wt the direction refracted through m (Mitsuba 3's `eval_transmittance`;
+/// the refracted ray's shadowing makes it fall faster towards grazing than
+/// 1 − the reflectance).
+fn transmitted(microfacet: &Microfacet, wo: Vec3A, m: Vec3A, eta: f32) -> f32 {
+    let dot = wo.dot(m);
+    let sin2_t = (1.0 - dot * dot).max(0.0) / (eta * eta);
+    if dot <= 0.0 || sin2_t >= 1.0 {
+        return 0.0;
+    }
+    let wt = -wo / eta + m * (dot / eta - (1.0 - sin2_t).sqrt());
+    if wt.z < 0.0 {
+        (1.0 - fresnel_dielectric(dot, eta).reflectance) * microfacet.g1(wt, m)
+    } else {
+        0.0
+    }
+}
+
+/// At incident cosine `cos`: the coating's transmittance from outside
+/// (IOR ratio `eta`), and the albedo of its reflection seen from inside
+/// (1 / `eta`). Each integral's cosine is kept off 0 (1e-6 and 1e-4, as
+/// Mitsuba): where that makes them differ, two passes.
+fn coating_row(microfacet: &Microfacet, cos: f32, eta: f32) -> (f32, f32) {
+    let (outside, inside) = (cos.max(1e-6), cos.max(1e-4));
+    if outside != inside {
+        let [t] = visible_normal_means(microfacet, outside, |wo, m| {
+            [transmitted(microfacet, wo, m, eta)]
+        });
+        let [r] = visible_normal_means(microfacet, inside, |wo, m| {
+            [reflected(microfacet, wo, m, 1.0 / eta)]
+        });
+        return (t, r);
+    }
+    let [t, r] = visible_normal_means(microfacet, cos, |wo, m| {
+        [
+            transmitted(microfacet, wo, m, eta),
+            reflected(microfacet, wo, m, 1.0 / eta),
+        ]
+    });
+    (t, r)
 }
 
 /// Roughness levels of [`CoatingLevels`]: √α = k / (LEVELS − 1). Each
@@ -294,10 +318,8 @@ fn coating_tables(microfacet: Microfacet, eta: f32) -> &'static CoatingTables {
             let cos = k as f32 / (TABLE_SIZE - 1) as f32;
             // Mitsuba's estimate of 2 ∫ R_int(μ) μ dμ: twice the mean over
             // the same 64 points, kept for agreement with its images.
-            (
-                coating_transmittance(&microfacet, cos, eta),
-                specular_albedo(&microfacet, cos, 1.0 / eta) * cos,
-            )
+            let (transmittance, albedo) = coating_row(&microfacet, cos, eta);
+            (transmittance, albedo * cos)
         })
         .collect();
     let external_transmittance = std::array::from_fn(|k| rows[k].0);
