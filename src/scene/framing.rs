@@ -13,10 +13,18 @@ use glam::{Mat3A, Mat4, Vec3A};
 use std::path::Path;
 
 /// Looks at the bounding box from the front (+z, y up), all of it in view.
-pub fn default_camera(triangles: &[TriangleInput], spheres: &[Sphere]) -> Camera {
+/// Instances count by their placed boxes.
+pub fn default_camera(
+    triangles: &[TriangleInput],
+    spheres: &[Sphere],
+    instances: &super::InstancesInput,
+) -> Camera {
     let mut lo = Vec3A::splat(f32::INFINITY);
     let mut hi = Vec3A::splat(f32::NEG_INFINITY);
     for v in triangles.iter().flat_map(|t| t.vertices) {
+        (lo, hi) = (lo.min(v), hi.max(v));
+    }
+    for (_, v) in instances.placed_corners().flatten().flatten() {
         (lo, hi) = (lo.min(v), hi.max(v));
     }
     for s in spheres {
@@ -70,7 +78,7 @@ pub fn bare_mesh(path: &Path, limits: &Limits) -> Result<SceneInput> {
             ),
         ));
     }
-    let camera = default_camera(&triangles, &[]);
+    let camera = default_camera(&triangles, &[], &Default::default());
     Ok(SceneInput {
         camera,
         materials: vec![super::load::default_material()],

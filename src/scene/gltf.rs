@@ -86,13 +86,7 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         Some(c) => c,
         None => {
             importer.warn("no camera: a default one frames the scene".into());
-            let mut triangles = importer.triangles.clone();
-            let instances = &importer.instances;
-            for &(p, to_world) in &instances.placements {
-                let local = &instances.prototypes[p as usize];
-                triangles.extend(super::InstancesInput::copy(local, to_world));
-            }
-            super::framing::default_camera(&triangles, &[])
+            super::framing::default_camera(&importer.triangles, &[], &importer.instances)
         }
     };
     options
@@ -433,8 +427,8 @@ impl Importer<'_> {
                 Bitmap::decode_channel(&bytes, channel, map)
                     .map_err(|m| format!("image {image}: {m}"))
             };
-            let alphas = decode(1, &|g| (roughness * g).powi(2)).map_err(|m| self.error(m))?;
             if roughness > 0.0 {
+                let alphas = decode(1, &|g| (roughness * g).powi(2)).map_err(|m| self.error(m))?;
                 alpha_texture = Some(self.push_texture(&t, alphas, &label));
             }
             let metal = decode(2, &|b| metallic * b).map_err(|m| self.error(m))?;

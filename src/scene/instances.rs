@@ -31,6 +31,31 @@ impl InstancesInput {
             })
             .collect()
     }
+
+    /// Per placement, the eight corners of its prototype's box (`None`
+    /// for an empty prototype), in its own space and placed: what framing
+    /// and range checks need, without copying any triangle.
+    pub fn placed_corners(&self) -> impl Iterator<Item = Option<[(Vec3A, Vec3A); 8]>> + '_ {
+        let boxes: Vec<(Vec3A, Vec3A)> = self.prototypes.iter().map(|p| bounds(p)).collect();
+        self.placements.iter().map(move |&(p, to_world)| {
+            let (lo, hi) = *boxes.get(p as usize)?;
+            (lo.cmple(hi).all()).then(|| {
+                std::array::from_fn(|c| {
+                    let pick = |axis: usize| if c >> axis & 1 == 0 { lo } else { hi };
+                    let local = Vec3A::new(pick(0).x, pick(1).y, pick(2).z);
+                    (local, to_world.transform_point3a(local))
+                })
+            })
+        })
+    }
+}
+
+/// The box around `triangles` (inverted when there are none).
+fn bounds(triangles: &[TriangleInput]) -> (Vec3A, Vec3A) {
+    triangles.iter().flat_map(|t| t.vertices).fold(
+        (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
+        |(lo, hi), v| (lo.min(v), hi.max(v)),
+    )
 }
 
 /// Checks the instances and keeps what can be shared: prototypes without
@@ -45,20 +70,16 @@ pub(super) fn checked(
     triangles: &mut Vec<TriangleInput>,
     dropped: &mut Dropped,
 ) -> Result<(Vec<Vec<TriangleInput>>, Vec<(u32, Affine3A)>)> {
-    let prototypes: Vec<Vec<TriangleInput>> = input
-        .prototypes
-        .into_iter()
-        .map(|p| dropped.triangles(p))
-        .collect();
-    let bounds: Vec<(Vec3A, Vec3A)> = prototypes
-        .iter()
-        .map(|p| {
-            p.iter().flat_map(|t| t.vertices).fold(
-                (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
-                |(lo, hi), v| (lo.min(v), hi.max(v)),
-            )
-        })
-        .collect();
+    let input = InstancesInput {
+        prototypes: input
+            .prototypes
+            .into_iter()
+            .map(|p| dropped.triangles(p))
+            .collect(),
+        placements: input.placements,
+    };
+    let corners: Vec<_> = input.placed_corners().collect();
+    let prototypes = input.prototypes;
     // Per prototype, once: whether it emits (then it is copied).
     let mut emits = Vec::with_capacity(prototypes.len());
     for p in &prototypes {
@@ -72,7 +93,7 @@ pub(super) fn checked(
         emits.push(any);
     }
     let mut placements = Vec::new();
-    for (prototype, to_world) in input.placements {
+    for ((prototype, to_world), corners) in input.placements.into_iter().zip(corners) {
         let Some(local) = prototypes.get(prototype as usize) else {
             return Err(Error::new(format!(
                 "internal: an instance of prototype {prototype}"
@@ -84,17 +105,8 @@ pub(super) fn checked(
                 "an instance's transform is singular or not finite",
             ));
         }
-        let (lo, hi) = bounds[prototype as usize];
-        let corners = (0..8).map(|c: u32| {
-            let pick = |axis: u32, lo: f32, hi: f32| if c >> axis & 1 == 0 { lo } else { hi };
-            Vec3A::new(
-                pick(0, lo.x, hi.x),
-                pick(1, lo.y, hi.y),
-                pick(2, lo.z, hi.z),
-            )
-        });
-        let reach = |p: Vec3A| in_range(p) && in_range(to_world.transform_point3a(p));
-        if !local.is_empty() && !corners.into_iter().all(reach) {
+        let reach = |(local, placed): &(Vec3A, Vec3A)| in_range(*local) && in_range(*placed);
+        if corners.is_some_and(|c| !c.iter().all(reach)) {
             return Err(Error::new(format!(
                 "an instance reaches beyond ±{MAX_COORDINATE:e} (or is not finite): areas and distances would overflow"
             )));

@@ -138,13 +138,11 @@ impl<'a> Importer<'a> {
             Some(s) => self.sensor(s),
             None => {
                 self.warn(&root.loc, "no sensor: a default camera frames the scene");
-                let mut triangles = self.triangles.clone();
-                let instances = &self.instances;
-                for &(p, to_world) in &instances.placements {
-                    let local = &instances.prototypes[p as usize];
-                    triangles.extend(crate::scene::InstancesInput::copy(local, to_world));
-                }
-                Ok(super::framing::default_camera(&triangles, &self.spheres))
+                Ok(super::framing::default_camera(
+                    &self.triangles,
+                    &self.spheres,
+                    &self.instances,
+                ))
             }
         }
     }
