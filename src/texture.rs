@@ -31,6 +31,9 @@ pub struct Bitmap {
     pub width: usize,
     pub height: usize,
     texels: Texels,
+    /// The mean texel, computed once (materials ask for it; the importer
+    /// computes it on the thread that decoded the image).
+    mean: std::sync::OnceLock<Rgb>,
 }
 
 /// How texels are kept. 8-bit images stay 8-bit, 3 bytes a texel, and are
@@ -143,16 +146,21 @@ impl Texture {
     /// The mean over the texture (for lobe choices that want one value).
     pub fn mean(&self) -> Rgb {
         match self {
-            Texture::Bitmap { image, .. } => {
-                let n = image.width * image.height;
-                (0..n).map(|i| image.at_index(i)).sum::<Rgb>() / n.max(1) as f32
-            }
+            Texture::Bitmap { image, .. } => image.mean(),
             Texture::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
         }
     }
 }
 
 impl Bitmap {
+    /// The mean texel.
+    pub fn mean(&self) -> Rgb {
+        *self.mean.get_or_init(|| {
+            let n = self.width * self.height;
+            (0..n).map(|i| self.at_index(i)).sum::<Rgb>() / n.max(1) as f32
+        })
+    }
+
     /// Reads an image (PNG, JPEG, TGA, EXR, HDR, by extension). 8- and
     /// 16-bit colour is sRGB-decoded unless `raw` (data such as roughness);
     /// float images (EXR, HDR) are linear. Non-finite texels become 0.
@@ -200,6 +208,7 @@ impl Bitmap {
             width,
             height,
             texels: Texels::Floats(texels),
+            mean: Default::default(),
         })
     }
 
@@ -242,6 +251,7 @@ impl Bitmap {
             width,
             height,
             texels,
+            mean: Default::default(),
         })
     }
 
@@ -291,6 +301,7 @@ impl Bitmap {
             width,
             height,
             texels,
+            mean: Default::default(),
         })
     }
 
@@ -301,6 +312,7 @@ impl Bitmap {
             width,
             height,
             texels: Texels::Floats(texels.iter().map(|t| t.to_array()).collect()),
+            mean: Default::default(),
         }
     }
 
@@ -440,6 +452,7 @@ pub fn read_pfm(bytes: &[u8]) -> Result<Bitmap, String> {
         width,
         height,
         texels: Texels::Floats(texels),
+        mean: Default::default(),
     })
 }
 

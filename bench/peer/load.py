@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Scene load time and peak memory, tracelab against Mitsuba 3, same files.
 
-Each measurement is its own process, run `--runs` times (the median is
-printed, with the range). Mitsuba: `mi.load_file` timed inside the process
-(its import and variant set-up not counted), peak RSS of the process, and
+Each measurement is its own process, run `--runs` times, the two
+renderers alternating (the median is printed, with the range). Mitsuba:
+`mi.load_file` timed inside the process (its import and variant set-up
+not counted), peak RSS of the process, and
 the RSS its import and set-up alone reach (loading the empty scene), so
 that what the scene costs can be told from what the library costs.
 tracelab: the load time of its render summary (parse, meshes, textures,
@@ -93,8 +94,11 @@ def main():
     print("scene | Mitsuba load s | Mitsuba peak RSS MiB | tracelab load s | tracelab peak RSS MiB")
     for scene in args.scenes:
         scene = os.path.abspath(scene)
-        m = [mitsuba(scene, args.variant) for _ in range(args.runs)]
-        t = [tracelab(args.tracelab, scene) for _ in range(args.runs)]
+        # Alternating, so that a busy or idle spell of the machine falls on both.
+        m, t = [], []
+        for _ in range(args.runs):
+            m.append(mitsuba(scene, args.variant))
+            t.append(tracelab(args.tracelab, scene))
         print(f"{scene} | {summary([x[0] for x in m])} | {summary([x[1] for x in m])} | "
               f"{summary([x[0] for x in t])} | {summary([x[1] for x in t])}")
 

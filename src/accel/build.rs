@@ -288,17 +288,24 @@ impl Geometry {
     }
 
     fn store_in_order(&mut self, triangles: &[TriangleInput], order: &[usize]) {
+        self.tri_vertices.reserve_exact(order.len());
+        self.tri_shading.reserve_exact(order.len());
+        self.tri_uvs
+            .reserve_exact(if self.keep_uvs { order.len() } else { 0 });
+        self.tri_normals
+            .reserve_exact(if self.keep_normals { order.len() } else { 0 });
         for &i in order {
-            self.tri_vertices.push(triangles[i].vertices);
-            self.tri_shading.push(TriangleShading::new(&triangles[i]));
+            let (t, shading) = (&triangles[i], TriangleShading::new(&triangles[i]));
+            self.tri_vertices.push(t.vertices);
             if self.keep_uvs {
                 let barycentric = [Vec2::ZERO, Vec2::X, Vec2::Y];
-                self.tri_uvs.push(triangles[i].uvs.unwrap_or(barycentric));
+                self.tri_uvs.push(t.uvs.unwrap_or(barycentric));
             }
             if self.keep_normals {
-                let flat = [TriangleShading::new(&triangles[i]).normal; 3];
-                self.tri_normals.push(triangles[i].normals.unwrap_or(flat));
+                self.tri_normals
+                    .push(t.normals.unwrap_or([shading.normal; 3]));
             }
+            self.tri_shading.push(shading);
         }
     }
 

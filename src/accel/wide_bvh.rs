@@ -61,6 +61,7 @@ impl WideBvh {
             nodes: Vec::new(),
             leaves: Vec::new(),
             order: Vec::with_capacity(triangles.len()),
+            scratch: Vec::with_capacity(LEAF_MAX),
         };
         let root = builder.collapse(0, 1)?;
         let Builder {
@@ -211,6 +212,8 @@ struct Builder<'a> {
     nodes: Vec<Node>,
     leaves: Vec<Block>,
     order: Vec<usize>,
+    /// A leaf's primitives, reused.
+    scratch: Vec<usize>,
 }
 
 impl Builder<'_> {
@@ -232,6 +235,19 @@ impl Builder<'_> {
         }
     }
 
+    /// A leaf block over `prims` (at most eight), stored after the others.
+    fn push_leaf(&mut self, prims: &[usize]) -> u32 {
+        let mut vertices = [[Vec3A::ZERO; 3]; LANES];
+        for (v, &p) in vertices.iter_mut().zip(prims) {
+            *v = self.triangles[p];
+        }
+        let first = self.order.len();
+        self.order.extend_from_slice(prims);
+        self.leaves
+            .push(Block::new(&vertices[..prims.len()], first));
+        (self.leaves.len() - 1) as u32 | LEAF_BIT
+    }
+
     /// The wide node or leaf for binary node `index` at `depth`. A subtree
     /// of at most eight triangles becomes one leaf block; otherwise the
     /// node's children are opened, largest surface area first, until there
@@ -245,33 +261,34 @@ impl Builder<'_> {
             return self.split_leaf(index);
         }
         if self.prim_count(index) <= LEAF_MAX {
-            let mut prims = Vec::with_capacity(LANES);
+            let mut prims = std::mem::take(&mut self.scratch);
+            prims.clear();
             self.gather(index, &mut prims);
-            let first = self.order.len();
-            let vertices: Vec<[Vec3A; 3]> = prims.iter().map(|&p| self.triangles[p]).collect();
-            self.order.extend_from_slice(&prims);
-            self.leaves.push(Block::new(&vertices, first));
-            return Some((self.leaves.len() - 1) as u32 | LEAF_BIT);
+            let leaf = self.push_leaf(&prims);
+            self.scratch = prims;
+            return Some(leaf);
         }
-        let mut children = vec![index];
-        while children.len() < LANES {
-            let widest = children
-                .iter()
-                .enumerate()
-                .filter(|&(_, &c)| {
-                    !self.bvh2.nodes[c as usize].is_leaf() && self.prim_count(c) > LEAF_MAX
-                })
-                .max_by(|a, b| {
-                    let area = |c: u32| self.bvh2.nodes[c as usize].aabb().half_area();
-                    area(*a.1).total_cmp(&area(*b.1))
-                })
-                .map(|(i, _)| i);
+        let (mut children, mut count) = ([index; LANES], 1);
+        while count < LANES {
+            let area = |c: u32| self.bvh2.nodes[c as usize].aabb().half_area();
+            let openable =
+                |c: u32| !self.bvh2.nodes[c as usize].is_leaf() && self.prim_count(c) > LEAF_MAX;
+            // The widest openable child; ties to the first, as max_by's last.
+            let mut widest: Option<usize> = None;
+            for i in (0..count).filter(|&i| openable(children[i])) {
+                if widest.is_none_or(|w| area(children[i]) >= area(children[w])) {
+                    widest = Some(i);
+                }
+            }
             let Some(i) = widest else { break };
-            let opened = children.swap_remove(i);
-            let first = self.bvh2.nodes[opened as usize].first_index;
-            children.extend([first, first + 1]);
+            let first = self.bvh2.nodes[children[i] as usize].first_index;
+            // swap_remove, then push both children.
+            children[i] = children[count - 1];
+            children[count - 1] = first;
+            children[count] = first + 1;
+            count += 1;
         }
-        self.push_node(children.len(), |builder, lane| {
+        self.push_node(count, |builder, lane| {
             let c = children[lane];
             let aabb = *builder.bvh2.nodes[c as usize].aabb();
             Some(((aabb.min, aabb.max), builder.collapse(c, depth + 1)?))
@@ -288,16 +305,11 @@ impl Builder<'_> {
             return None;
         }
         self.push_node(chunks.len(), |builder, lane| {
-            let vertices: Vec<[Vec3A; 3]> =
-                chunks[lane].iter().map(|&p| builder.triangles[p]).collect();
             let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-            for p in vertices.iter().flatten() {
-                (lo, hi) = (lo.min(*p), hi.max(*p));
+            for p in chunks[lane].iter().flat_map(|&p| builder.triangles[p]) {
+                (lo, hi) = (lo.min(p), hi.max(p));
             }
-            let first = builder.order.len();
-            builder.order.extend_from_slice(&chunks[lane]);
-            builder.leaves.push(Block::new(&vertices, first));
-            Some(((lo, hi), (builder.leaves.len() - 1) as u32 | LEAF_BIT))
+            Some(((lo, hi), builder.push_leaf(&chunks[lane])))
         })
     }
 
@@ -314,15 +326,13 @@ impl Builder<'_> {
             boxes: Boxes8::new(&[]),
             children: [0; LANES],
         });
-        let mut boxes = Vec::with_capacity(LANES);
+        let mut boxes = [(Vec3A::ZERO, Vec3A::ZERO); LANES];
         let mut refs = [0u32; LANES];
-        for (lane, r) in refs.iter_mut().enumerate().take(count) {
-            let (aabb, reference) = child(self, lane)?;
-            boxes.push(aabb);
-            *r = reference;
+        for lane in 0..count {
+            (boxes[lane], refs[lane]) = child(self, lane)?;
         }
         self.nodes[slot] = Node {
-            boxes: Boxes8::new(&boxes),
+            boxes: Boxes8::new(&boxes[..count]),
             children: refs,
         };
         Some(slot as u32)

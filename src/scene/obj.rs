@@ -36,7 +36,7 @@ pub struct ObjMesh {
 pub fn load_obj(path: &Path) -> Result<ObjMesh> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| Error::at(path, None, format!("cannot read OBJ file: {e}")))?;
-    check_obj_text(path, &text)?;
+    scan_obj_text(path, &text, false)?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let options = tobj::LoadOptions {
         triangulate: true,
@@ -52,9 +52,26 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh> {
             tobj::load_mtl(dir.join(mtl))
         })
     }))
-    .map_err(|_| Error::at(path, None, "malformed OBJ or MTL: the OBJ parser gave up"))?;
-    let (models, materials) =
-        parsed.map_err(|e| Error::at(path, None, format!("malformed OBJ: {e}")))?;
+    .map_err(|_| {
+        check_obj_text(path, &text).err().unwrap_or_else(|| {
+            Error::at(path, None, "malformed OBJ or MTL: the OBJ parser gave up")
+        })
+    })?;
+    let (models, materials) = parsed.map_err(|e| {
+        check_obj_text(path, &text)
+            .err()
+            .unwrap_or_else(|| Error::at(path, None, format!("malformed OBJ: {e}")))
+    })?;
+    let in_range = |x: &f32| x.is_finite() && x.abs() <= super::MAX_COORDINATE;
+    if !models.iter().all(|m| m.mesh.positions.iter().all(in_range)) {
+        return Err(check_obj_text(path, &text).err().unwrap_or_else(|| {
+            Error::at(
+                path,
+                None,
+                "a vertex coordinate is not finite or out of range",
+            )
+        }));
+    }
     let materials = materials
         .map_err(|e| Error::at(path, None, format!("cannot load its material library: {e}")))?;
     let mtl_path = mtl_library(&text)
@@ -122,6 +139,14 @@ fn mtl_library(text: &str) -> Option<&str> {
 
 /// Line scan for what tobj accepts silently or reports without a line.
 pub fn check_obj_text(path: &Path, text: &str) -> Result<()> {
+    scan_obj_text(path, text, true)
+}
+
+/// [`check_obj_text`]; without `coordinates`, vertex lines are only
+/// counted, not parsed (a second parse of every number was a fifth of an
+/// OBJ's load: [`load_obj`] checks the parsed positions instead, and scans
+/// again with `coordinates` to say which line is wrong).
+fn scan_obj_text(path: &Path, text: &str, coordinates: bool) -> Result<()> {
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let (mut vertex_count, mut texcoord_count, mut normal_count) = (0i64, 0i64, 0i64);
     for (number, line) in text.lines().enumerate() {
@@ -129,15 +154,16 @@ pub fn check_obj_text(path: &Path, text: &str) -> Result<()> {
         let mut words = line.split_whitespace();
         match words.next() {
             Some("v") => {
-                let coords: Vec<&str> = words.take(3).collect();
-                if coords.len() < 3 {
+                let mut coords = [""; 3];
+                let given = coords.iter_mut().zip(words).map(|(c, w)| *c = w).count();
+                if given < 3 {
                     return Err(Error::at(
                         path,
                         Some(number),
                         "vertex needs three coordinates `v x y z`",
                     ));
                 }
-                for c in coords {
+                for c in coords.into_iter().filter(|_| coordinates) {
                     match c.parse::<f32>() {
                         Ok(x) if x.is_finite() && x.abs() > super::MAX_COORDINATE => {
                             return Err(Error::at(

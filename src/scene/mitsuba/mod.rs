@@ -5,6 +5,7 @@
 //! was done instead, and `strict` makes the first one an error.
 
 mod bsdfs;
+mod meshes;
 mod prefetch;
 mod props;
 mod shapes;
@@ -49,8 +50,13 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         lights: Vec::new(),
         environment: None,
         hints: RenderHints::default(),
-        prefetched: prefetch::Prefetched::new(&doc, &ids),
+        prefetched: prefetch::Prefetched::new(&doc, &ids, options.limits.max_triangles),
     };
+    // One allocation for the scene's triangles, not a doubling per mesh.
+    let expected = importer.prefetched.triangle_count();
+    importer
+        .triangles
+        .reserve(expected.min(options.limits.max_triangles));
     let camera = importer.scene()?;
     options.check_strict(&importer.warnings)?;
     Ok(SceneInput {

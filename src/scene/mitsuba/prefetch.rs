@@ -1,71 +1,143 @@
-//! The bitmaps a scene names, decoded on every core before the importer
-//! walks the scene in file order: a dozen JPEGs were a quarter of the load
-//! time of Bitterli's interiors on one thread. A file that fails here is
-//! left out and read again in order, where its error gets the element's
-//! file:line:column. Meshes are read in order: decoding them ahead too
-//! holds every mesh at once beside the triangles made from them
+//! The bitmaps and mesh files a scene names, decoded on every core before
+//! the importer walks the scene in file order: the dozen JPEGs and the
+//! hundreds of OBJ files of Bitterli's interiors were most of their load
+//! time on one thread. A file that fails here is left out and read again
+//! in order, where its error gets the element's file:line:column. A mesh
+//! is handed over once and dropped from here, so that the meshes waiting
+//! and the triangles made from them add up to about one copy of the scene
 //! (docs/performance.md, "Loading").
 
+use super::meshes::MeshFile;
 use super::props::Props;
 use super::xml::{Document, Element};
+use crate::scene::mesh::MeshData;
 use crate::texture::Bitmap;
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// A bitmap file and whether it is read `raw`.
 type Key = (PathBuf, bool);
 
-/// Bitmaps decoded ahead, shared by every texture that names them.
+/// A file to decode.
+#[derive(PartialEq, Eq, PartialOrd, Ord)]
+enum Job {
+    Bitmap(Key),
+    Mesh(MeshFile),
+}
+
+/// Bitmaps and meshes decoded ahead.
 #[derive(Default)]
 pub(super) struct Prefetched {
+    /// Shared by every texture that names them.
     bitmaps: HashMap<Key, Arc<Bitmap>>,
+    /// Taken by the first shape that names them.
+    meshes: HashMap<MeshFile, MeshData>,
 }
 
 impl Prefetched {
     /// Decodes, in parallel, every bitmap file that an element of `doc`
-    /// names (textures and environment maps).
-    pub(super) fn new(doc: &Document, ids: &HashMap<String, &Element>) -> Prefetched {
-        let mut keys = Vec::new();
-        collect(&doc.root, doc, ids, &mut keys);
-        keys.sort();
-        keys.dedup();
-        let bitmaps = keys
+    /// names (textures and environment maps) and every mesh file, meshes
+    /// until they hold `max_triangles` (the walk reads the rest, and stops
+    /// at the limit with the shape's place).
+    pub(super) fn new(
+        doc: &Document,
+        ids: &HashMap<String, &Element>,
+        max_triangles: usize,
+    ) -> Prefetched {
+        let mut jobs = Vec::new();
+        collect(&doc.root, doc, ids, &mut jobs);
+        jobs.sort();
+        jobs.dedup();
+        // Largest first, so that no core is left with a big file at the end.
+        jobs.sort_by_cached_key(|job| {
+            let path = match job {
+                Job::Bitmap((path, _)) => path,
+                Job::Mesh(file) => &file.path,
+            };
+            std::cmp::Reverse(std::fs::metadata(path).map_or(0, |m| m.len()))
+        });
+        let triangles = AtomicUsize::new(0);
+        let decoded: Vec<Decoded> = jobs
             .into_par_iter()
-            .filter_map(|key| {
-                let bitmap = Bitmap::read(&key.0, key.1).ok()?;
-                Some((key, Arc::new(bitmap)))
+            .with_max_len(1)
+            .filter_map(|job| match job {
+                Job::Bitmap(key) => {
+                    let bitmap = Bitmap::read(&key.0, key.1).ok()?;
+                    // Materials read it in the walk, on one thread.
+                    bitmap.mean();
+                    Some(Decoded::Bitmap(key, Arc::new(bitmap)))
+                }
+                Job::Mesh(file) => {
+                    if triangles.load(Ordering::Relaxed) > max_triangles {
+                        return None;
+                    }
+                    let mesh = file.read().ok()?;
+                    triangles.fetch_add(mesh.indices.len(), Ordering::Relaxed);
+                    Some(Decoded::Mesh(file, mesh))
+                }
             })
             .collect();
-        Prefetched { bitmaps }
+        let mut prefetched = Prefetched::default();
+        for d in decoded {
+            match d {
+                Decoded::Bitmap(key, bitmap) => {
+                    prefetched.bitmaps.insert(key, bitmap);
+                }
+                Decoded::Mesh(file, mesh) => {
+                    prefetched.meshes.insert(file, mesh);
+                }
+            }
+        }
+        prefetched
     }
 
     /// The bitmap of `path` read with `raw`, if it was decoded.
     pub(super) fn bitmap(&self, path: &Path, raw: bool) -> Option<Arc<Bitmap>> {
         self.bitmaps.get(&(path.to_path_buf(), raw)).cloned()
     }
+
+    /// Triangles in the meshes decoded (each counted once).
+    pub(super) fn triangle_count(&self) -> usize {
+        self.meshes.values().map(|m| m.indices.len()).sum()
+    }
+
+    /// The mesh of `file`, if it was decoded and not yet taken.
+    pub(super) fn mesh(&mut self, file: &MeshFile) -> Option<MeshData> {
+        self.meshes.remove(file)
+    }
 }
 
-/// The bitmaps that `e` and the elements inside it name.
-fn collect(e: &Element, doc: &Document, ids: &HashMap<String, &Element>, keys: &mut Vec<Key>) {
+enum Decoded {
+    Bitmap(Key, Arc<Bitmap>),
+    Mesh(MeshFile, MeshData),
+}
+
+/// The files that `e` and the elements inside it name.
+fn collect(e: &Element, doc: &Document, ids: &HashMap<String, &Element>, jobs: &mut Vec<Job>) {
     for c in &e.children {
-        let bitmap = matches!(
-            (c.tag.as_str(), c.plugin()),
-            ("texture", "bitmap") | ("emitter", "envmap")
-        );
-        if bitmap {
-            let p = Props::new(c, ids);
-            let path = p
-                .string("filename")
-                .ok()
-                .flatten()
-                .and_then(|name| doc.resolve(name, &c.loc).ok());
-            if let Some(path) = path {
-                let raw = c.tag == "texture" && p.bool("raw").ok().flatten().unwrap_or(false);
-                keys.push((path, raw));
+        match (c.tag.as_str(), c.plugin()) {
+            ("texture", "bitmap") | ("emitter", "envmap") => {
+                let p = Props::new(c, ids);
+                let path = p
+                    .string("filename")
+                    .ok()
+                    .flatten()
+                    .and_then(|name| doc.resolve(name, &c.loc).ok());
+                if let Some(path) = path {
+                    let raw = c.tag == "texture" && p.bool("raw").ok().flatten().unwrap_or(false);
+                    jobs.push(Job::Bitmap((path, raw)));
+                }
             }
+            ("shape", _) => {
+                if let Ok(Some(file)) = MeshFile::of(c, &Props::new(c, ids), doc) {
+                    jobs.push(Job::Mesh(file));
+                }
+            }
+            _ => {}
         }
-        collect(c, doc, ids, keys);
+        collect(c, doc, ids, jobs);
     }
 }

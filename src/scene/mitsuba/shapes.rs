@@ -3,13 +3,14 @@
 //! groups, with their BSDFs and area emitters.
 
 use super::Importer;
+use super::meshes::MeshFile;
 use super::props::{Colour, Props};
 use super::xml::Element;
 use crate::accel::{NO_LIGHT, Sphere};
 use crate::error::Result;
 use crate::scene::mesh::{MeshData, Orientation};
 use crate::scene::{MAX_COORDINATE, in_range};
-use glam::{Mat4, Vec2, Vec3A};
+use glam::{Mat4, Vec3A};
 
 /// Segments of a tessellated disk or cylinder.
 const SEGMENTS: u32 = 128;
@@ -47,23 +48,11 @@ impl<'a> Importer<'a> {
         let start = self.triangles.len();
         let (mesh, orientation, face_normals) = match kind {
             "obj" | "ply" | "serialized" => {
-                let file = p
-                    .string("filename")?
-                    .ok_or_else(|| e.loc.error(format!("a {kind} shape needs `filename`")))?;
-                let path = self.doc.resolve(file, &e.loc)?;
+                let file = MeshFile::of(e, &p, self.doc)?.expect("a mesh shape");
                 let face_normals = p.bool("face_normals")?.unwrap_or(false);
-                let mesh = match kind {
-                    "obj" => {
-                        let flip_uv = p.bool("flip_tex_coords")?.unwrap_or(true);
-                        obj_mesh(&path, flip_uv)?
-                    }
-                    "ply" => crate::scene::ply::load_ply(&path)?,
-                    _ => {
-                        let index = p.int("shape_index")?.unwrap_or(0);
-                        let index = usize::try_from(index)
-                            .map_err(|_| e.loc.error("shape_index must be >= 0"))?;
-                        crate::scene::serialized::load_serialized(&path, index)?
-                    }
+                let mesh = match self.prefetched.mesh(&file) {
+                    Some(mesh) => mesh,
+                    None => file.read()?,
                 };
                 (mesh, Orientation::Winding, face_normals)
             }
@@ -279,32 +268,4 @@ impl<'a> Importer<'a> {
         }
         Ok(Some(radiance))
     }
-}
-
-/// An OBJ file as an indexed mesh (its MTL materials are Mitsuba's to ignore).
-fn obj_mesh(path: &std::path::Path, flip_uv: bool) -> Result<MeshData> {
-    let obj = crate::scene::obj::load_obj(path)?;
-    let mut mesh = MeshData::default();
-    let has_normals =
-        obj.triangles.iter().all(|t| t.normals.is_some()) && !obj.triangles.is_empty();
-    let has_uvs = obj.triangles.iter().all(|t| t.uvs.is_some()) && !obj.triangles.is_empty();
-    let (mut normals, mut uvs) = (Vec::new(), Vec::new());
-    for t in &obj.triangles {
-        let base = mesh.positions.len() as u32;
-        mesh.positions.extend(t.vertices.map(glam::Vec3::from));
-        if has_normals {
-            normals.extend(t.normals.unwrap().map(glam::Vec3::from));
-        }
-        if has_uvs {
-            // load_obj flips v as Mitsuba does by default; undo on request.
-            uvs.extend(t.uvs.unwrap().map(|uv| match flip_uv {
-                true => uv,
-                false => Vec2::new(uv.x, 1.0 - uv.y),
-            }));
-        }
-        mesh.indices.push([base, base + 1, base + 2]);
-    }
-    mesh.normals = has_normals.then_some(normals);
-    mesh.uvs = has_uvs.then_some(uvs);
-    Ok(mesh)
 }
