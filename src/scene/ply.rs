@@ -5,57 +5,74 @@
 use super::mesh::MeshData;
 use crate::error::{Error, Result};
 use glam::{Vec2, Vec3};
-use ply_rs_bw::parser::Parser;
-use ply_rs_bw::ply::{DefaultElement, Property};
+use ply_rs_bw::parser::{Parser, Reader};
+use ply_rs_bw::ply::{PropertyAccess, PropertyAccessResult, PropertyType};
 use std::path::Path;
 
-/// Reads a PLY file.
+/// Reads a PLY file. Elements are read into typed vertices and faces
+/// (ply-rs's `PropertyAccess`), not its default map per element, which
+/// was most of the time of a large mesh.
 pub fn load_ply(path: &Path) -> Result<MeshData> {
     let err = |m: String| Error::at(path, None, m);
     let file = std::fs::File::open(path).map_err(|e| err(format!("cannot read PLY file: {e}")))?;
-    let mut reader = std::io::BufReader::new(file);
-    let ply = Parser::<DefaultElement>::new()
-        .read_ply(&mut reader)
-        .map_err(|e| err(format!("not a valid PLY file: {e}")))?;
-    let vertices = ply
-        .payload
-        .get("vertex")
-        .ok_or_else(|| err("no `vertex` element".into()))?;
-    let faces = ply
-        .payload
-        .get("face")
-        .ok_or_else(|| err("no `face` element".into()))?;
-    let number = |e: &DefaultElement, names: &[&str]| -> Option<f32> {
-        names.iter().find_map(|n| scalar(e.get(*n)?))
+    let mut reader = Reader::new(std::io::BufReader::new(file));
+    let invalid = |e: ply_rs_bw::parser::ParseError| err(format!("not a valid PLY file: {e}"));
+    let header = Parser::<Skipped>::new()
+        .read_header(&mut reader)
+        .map_err(invalid)?;
+    let scalar = |element: &str, names: &[&str]| {
+        header.elements.get(element).is_some_and(|e| {
+            names.iter().any(|n| {
+                e.properties
+                    .get(*n)
+                    .is_some_and(|p| matches!(p.data_type, PropertyType::Scalar(_)))
+            })
+        })
     };
-    let mut mesh = MeshData::default();
-    let first = vertices.first();
-    let has = |names: &[&str]| first.is_some_and(|e| names.iter().any(|n| e.contains_key(*n)));
-    let (has_normals, has_uvs) = (has(&["nx"]), has(&["u", "s", "texture_u", "texture_s"]));
-    let mut normals = Vec::new();
-    let mut uvs = Vec::new();
-    for (i, v) in vertices.iter().enumerate() {
-        let p = [&["x"][..], &["y"], &["z"]].map(|n| number(v, n));
-        let [Some(x), Some(y), Some(z)] = p else {
-            return Err(err(format!("vertex {i} lacks x, y or z")));
-        };
-        mesh.positions.push(Vec3::new(x, y, z));
-        if has_normals {
-            let n = [&["nx"][..], &["ny"], &["nz"]].map(|n| number(v, n).unwrap_or(0.0));
-            normals.push(Vec3::from(n));
-        }
-        if has_uvs {
-            let u = number(v, &["u", "s", "texture_u", "texture_s"]).unwrap_or(0.0);
-            let w = number(v, &["v", "t", "texture_v", "texture_t"]).unwrap_or(0.0);
-            uvs.push(Vec2::new(u, w));
+    if !header.elements.contains_key("vertex") {
+        return Err(err("no `vertex` element".into()));
+    }
+    if !header.elements.contains_key("face") {
+        return Err(err("no `face` element".into()));
+    }
+    if !(scalar("vertex", &["x"]) && scalar("vertex", &["y"]) && scalar("vertex", &["z"])) {
+        return Err(err("vertices lack x, y or z".into()));
+    }
+    let (has_normals, has_uvs) = (scalar("vertex", &["nx"]), scalar("vertex", &U));
+    let (mut vertices, mut faces) = (Vec::new(), Vec::new());
+    // Every element in the header's order, those not read skipped over.
+    for (name, element) in &header.elements {
+        match name.as_str() {
+            "vertex" => {
+                vertices = Parser::<Vertex>::new()
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(invalid)?;
+            }
+            "face" => {
+                faces = Parser::<Face>::new()
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(invalid)?;
+            }
+            _ => {
+                Parser::<Skipped>::new()
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(invalid)?;
+            }
         }
     }
+    let mut mesh = MeshData {
+        positions: vertices.iter().map(|v| v.position).collect(),
+        normals: has_normals.then(|| vertices.iter().map(|v| v.normal).collect()),
+        uvs: has_uvs.then(|| vertices.iter().map(|v| v.uv).collect()),
+        indices: Vec::with_capacity(faces.len()),
+    };
+    drop(vertices);
     for (i, f) in faces.iter().enumerate() {
-        let list = ["vertex_indices", "vertex_index"]
-            .iter()
-            .find_map(|n| f.get(*n))
-            .and_then(index_list)
-            .ok_or_else(|| err(format!("face {i} has no vertex_indices list")))?;
+        let list = match &f.indices {
+            Some(Ok(list)) => list,
+            Some(Err(())) => return Err(err(format!("face {i} has a negative vertex index"))),
+            None => return Err(err(format!("face {i} has no vertex_indices list"))),
+        };
         if list.len() < 3 {
             return Err(err(format!("face {i} has {} vertices", list.len())));
         }
@@ -63,36 +80,115 @@ pub fn load_ply(path: &Path) -> Result<MeshData> {
             mesh.indices.push([list[0], list[k], list[k + 1]]);
         }
     }
-    mesh.normals = has_normals.then_some(normals);
-    mesh.uvs = has_uvs.then_some(uvs);
     mesh.validate().map_err(err)?;
     Ok(mesh)
 }
 
-fn scalar(p: &Property) -> Option<f32> {
-    Some(match *p {
-        Property::Float(x) => x,
-        Property::Double(x) => x as f32,
-        Property::Char(x) => x as f32,
-        Property::UChar(x) => x as f32,
-        Property::Short(x) => x as f32,
-        Property::UShort(x) => x as f32,
-        Property::Int(x) => x as f32,
-        Property::UInt(x) => x as f32,
-        _ => return None,
-    })
+/// The names of the first texture coordinate, and of the second.
+const U: [&str; 4] = ["u", "s", "texture_u", "texture_s"];
+const V: [&str; 4] = ["v", "t", "texture_v", "texture_t"];
+
+/// A vertex's properties that tracelab reads.
+#[derive(Default)]
+struct Vertex {
+    position: Vec3,
+    normal: Vec3,
+    uv: Vec2,
 }
 
-fn index_list(p: &Property) -> Option<Vec<u32>> {
-    let to = |v: i64| u32::try_from(v).ok();
-    match p {
-        Property::ListChar(v) => v.iter().map(|&x| to(x as i64)).collect(),
-        Property::ListUChar(v) => v.iter().map(|&x| Some(x as u32)).collect(),
-        Property::ListShort(v) => v.iter().map(|&x| to(x as i64)).collect(),
-        Property::ListUShort(v) => v.iter().map(|&x| Some(x as u32)).collect(),
-        Property::ListInt(v) => v.iter().map(|&x| to(x as i64)).collect(),
-        Property::ListUInt(v) => Some(v.clone()),
-        _ => None,
+impl Vertex {
+    fn set(&mut self, name: &str, value: f32) -> PropertyAccessResult {
+        match name {
+            "x" => self.position.x = value,
+            "y" => self.position.y = value,
+            "z" => self.position.z = value,
+            "nx" => self.normal.x = value,
+            "ny" => self.normal.y = value,
+            "nz" => self.normal.z = value,
+            _ if U.contains(&name) => self.uv.x = value,
+            _ if V.contains(&name) => self.uv.y = value,
+            _ => return PropertyAccessResult::Ignored,
+        }
+        PropertyAccessResult::Set
+    }
+}
+
+impl PropertyAccess for Vertex {
+    fn new() -> Self {
+        Vertex::default()
+    }
+    fn set_char(&mut self, name: &str, value: i8) -> PropertyAccessResult {
+        self.set(name, value as f32)
+    }
+    fn set_uchar(&mut self, name: &str, value: u8) -> PropertyAccessResult {
+        self.set(name, value as f32)
+    }
+    fn set_short(&mut self, name: &str, value: i16) -> PropertyAccessResult {
+        self.set(name, value as f32)
+    }
+    fn set_ushort(&mut self, name: &str, value: u16) -> PropertyAccessResult {
+        self.set(name, value as f32)
+    }
+    fn set_int(&mut self, name: &str, value: i32) -> PropertyAccessResult {
+        self.set(name, value as f32)
+    }
+    fn set_uint(&mut self, name: &str, value: u32) -> PropertyAccessResult {
+        self.set(name, value as f32)
+    }
+    fn set_float(&mut self, name: &str, value: f32) -> PropertyAccessResult {
+        self.set(name, value)
+    }
+    fn set_double(&mut self, name: &str, value: f64) -> PropertyAccessResult {
+        self.set(name, value as f32)
+    }
+}
+
+/// A face's vertex list: None until read, Err for a negative index.
+#[derive(Default)]
+struct Face {
+    indices: Option<std::result::Result<Vec<u32>, ()>>,
+}
+
+impl Face {
+    fn set<T: Copy + TryInto<u32>>(&mut self, name: &str, list: Vec<T>) -> PropertyAccessResult {
+        if !matches!(name, "vertex_indices" | "vertex_index") {
+            return PropertyAccessResult::Ignored;
+        }
+        self.indices = Some(list.iter().map(|&i| i.try_into().map_err(|_| ())).collect());
+        PropertyAccessResult::Set
+    }
+}
+
+impl PropertyAccess for Face {
+    fn new() -> Self {
+        Face::default()
+    }
+    fn set_list_char(&mut self, name: &str, value: Vec<i8>) -> PropertyAccessResult {
+        self.set(name, value)
+    }
+    fn set_list_uchar(&mut self, name: &str, value: Vec<u8>) -> PropertyAccessResult {
+        self.set(name, value)
+    }
+    fn set_list_short(&mut self, name: &str, value: Vec<i16>) -> PropertyAccessResult {
+        self.set(name, value)
+    }
+    fn set_list_ushort(&mut self, name: &str, value: Vec<u16>) -> PropertyAccessResult {
+        self.set(name, value)
+    }
+    fn set_list_int(&mut self, name: &str, value: Vec<i32>) -> PropertyAccessResult {
+        self.set(name, value)
+    }
+    fn set_list_uint(&mut self, name: &str, value: Vec<u32>) -> PropertyAccessResult {
+        self.set(name, value)
+    }
+}
+
+/// An element tracelab does not read, consumed and dropped.
+struct Skipped;
+
+impl PropertyAccess for Skipped {
+    fn new() -> Self {
+        Skipped
     }
 }
 
