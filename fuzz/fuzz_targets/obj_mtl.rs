@@ -4,27 +4,18 @@
 #![no_main]
 
 mod common;
+mod scratch;
 
 use libfuzzer_sys::fuzz_target;
 use std::path::PathBuf;
-use std::sync::OnceLock;
 
 fn dir() -> &'static PathBuf {
-    static DIR: OnceLock<PathBuf> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let base = if std::path::Path::new("/dev/shm").is_dir() {
-            PathBuf::from("/dev/shm")
-        } else {
-            std::env::temp_dir()
-        };
-        let dir = base.join(format!("tracelab-fuzz-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).expect("fuzz scratch folder");
+    scratch::dir(|dir| {
         std::fs::write(
             dir.join("scene.toml"),
             "[camera]\neye = [0, 1, 4]\nlook_at = [0, 0, 0]\nfov_y = 40\nwidth = 4\nheight = 4\n\n[[mesh]]\nfile = \"mesh.obj\"\n\n[[point_light]]\nposition = [0, 3, 2]\nintensity = [5, 5, 5]\n",
         )
         .expect("fuzz scene");
-        dir
     })
 }
 

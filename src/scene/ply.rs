@@ -6,7 +6,7 @@ use super::mesh::MeshData;
 use crate::error::{Error, Result};
 use glam::{Vec2, Vec3};
 use ply_rs_bw::parser::{Parser, Reader};
-use ply_rs_bw::ply::{PropertyAccess, PropertyAccessResult, PropertyType};
+use ply_rs_bw::ply::{Encoding, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType};
 use std::path::Path;
 
 /// Reads a PLY file. Elements are read into typed vertices and faces
@@ -15,6 +15,7 @@ use std::path::Path;
 pub fn load_ply(path: &Path) -> Result<MeshData> {
     let err = |m: String| Error::at(path, None, m);
     let file = std::fs::File::open(path).map_err(|e| err(format!("cannot read PLY file: {e}")))?;
+    let bytes = file.metadata().map_or(u64::MAX, |m| m.len());
     let mut reader = Reader::new(std::io::BufReader::new(file));
     let invalid = |e: ply_rs_bw::parser::ParseError| err(format!("not a valid PLY file: {e}"));
     let header = Parser::<Skipped>::new()
@@ -39,6 +40,29 @@ pub fn load_ply(path: &Path) -> Result<MeshData> {
         return Err(err("vertices lack x, y or z".into()));
     }
     let (has_normals, has_uvs) = (scalar("vertex", &["nx"]), scalar("vertex", &U));
+    // Each element takes at least a byte (a property, or an ASCII line),
+    // so no count may pass the file's size: ply-rs pushes elements until
+    // the count, and an element whose properties went elsewhere (a name
+    // declared twice) reads nothing, forever (found by fuzzing).
+    for (name, element) in &header.elements {
+        let least: u64 = match header.encoding {
+            Encoding::Ascii => 1,
+            _ => element
+                .properties
+                .values()
+                .map(|p| match &p.data_type {
+                    PropertyType::Scalar(t) | PropertyType::List(t, _) => scalar_bytes(t),
+                })
+                .sum::<u64>()
+                .max(1),
+        };
+        if (element.count as u64).saturating_mul(least) > bytes {
+            return Err(err(format!(
+                "element `{name}` declares {} entries, more than the file's {bytes} bytes can hold",
+                element.count
+            )));
+        }
+    }
     let (mut vertices, mut faces) = (Vec::new(), Vec::new());
     // Every element in the header's order, those not read skipped over.
     for (name, element) in &header.elements {
@@ -82,6 +106,16 @@ pub fn load_ply(path: &Path) -> Result<MeshData> {
     }
     mesh.validate().map_err(err)?;
     Ok(mesh)
+}
+
+/// Bytes of a binary scalar (a list's length, at least).
+fn scalar_bytes(t: &ScalarType) -> u64 {
+    match t {
+        ScalarType::Char | ScalarType::UChar => 1,
+        ScalarType::Short | ScalarType::UShort => 2,
+        ScalarType::Int | ScalarType::UInt | ScalarType::Float => 4,
+        ScalarType::Double => 8,
+    }
 }
 
 /// The names of the first texture coordinate, and of the second.
