@@ -107,13 +107,51 @@ impl Image {
         RgbImage::from_raw(self.width, self.height, data).expect("buffer matches its dimensions")
     }
 
-    /// Error of `self` against `reference`.
+    /// How many times larger than `reference` this image is, the same
+    /// whole number along both axes (1 for equal sizes); None otherwise.
+    pub fn scale_over(&self, reference: &Image) -> Option<u32> {
+        let (w, h) = (reference.width.max(1), reference.height.max(1));
+        let k = self.width / w;
+        (k >= 1 && self.width == k * w && self.height == k * h).then_some(k)
+    }
+
+    /// Each k × k block of pixels averaged into one (a box filter).
+    pub fn downsampled(&self, k: u32) -> Image {
+        let k = k.max(1);
+        let (w, h) = (self.width / k, self.height / k);
+        let mut pixels = vec![[0.0f32; 3]; (w * h) as usize];
+        let weight = 1.0 / (k * k) as f32;
+        for y in 0..h * k {
+            let row = &self.pixels[(y * self.width) as usize..][..(w * k) as usize];
+            let out = &mut pixels[((y / k) * w) as usize..][..w as usize];
+            for (x, p) in row.iter().enumerate() {
+                let o = &mut out[x / k as usize];
+                for c in 0..3 {
+                    o[c] += p[c] * weight;
+                }
+            }
+        }
+        Image {
+            width: w,
+            height: h,
+            pixels,
+        }
+    }
+
+    /// Error of `self` against `reference`. A reference smaller by a whole
+    /// factor k (Tungsten's and the shipped references are box-downsampled)
+    /// is compared with this image box-downsampled by k: callers that show
+    /// the figure say so ([`Image::scale_over`]).
     pub fn compare(&self, reference: &Image) -> Result<ErrorMetrics> {
-        if (self.width, self.height) != (reference.width, reference.height) {
-            return Err(Error::new(format!(
-                "images differ in size: {}x{} vs {}x{}",
-                self.width, self.height, reference.width, reference.height
-            )));
+        match self.scale_over(reference) {
+            Some(1) => {}
+            Some(k) => return self.downsampled(k).compare(reference),
+            None => {
+                return Err(Error::new(format!(
+                    "images differ in size: {}x{} vs {}x{} (nor is the first a whole multiple of the second)",
+                    self.width, self.height, reference.width, reference.height
+                )));
+            }
         }
         let (mut se, mut rel_se, mut rel_ae) = (0.0f64, 0.0f64, 0.0f64);
         for (a, b) in self.pixels.iter().zip(&reference.pixels) {
@@ -242,7 +280,29 @@ mod tests {
         assert!((m.rmse - 0.1).abs() < 1e-6);
         let expected_rel_mse = (0.01 / 1.01 + 0.01 / 0.01) / 2.0;
         assert!((m.relative_mse - expected_rel_mse).abs() < 1e-5);
-        assert!(a.compare(&Image::new(1, 1)).is_err());
+        assert!(a.compare(&Image::new(3, 1)).is_err());
+    }
+
+    #[test]
+    fn a_smaller_reference_is_compared_with_the_box_downsampled_image() {
+        // 4 x 2 against 2 x 1: each reference pixel is the mean of a 2 x 2 block.
+        let image = Image {
+            width: 4,
+            height: 2,
+            pixels: [1.0, 3.0, 10.0, 10.0, 3.0, 1.0, 10.0, 14.0]
+                .map(|v| [v; 3])
+                .to_vec(),
+        };
+        assert_eq!(image.downsampled(2).pixels, vec![[2.0; 3], [11.0; 3]]);
+        let reference = Image {
+            width: 2,
+            height: 1,
+            pixels: vec![[2.0; 3], [10.0; 3]],
+        };
+        assert_eq!(image.scale_over(&reference), Some(2));
+        let m = image.compare(&reference).unwrap();
+        assert!((m.rmse - 0.5f64.sqrt()).abs() < 1e-6, "{}", m.rmse);
+        assert_eq!(Image::new(4, 3).scale_over(&reference), None);
     }
 
     #[test]

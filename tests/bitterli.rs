@@ -1,7 +1,8 @@
 //! Bitterli's Mitsuba 3 releases of Veach's scenes, as shipped in scenes/,
 //! imported and rendered against Mitsuba 3 renders of the same files at the
 //! same resolution (tests/data/bitterli, from bench/references/bitterli.py)
-//! and against the Tungsten renders that ship with them, box-downsampled.
+//! and against the Tungsten renders that ship with them, box-downsampled
+//! (scenes/<name>/TungstenRender.exr).
 //!
 //! Tolerances: the expected MSE of two independent estimates is the mean of
 //! var(ours) + var(Mitsuba) per pixel and channel (Mitsuba's from 16
@@ -73,7 +74,10 @@ fn check(name: &str, width: u32, height: u32, spp: u32) {
             theirs[c]
         );
     }
-    let tungsten = reference(&format!("bitterli/{name}_tungsten.exr"));
+    // Beside the scene, where the viewer finds it.
+    let tungsten =
+        tracelab::image::Image::read(&repo_path(&format!("scenes/{name}/TungstenRender.exr")))
+            .expect("Tungsten reference loads");
     let clamped_mean = |pixels: &[[f32; 3]]| {
         let sum: f64 = pixels
             .iter()

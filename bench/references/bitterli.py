@@ -4,8 +4,11 @@
 Renders each scene.xml with Mitsuba 3 (path tracer, the file's
 max_depth and tent filter) at the test's resolution, and
 box-downsamples the Tungsten reference that ships with the scene to the same
-resolution. Writes tests/data/bitterli/<scene>_{mitsuba,mitsuba_var,tungsten}.exr (the
-variance is that of the mean, from 16 independent passes).
+resolution. Writes tests/data/bitterli/<scene>_{mitsuba,mitsuba_var}.exr (the
+variance is that of the mean, from 16 independent passes) and
+scenes/<scene>/TungstenRender.exr (downsampled; the viewer loads a reference
+it finds beside a scene, and compares it with the image box-downsampled by
+the same factor).
 
     pip install mitsuba numpy      # and apt-get install libllvm19
     python3 bench/references/bitterli.py --tungsten DIR   # DIR/<scene>/TungstenRender.exr
@@ -48,7 +51,8 @@ def main():
         if args.tungsten:
             t = np.array(mi.Bitmap(os.path.join(args.tungsten, name, "TungstenRender.exr")))[..., :3]
             t = t.reshape(h, factor, w, factor, 3).mean(axis=(1, 3))
-            mi.Bitmap(t.astype(np.float32)).write(os.path.join(OUT, f"{name}_tungsten.exr"))
+            out = os.path.join(REPO, "scenes", name, "TungstenRender.exr")
+            mi.Bitmap(t.astype(np.float32)).write(out)
             print(name, "tungsten mean", t.mean(axis=(0, 1)))
 
 

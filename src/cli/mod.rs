@@ -249,6 +249,14 @@ fn compare(image: &Path, reference: &Path) -> Result<()> {
             reference.display()
         ))
     })?;
+    if let Some(k) = a.scale_over(&b).filter(|&k| k > 1) {
+        eprintln!(
+            "note: {} is {k}x the reference's {}x{}: compared box-downsampled by {k}",
+            image.display(),
+            b.width,
+            b.height
+        );
+    }
     let (ma, mb) = (a.mean(), b.mean());
     println!(
         "RMSE {:.6} | relative MSE {:.6} | mean relative error {:.6}",

@@ -91,6 +91,9 @@ pub struct ViewerApp {
     /// Camera moved with the mouse; `None` uses the scene's.
     pub camera: Option<Camera>,
     reference: Option<Arc<Image>>,
+    /// Where the reference came from when it was found beside the scene
+    /// (the next scene replaces it; a reference chosen by hand stays).
+    reference_beside: Option<std::path::PathBuf>,
     pub errors: Vec<String>,
     pub toasts: Vec<Toast>,
     textures: Vec<TextureHandle>,
@@ -147,6 +150,7 @@ impl ViewerApp {
             scene_name: String::new(),
             camera: None,
             reference: None,
+            reference_beside: None,
             errors,
             toasts: Vec::new(),
             textures: Vec::new(),
@@ -204,8 +208,51 @@ impl ViewerApp {
                     .map(|s| s.to_string_lossy().into_owned())
                     .unwrap_or_else(|| "scene".into());
                 self.view = ViewTransform::default();
+                self.pick_reference_beside(p);
             }
             Err(e) => self.errors.push(e.to_string()),
+        }
+    }
+
+    /// The reference file found beside the scene, if that is the one in use.
+    pub fn reference_beside_scene(&self) -> Option<&Path> {
+        self.reference_beside.as_deref()
+    }
+
+    /// A reference beside the scene file (`reference.exr`, or the
+    /// `TungstenRender.exr` that Bitterli's scenes ship) is loaded with
+    /// the scene, as a renderer's test scene is meant to be compared,
+    /// unless a reference was chosen by hand; it is not remembered in the
+    /// settings.
+    fn pick_reference_beside(&mut self, scene: &Path) {
+        if self.reference.is_some() && self.reference_beside.is_none() {
+            return;
+        }
+        let dir = scene.parent().unwrap_or(Path::new("."));
+        let found = ["reference.exr", "TungstenRender.exr"]
+            .into_iter()
+            .map(|name| dir.join(name))
+            .find(|p| p.is_file());
+        self.reference = None;
+        self.reference_beside = None;
+        self.live.set_reference(None);
+        let Some(path) = found else {
+            return;
+        };
+        match Image::read(&path) {
+            Ok(image) => {
+                self.toast(format!(
+                    "reference {} ({}x{}, found beside the scene): true RMSE where the image is a whole multiple of its size",
+                    path.display(),
+                    image.width,
+                    image.height
+                ));
+                let image = Arc::new(image);
+                self.reference = Some(image.clone());
+                self.reference_beside = Some(path);
+                self.live.set_reference(Some(image));
+            }
+            Err(e) => self.toast(format!("reference beside the scene not read: {e}")),
         }
     }
 
@@ -221,6 +268,7 @@ impl ViewerApp {
             Ok(image) => {
                 let image = Arc::new(image);
                 self.reference = Some(image.clone());
+                self.reference_beside = None;
                 self.live.set_reference(Some(image));
                 self.settings.reference_path = path.to_string();
             }
@@ -238,6 +286,7 @@ impl ViewerApp {
         if let Some(view) = frame.views.get(index) {
             let reference = Arc::new(view.snapshot.image.clone());
             self.reference = Some(reference.clone());
+            self.reference_beside = None;
             self.live.set_reference(Some(reference));
             self.settings.reference_path.clear();
             self.toast(format!(

@@ -302,6 +302,10 @@ fn reference_section(ui: &mut egui::Ui, app: &mut ViewerApp) {
             app.settings.reference_path = path;
         }
     });
+    if let Some(path) = app.reference_beside_scene() {
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        ui.label(format!("In use: {name}, found beside the scene"));
+    }
     if ui
         .button("Use image A as reference")
         .on_hover_text("Freeze the current image A (e.g. a long render) as the reference for RMSE")

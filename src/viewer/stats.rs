@@ -87,7 +87,15 @@ fn view_summary(name: &str, view: &LiveView, app: &ViewerApp) -> String {
             Some(ErrorEstimate::Unknown) | None => "est. RMSE n/a".into(),
         },
         match last.and_then(|p| p.rmse) {
-            Some(rmse) => format!(" | RMSE {rmse:.5}"),
+            // A smaller reference is compared with the image box-downsampled.
+            Some(rmse) => match app
+                .reference()
+                .and_then(|r| view.snapshot.image.scale_over(r))
+                .filter(|&k| k > 1)
+            {
+                Some(k) => format!(" | RMSE {rmse:.5} (image box-downsampled {k}x)"),
+                None => format!(" | RMSE {rmse:.5}"),
+            },
             None if app.reference().is_some() => " | RMSE n/a (size differs)".into(),
             None => String::new(),
         },
