@@ -153,6 +153,15 @@ impl Texture {
 }
 
 impl Bitmap {
+    fn new(width: usize, height: usize, texels: Texels) -> Bitmap {
+        Bitmap {
+            width,
+            height,
+            texels,
+            mean: Default::default(),
+        }
+    }
+
     /// The mean texel.
     pub fn mean(&self) -> Rgb {
         *self.mean.get_or_init(|| {
@@ -204,12 +213,7 @@ impl Bitmap {
                 [a; 3]
             })
             .collect();
-        Ok(Bitmap {
-            width,
-            height,
-            texels: Texels::Floats(texels),
-            mean: Default::default(),
-        })
+        Ok(Bitmap::new(width, height, Texels::Floats(texels)))
     }
 
     /// One channel of an image held in memory (0 red, 1 green, 2 blue),
@@ -247,12 +251,7 @@ impl Bitmap {
                     .collect(),
             ),
         };
-        Ok(Bitmap {
-            width,
-            height,
-            texels,
-            mean: Default::default(),
-        })
+        Ok(Bitmap::new(width, height, texels))
     }
 
     /// The smallest, largest and mean texel value of the first channel.
@@ -297,23 +296,17 @@ impl Bitmap {
                 )
             }
         };
-        Ok(Bitmap {
-            width,
-            height,
-            texels,
-            mean: Default::default(),
-        })
+        Ok(Bitmap::new(width, height, texels))
     }
 
     /// Linear texels given as values (for tests and generated maps).
     pub fn from_texels(width: usize, height: usize, texels: &[Rgb]) -> Bitmap {
         assert_eq!(texels.len(), width * height, "{width}x{height} texels");
-        Bitmap {
+        Bitmap::new(
             width,
             height,
-            texels: Texels::Floats(texels.iter().map(|t| t.to_array()).collect()),
-            mean: Default::default(),
-        }
+            Texels::Floats(texels.iter().map(|t| t.to_array()).collect()),
+        )
     }
 
     /// Texel number `i` (row-major from the top row), linear.
@@ -448,12 +441,7 @@ pub fn read_pfm(bytes: &[u8]) -> Result<Bitmap, String> {
             };
         }
     }
-    Ok(Bitmap {
-        width,
-        height,
-        texels: Texels::Floats(texels),
-        mean: Default::default(),
-    })
+    Ok(Bitmap::new(width, height, Texels::Floats(texels)))
 }
 
 /// The sRGB transfer function's inverse (IEC 61966-2-1).

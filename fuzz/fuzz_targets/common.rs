@@ -1,4 +1,4 @@
-//! What both targets do with a scene that loaded: build it and render one
+//! What every target does with a scene that loaded: build it and render one
 //! sample per pixel of a tiny image, so that a scene that loads but breaks
 //! the BVH, the lights or the tracer is found too.
 
@@ -6,7 +6,7 @@ use std::sync::Arc;
 use tracelab::integrator::{Integrator, PathTracer};
 use tracelab::render::{RenderSettings, Session};
 use tracelab::sampling::SamplerKind;
-use tracelab::scene::{Limits, Scene, SceneInput};
+use tracelab::scene::{Limits, LoadOptions, Scene, SceneInput};
 
 /// Small limits: a fuzzer must not spend its time on huge meshes or images.
 pub fn limits() -> Limits {
@@ -36,5 +36,18 @@ pub fn build_and_render(input: SceneInput) {
     };
     if let Ok(session) = Session::new(Arc::new(scene), settings) {
         session.render_pass(1);
+    }
+}
+
+/// Loads any scene file the loader knows (by its extension) with the small
+/// limits, and builds and renders what loads.
+#[allow(dead_code)] // the targets that parse text themselves do not call it
+pub fn load_and_render(path: &std::path::Path) {
+    let options = LoadOptions {
+        limits: limits(),
+        ..Default::default()
+    };
+    if let Ok(input) = tracelab::scene::load::load_any(path, &options) {
+        build_and_render(input);
     }
 }

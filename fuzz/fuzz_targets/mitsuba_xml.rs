@@ -7,7 +7,6 @@ mod common;
 mod scratch;
 
 use libfuzzer_sys::fuzz_target;
-use tracelab::scene::LoadOptions;
 
 fuzz_target!(|data: &[u8]| {
     let dir = scratch::dir(|dir| {
@@ -18,11 +17,5 @@ fuzz_target!(|data: &[u8]| {
     if std::fs::write(&path, data).is_err() {
         return;
     }
-    let options = LoadOptions {
-        limits: common::limits(),
-        ..Default::default()
-    };
-    if let Ok(input) = tracelab::scene::load::load_any(&path, &options) {
-        common::build_and_render(input);
-    }
+    common::load_and_render(&path);
 });

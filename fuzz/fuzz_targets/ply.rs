@@ -7,18 +7,11 @@ mod common;
 mod scratch;
 
 use libfuzzer_sys::fuzz_target;
-use tracelab::scene::LoadOptions;
 
 fuzz_target!(|data: &[u8]| {
     let path = scratch::dir(|_| {}).join("mesh.ply");
     if std::fs::write(&path, data).is_err() {
         return;
     }
-    let options = LoadOptions {
-        limits: common::limits(),
-        ..Default::default()
-    };
-    if let Ok(input) = tracelab::scene::load::load_any(&path, &options) {
-        common::build_and_render(input);
-    }
+    common::load_and_render(&path);
 });
