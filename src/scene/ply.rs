@@ -147,33 +147,29 @@ impl Vertex {
     }
 }
 
+/// ply-rs has one setter per PLY type; each `$method` here converts its
+/// `$ty` and hands it to the element's own `set`.
+macro_rules! forward {
+    ($($method:ident($ty:ty) => $convert:expr;)*) => {
+        $(fn $method(&mut self, name: &str, value: $ty) -> PropertyAccessResult {
+            self.set(name, $convert(value))
+        })*
+    };
+}
+
 impl PropertyAccess for Vertex {
     fn new() -> Self {
         Vertex::default()
     }
-    fn set_char(&mut self, name: &str, value: i8) -> PropertyAccessResult {
-        self.set(name, value as f32)
-    }
-    fn set_uchar(&mut self, name: &str, value: u8) -> PropertyAccessResult {
-        self.set(name, value as f32)
-    }
-    fn set_short(&mut self, name: &str, value: i16) -> PropertyAccessResult {
-        self.set(name, value as f32)
-    }
-    fn set_ushort(&mut self, name: &str, value: u16) -> PropertyAccessResult {
-        self.set(name, value as f32)
-    }
-    fn set_int(&mut self, name: &str, value: i32) -> PropertyAccessResult {
-        self.set(name, value as f32)
-    }
-    fn set_uint(&mut self, name: &str, value: u32) -> PropertyAccessResult {
-        self.set(name, value as f32)
-    }
-    fn set_float(&mut self, name: &str, value: f32) -> PropertyAccessResult {
-        self.set(name, value)
-    }
-    fn set_double(&mut self, name: &str, value: f64) -> PropertyAccessResult {
-        self.set(name, value as f32)
+    forward! {
+        set_char(i8) => f32::from;
+        set_uchar(u8) => f32::from;
+        set_short(i16) => f32::from;
+        set_ushort(u16) => f32::from;
+        set_int(i32) => |v| v as f32;
+        set_uint(u32) => |v| v as f32;
+        set_float(f32) => |v| v;
+        set_double(f64) => |v| v as f32;
     }
 }
 
@@ -197,23 +193,13 @@ impl PropertyAccess for Face {
     fn new() -> Self {
         Face::default()
     }
-    fn set_list_char(&mut self, name: &str, value: Vec<i8>) -> PropertyAccessResult {
-        self.set(name, value)
-    }
-    fn set_list_uchar(&mut self, name: &str, value: Vec<u8>) -> PropertyAccessResult {
-        self.set(name, value)
-    }
-    fn set_list_short(&mut self, name: &str, value: Vec<i16>) -> PropertyAccessResult {
-        self.set(name, value)
-    }
-    fn set_list_ushort(&mut self, name: &str, value: Vec<u16>) -> PropertyAccessResult {
-        self.set(name, value)
-    }
-    fn set_list_int(&mut self, name: &str, value: Vec<i32>) -> PropertyAccessResult {
-        self.set(name, value)
-    }
-    fn set_list_uint(&mut self, name: &str, value: Vec<u32>) -> PropertyAccessResult {
-        self.set(name, value)
+    forward! {
+        set_list_char(Vec<i8>) => |v| v;
+        set_list_uchar(Vec<u8>) => |v| v;
+        set_list_short(Vec<i16>) => |v| v;
+        set_list_ushort(Vec<u16>) => |v| v;
+        set_list_int(Vec<i32>) => |v| v;
+        set_list_uint(Vec<u32>) => |v| v;
     }
 }
 

@@ -24,7 +24,8 @@ type Key = (PathBuf, bool);
 /// A file to decode.
 #[derive(PartialEq, Eq, PartialOrd, Ord)]
 enum Job {
-    Bitmap(Key),
+    /// A bitmap, and whether a texture reads it (materials ask for its mean).
+    Bitmap(Key, bool),
     Mesh(MeshFile),
 }
 
@@ -50,11 +51,19 @@ impl Prefetched {
         let mut jobs = Vec::new();
         collect(&doc.root, doc, ids, &mut jobs);
         jobs.sort();
-        jobs.dedup();
+        // One job per file; a bitmap read both as a texture and as an
+        // environment is a texture (sorted after, `true` > `false`).
+        jobs.dedup_by(|later, kept| match (later, kept) {
+            (Job::Bitmap(a, texture), Job::Bitmap(b, kept_texture)) if a == b => {
+                *kept_texture |= *texture;
+                true
+            }
+            (later, kept) => later == kept,
+        });
         // Largest first, so that no core is left with a big file at the end.
         jobs.sort_by_cached_key(|job| {
             let path = match job {
-                Job::Bitmap((path, _)) => path,
+                Job::Bitmap((path, _), _) => path,
                 Job::Mesh(file) => &file.path,
             };
             std::cmp::Reverse(std::fs::metadata(path).map_or(0, |m| m.len()))
@@ -64,10 +73,12 @@ impl Prefetched {
             .into_par_iter()
             .with_max_len(1)
             .filter_map(|job| match job {
-                Job::Bitmap(key) => {
+                Job::Bitmap(key, texture) => {
                     let bitmap = Bitmap::read(&key.0, key.1).ok()?;
-                    // Materials read it in the walk, on one thread.
-                    bitmap.mean();
+                    if texture {
+                        // Materials read it in the walk, on one thread.
+                        bitmap.mean();
+                    }
                     Some(Decoded::Bitmap(key, Arc::new(bitmap)))
                 }
                 Job::Mesh(file) => {
@@ -128,7 +139,7 @@ fn collect(e: &Element, doc: &Document, ids: &HashMap<String, &Element>, jobs: &
                     .and_then(|name| doc.resolve(name, &c.loc).ok());
                 if let Some(path) = path {
                     let raw = c.tag == "texture" && p.bool("raw").ok().flatten().unwrap_or(false);
-                    jobs.push(Job::Bitmap((path, raw)));
+                    jobs.push(Job::Bitmap((path, raw), c.tag == "texture"));
                 }
             }
             ("shape", _) => {
