@@ -24,6 +24,19 @@ pub fn pdf(wo: Vec3A, wi: Vec3A) -> f32 {
     cosine_hemisphere_pdf(wi.abs())
 }
 
+/// f(wo, wi) with the densities both ways, one side test for all three.
+#[inline]
+pub fn eval_with_pdfs(albedo: Rgb, wo: Vec3A, wi: Vec3A) -> (Rgb, f32, f32) {
+    if wo.z * wi.z <= 0.0 {
+        return (Rgb::ZERO, 0.0, 0.0);
+    }
+    (
+        albedo * FRAC_1_PI,
+        wi.z.abs() * FRAC_1_PI,
+        wo.z.abs() * FRAC_1_PI,
+    )
+}
+
 /// A cosine-distributed direction on wo's side; weight f cos / pdf = albedo.
 #[inline]
 pub fn sample(albedo: Rgb, wo: Vec3A, u: Vec2) -> Option<BsdfSample> {

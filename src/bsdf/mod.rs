@@ -198,6 +198,7 @@ impl Bsdf {
     #[inline]
     pub fn eval_with_pdfs(&self, wo: Vec3A, wi: Vec3A) -> (Rgb, f32, f32) {
         match *self {
+            Bsdf::Diffuse { albedo } => lambert::eval_with_pdfs(albedo, wo, wi),
             Bsdf::Glossy { .. } => {
                 let (wo, wi) = orient(true, wo, wi).unwrap_or((wo, wi));
                 self.phong().eval_with_pdfs(wo, wi)

@@ -87,12 +87,11 @@ impl Bdpt {
         // The connection's end: a light point s = 1 sampled itself replaces
         // the subpath's own.
         let light_sum = if s >= 1 {
-            let qs = if s == 1 && t > 1 {
-                joint.sampled.as_ref().unwrap_or(&light[0])
-            } else {
-                &light[s - 1]
+            let (pdf_fwd, delta_light) = match joint.sampled_light {
+                Some(l) => (l.pdf_fwd, l.delta),
+                None => (light[s - 1].pdf_fwd, light[s - 1].delta_light),
             };
-            let r_s1 = self.mis_power(joint.qs_rev, qs.pdf_fwd);
+            let r_s1 = self.mis_power(joint.qs_rev, pdf_fwd);
             let deeper = if s >= 2 {
                 let r_s2 = self.mis_power(joint.qs_minus_rev, light[s - 2].pdf_fwd);
                 let previous_delta = if s >= 3 {
@@ -108,7 +107,7 @@ impl Bdpt {
             let previous_delta = if s >= 2 {
                 light[s - 2].delta
             } else {
-                qs.delta_light
+                delta_light
             };
             r_s1 * (one_if(!previous_delta) + deeper)
         } else {

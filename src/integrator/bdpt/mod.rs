@@ -42,7 +42,7 @@ mod mis;
 mod vertex;
 
 use mis::{light_direction_pdf, pdf};
-use vertex::{Kind, Vertex, emission_of, origin_density, surface_vertex};
+use vertex::{Kind, Local, Subpath, Vertex, emission_of, origin_density, surface_vertex};
 
 /// The deepest path bidirectional path tracing makes: subpaths live in
 /// per-thread buffers of this capacity, so that a sample allocates nothing.
@@ -146,9 +146,9 @@ thread_local! {
     /// The two subpaths of the sample being traced, kept per render thread
     /// so that a sample neither allocates nor clears kilobytes of stack
     /// (fixed arrays on the stack measured 5.7% of the time in memmove).
-    static SUBPATHS: RefCell<(Vec<Vertex>, Vec<Vertex>)> = RefCell::new((
-        Vec::with_capacity(MAX_VERTICES),
-        Vec::with_capacity(MAX_VERTICES),
+    static SUBPATHS: RefCell<(Subpath, Subpath)> = RefCell::new((
+        Subpath::with_capacity(MAX_VERTICES),
+        Subpath::with_capacity(MAX_VERTICES),
     ));
 }
 
@@ -291,8 +291,8 @@ impl Bdpt {
             );
         }
 
-        self.prepare_mis(camera_path, light_path);
-        let (cam, light) = (camera_path.as_slice(), light_path.as_slice());
+        self.prepare_mis(&mut camera_path.vertices, &mut light_path.vertices);
+        let (cam, light) = (&*camera_path, &*light_path);
         for t in 1..=cam.len() {
             for s in 0..=light.len() {
                 if s + t < 2 || s + t - 2 > max_depth {
@@ -304,7 +304,7 @@ impl Bdpt {
                 let weight = if self.faulty_strategy == Some((s as u32, t as u32)) {
                     1.0
                 } else {
-                    self.mis_weight(cam, light, s, t, &joint)
+                    self.mis_weight(&cam.vertices, &light.vertices, s, t, &joint)
                 };
                 let value = joint.value;
                 let (film, scale) = match joint.film {
@@ -337,7 +337,7 @@ impl Bdpt {
         max_vertices: usize,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
-        path: &mut Vec<Vertex>,
+        path: &mut Subpath,
     ) {
         // What the subpath carries relative to where it started, with the
         // radiance scaling of refraction divided out: roulette reads it, so
@@ -361,7 +361,7 @@ impl Bdpt {
                 if transport == Transport::Radiance
                     && let Some(env) = scene.lights.environment()
                 {
-                    let previous = path[path.len() - 1];
+                    let previous = path.vertices[path.len() - 1];
                     let distance =
                         crate::scene::light::beyond_bounds(ray.origin, env.center, env.radius);
                     path.push(Vertex {
@@ -388,7 +388,7 @@ impl Bdpt {
             let material = &scene.materials[hit.material as usize];
             let wo_world = -ray.direction;
             let index = path.len();
-            let previous = path[index - 1];
+            let previous = path.vertices[index - 1];
             let bsdf = scene.bsdf_at(&hit);
             let mut vertex = surface_vertex(&hit, bsdf, wo_world, beta);
             if scene.features.shading_normals {
@@ -409,13 +409,11 @@ impl Bdpt {
             } else {
                 previous.area_density_at(pdf_direction, &vertex)
             };
-            path.push(vertex);
+            let Local { frame, wo, .. } = path.push(vertex);
             if path.len() >= max_vertices || bsdf.is_black() {
                 break;
             }
 
-            let frame = vertex.frame();
-            let wo = frame.to_local(wo_world);
             let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
                 break;
             };
@@ -424,23 +422,19 @@ impl Bdpt {
                     relative /= bsdf.refraction_scale(wo, sample.wi);
                     sample.weight
                 }
-                Transport::Importance => importance_weight(
-                    bsdf,
-                    wo,
-                    sample.wi,
-                    vertex.normal_local(&frame),
-                    sample.weight,
-                ),
+                Transport::Importance => {
+                    importance_weight(bsdf, wo, sample.wi, path.local[index].normal, sample.weight)
+                }
             };
             let (pdf_fwd, pdf_rev) = if sample.specular {
                 (0.0, 0.0)
             } else {
                 (sample.pdf, bsdf.pdf(sample.wi, wo))
             };
-            path[index].delta = sample.specular;
+            path.vertices[index].delta = sample.specular;
             beta *= weight;
             relative *= weight;
-            path[index - 1].pdf_rev = path[index].area_density_at(pdf_rev, &previous);
+            path.vertices[index - 1].pdf_rev = pdf_rev * path.local[index].to_previous;
             bounces += 1;
             if self.russian_roulette && bounces > self.rr_depth {
                 let q = relative.max_element().min(1.0);
@@ -465,13 +459,15 @@ impl Bdpt {
     fn connect(
         &self,
         scene: &Scene,
-        cam: &[Vertex],
-        light: &[Vertex],
+        cam: &Subpath,
+        light: &Subpath,
         s: usize,
         t: usize,
         time: f32,
         counts: &mut RayCounts,
     ) -> Option<Connection> {
+        let (cam, cam_local) = (cam.vertices.as_slice(), cam.local.as_slice());
+        let (light, light_local) = (light.vertices.as_slice(), light.local.as_slice());
         if s == 0 {
             // The camera subpath found a light by itself.
             let pt = &cam[t - 1];
@@ -491,7 +487,7 @@ impl Bdpt {
             return Some(Connection {
                 value,
                 film: None,
-                sampled: None,
+                sampled_light: None,
                 pt_rev,
                 pt_minus_rev: light_direction_pdf(scene, pt, pm),
                 qs_rev: 0.0,
@@ -511,7 +507,8 @@ impl Bdpt {
                 return None;
             }
             let c = scene.camera.connect(qs.point, qs.u_connect)?;
-            let value = qs.beta * qs.scatter(scene, c.wi) * (qs.shading_cos(c.wi) * c.weight);
+            let (f, pdf_back) = qs.scatter(scene, c.wi, &light_local[s - 1]);
+            let value = qs.beta * f * (qs.shading_cos(c.wi) * c.weight);
             if !(value.max_element() > 0.0)
                 || !sees_lens(scene, qs.point, qs.error, qs.normal, &c, time, counts)
             {
@@ -522,30 +519,28 @@ impl Bdpt {
                 point: c.lens_point,
                 ..Vertex::EMPTY
             };
-            let qs_minus = (s > 1).then(|| &light[s - 2]);
             return Some(Connection {
                 value,
                 film: Some(c.film),
                 qs_rev: pdf(scene, &lens, None, qs),
-                qs_minus_rev: qs_minus.map_or(0.0, |qm| pdf(scene, qs, Some(&lens), qm)),
+                qs_minus_rev: pdf_back * light_local[s - 1].to_previous,
                 // The lens point's own densities are never read.
                 pt_rev: 0.0,
                 pt_minus_rev: 0.0,
-                sampled: Some(lens),
+                sampled_light: None,
             });
         }
         let pt = &cam[t - 1];
         if pt.kind != Kind::Surface || pt.bsdf.is_specular() {
             return None;
         }
-        let pm = &cam[t - 2];
-        let frame = pt.frame();
-        let wo = frame.to_local(pt.wo);
+        let pl = &cam_local[t - 1];
         if s == 1 {
             // Next-event estimation from z_{t-1}.
             let ls = scene.lights.sample(pt.point, pt.u_select, pt.u_connect)?;
-            let (f, _, pdf_reverse) = pt.bsdf.eval_with_pdfs(wo, frame.to_local(ls.wi));
-            let value = pt.beta * f * ls.radiance * (pt.shading_cos(ls.wi) / ls.pdf);
+            let (f, pdf_forward, pdf_reverse) =
+                pt.bsdf.eval_with_pdfs(pl.wo, pl.frame.to_local(ls.wi));
+            let value = pt.beta * f * ls.radiance * (pl.shading_cos(ls.wi) / ls.pdf);
             if !(value.max_element() > 0.0) {
                 return None;
             }
@@ -585,10 +580,13 @@ impl Bdpt {
                 value,
                 film: None,
                 pt_rev,
-                pt_minus_rev: pt.area_density_at(pdf_reverse, pm),
-                qs_rev: pdf(scene, pt, Some(pm), &sampled),
+                pt_minus_rev: pdf_reverse * pl.to_previous,
+                qs_rev: pt.area_density_at(pdf_forward, &sampled),
                 qs_minus_rev: 0.0,
-                sampled: Some(sampled),
+                sampled_light: Some(SampledLight {
+                    pdf_fwd: sampled.pdf_fwd,
+                    delta: sampled.delta_light,
+                }),
             });
         }
         // Both subpaths end on surfaces: a shadow ray joins them. One
@@ -603,12 +601,12 @@ impl Bdpt {
             return None;
         }
         let w = d / dist2.sqrt();
-        let (f_pt, pdf_pt, pdf_pt_reverse) = pt.bsdf.eval_with_pdfs(wo, frame.to_local(-w));
-        let qs_frame = qs.frame();
-        let (qs_wo, qs_w) = (qs_frame.to_local(qs.wo), qs_frame.to_local(w));
-        let (f_qs, pdf_qs, pdf_qs_reverse) = qs.bsdf.eval_adjoint_with_pdfs(qs_wo, qs_w);
-        let f_qs = f_qs * shading_correction(qs_wo, qs_w, qs.normal_local(&qs_frame));
-        let g = qs.shading_cos(w) * pt.shading_cos(w) / dist2;
+        let (f_pt, pdf_pt, pdf_pt_reverse) = pt.bsdf.eval_with_pdfs(pl.wo, pl.frame.to_local(-w));
+        let ql = &light_local[s - 1];
+        let qs_w = ql.frame.to_local(w);
+        let (f_qs, pdf_qs, pdf_qs_reverse) = qs.bsdf.eval_adjoint_with_pdfs(ql.wo, qs_w);
+        let f_qs = f_qs * shading_correction(ql.wo, qs_w, ql.normal);
+        let g = ql.shading_cos(w) * pl.shading_cos(w) / dist2;
         let value = qs.beta * f_qs * f_pt * pt.beta * g;
         if !(value.max_element() > 0.0) {
             return None;
@@ -622,26 +620,35 @@ impl Bdpt {
         Some(Connection {
             value,
             film: None,
-            sampled: None,
-            pt_rev: qs.area_density_at(pdf_qs, pt),
-            pt_minus_rev: pt.area_density_at(pdf_pt_reverse, pm),
-            qs_rev: pt.area_density_at(pdf_pt, qs),
-            qs_minus_rev: qs.area_density_at(pdf_qs_reverse, &light[s - 2]),
+            sampled_light: None,
+            // Densities per area at the far end of the shadow ray: cos / d².
+            pt_rev: pdf_qs * pt.normal.dot(w).abs() / dist2,
+            pt_minus_rev: pdf_pt_reverse * pl.to_previous,
+            qs_rev: pdf_pt * qs.normal.dot(w).abs() / dist2,
+            qs_minus_rev: pdf_qs_reverse * ql.to_previous,
         })
     }
 }
 
 /// What [`Bdpt::connect`] found for one strategy: the unweighted value,
-/// where it lands (t = 1), the vertex the strategy sampled itself, and the
+/// where it lands (t = 1), the light point that strategy s = 1 sampled, and the
 /// reverse densities (area) of the vertices next to the connection in the
 /// joined path: z_{t-1} and z_{t-2} sampled from the light side, y_{s-1}
 /// and y_{s-2} from the camera side.
 struct Connection {
     value: Rgb,
     film: Option<Vec2>,
-    sampled: Option<Vertex>,
+    sampled_light: Option<SampledLight>,
     pt_rev: f32,
     pt_minus_rev: f32,
     qs_rev: f32,
     qs_minus_rev: f32,
+}
+
+/// What the MIS weight reads of the light point that strategy s = 1
+/// sampled itself, in place of the light subpath's y_0.
+#[derive(Clone, Copy)]
+struct SampledLight {
+    pdf_fwd: f32,
+    delta: bool,
 }

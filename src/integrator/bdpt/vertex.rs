@@ -97,16 +97,18 @@ impl Vertex {
         u_connect: Vec2::ZERO,
     };
 
-    /// At a light subpath's surface vertex, the adjoint BSDF from wo (the
-    /// light's side) to w; at a light vertex (whose beta is 1 /
-    /// p_position), the emitted radiance towards `w`; `w` is a unit vector.
+    /// At a light subpath's surface vertex (whose frame is `local`), the
+    /// adjoint BSDF from wo (the light's side) to w, with the density
+    /// (solid angle) of sampling wo from w; at a light vertex (whose beta
+    /// is 1 / p_position), the emitted radiance towards `w`, density 0 (not
+    /// read); `w` is a unit vector.
     #[inline]
-    pub(super) fn scatter(&self, scene: &Scene, w: Vec3A) -> Rgb {
-        match self.kind {
+    pub(super) fn scatter(&self, scene: &Scene, w: Vec3A, local: &Local) -> (Rgb, f32) {
+        let emitted = match self.kind {
             Kind::Surface => {
-                let frame = self.frame();
-                let (wo, w) = (frame.to_local(self.wo), frame.to_local(w));
-                self.bsdf.eval(w, wo) * shading_correction(wo, w, self.normal_local(&frame))
+                let w = local.frame.to_local(w);
+                let (f, pdf_back, _) = self.bsdf.eval_with_pdfs(w, local.wo);
+                return (f * shading_correction(local.wo, w, local.normal), pdf_back);
             }
             Kind::Light if self.infinite => Rgb::ZERO,
             Kind::Light => {
@@ -123,7 +125,8 @@ impl Vertex {
                 }
             }
             Kind::Camera => Rgb::ZERO,
-        }
+        };
+        (emitted, 0.0)
     }
 
     /// The frame of the BSDF: the shading normal's where there is one.
@@ -179,6 +182,76 @@ impl Vertex {
             return 0.0;
         }
         pdf_direction * next.cos(d / dist2.sqrt()) / dist2
+    }
+}
+
+/// A vertex's BSDF frame with its directions in that frame, made once per
+/// subpath vertex rather than once per strategy through it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Local {
+    pub(super) frame: Frame,
+    /// [`Vertex::wo`] in the frame.
+    pub(super) wo: Vec3A,
+    /// The geometric normal in the frame ([`Vertex::normal_local`]).
+    pub(super) normal: Vec3A,
+    /// What turns a density (solid angle) of this vertex sampling its
+    /// subpath's previous vertex into one per area there
+    /// ([`Vertex::area_density_at`] is linear in the density); 0 at the
+    /// subpath's first vertex.
+    pub(super) to_previous: f32,
+}
+
+impl Local {
+    #[inline]
+    fn of(v: &Vertex, previous: Option<&Vertex>) -> Local {
+        let frame = v.frame();
+        Local {
+            wo: frame.to_local(v.wo),
+            normal: v.normal_local(&frame),
+            frame,
+            to_previous: previous.map_or(0.0, |p| v.area_density_at(1.0, p)),
+        }
+    }
+
+    /// |cos| between the shading normal and the unit vector `w` (a surface
+    /// vertex's [`Vertex::shading_cos`]).
+    #[inline]
+    pub(super) fn shading_cos(&self, w: Vec3A) -> f32 {
+        self.frame.n.dot(w).abs()
+    }
+}
+
+/// A subpath: its vertices and, beside each, its [`Local`] frame.
+#[derive(Default)]
+pub(super) struct Subpath {
+    pub(super) vertices: Vec<Vertex>,
+    pub(super) local: Vec<Local>,
+}
+
+impl Subpath {
+    pub(super) fn with_capacity(capacity: usize) -> Self {
+        Subpath {
+            vertices: Vec::with_capacity(capacity),
+            local: Vec::with_capacity(capacity),
+        }
+    }
+
+    pub(super) fn clear(&mut self) {
+        self.vertices.clear();
+        self.local.clear();
+    }
+
+    pub(super) fn len(&self) -> usize {
+        self.vertices.len()
+    }
+
+    /// Appends `v` and returns its frame.
+    #[inline]
+    pub(super) fn push(&mut self, v: Vertex) -> Local {
+        let local = Local::of(&v, self.vertices.last());
+        self.vertices.push(v);
+        self.local.push(local);
+        local
     }
 }
 
