@@ -19,7 +19,7 @@ use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Sampler, SamplerKind};
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
-use glam::{Vec2, Vec3A};
+use glam::{Vec2, Vec3, Vec3A};
 use rayon::prelude::*;
 
 /// A photon: where it landed, where it came from, and what it carries.
@@ -99,13 +99,22 @@ pub fn describe_photons(photons: u32) -> String {
 /// Photons (or other [`Stored`] points) in a hash grid.
 pub struct PhotonMap<P = Photon> {
     photons: Vec<P>,
-    /// Photon indices sorted by cell hash; `starts[h]..starts[h + 1]`
-    /// are those of hash h.
-    order: Vec<u32>,
+    /// Each photon's position and index, sorted by cell hash;
+    /// `starts[h]..starts[h + 1]` are those of hash h. A lookup tests
+    /// distances on these 16 bytes in a row and reads a photon only where it
+    /// is near (most candidates of the 2 x 2 x 2 cells are not).
+    entries: Vec<Entry>,
     starts: Vec<u32>,
     cell: f32,
     /// The largest lookup radius.
     radius: f32,
+}
+
+/// A photon's position and its index in [`PhotonMap::items`].
+#[derive(Clone, Copy, Default)]
+struct Entry {
+    position: Vec3,
+    index: u32,
 }
 
 impl<P: Stored> PhotonMap<P> {
@@ -113,7 +122,7 @@ impl<P: Stored> PhotonMap<P> {
     pub fn build(photons: Vec<P>, radius: f32) -> PhotonMap<P> {
         let buckets = photons.len().next_power_of_two().max(1);
         let mut map = PhotonMap {
-            order: vec![0; photons.len()],
+            entries: vec![Entry::default(); photons.len()],
             starts: vec![0; buckets + 1],
             photons: Vec::new(),
             cell: 2.0 * radius,
@@ -130,8 +139,11 @@ impl<P: Stored> PhotonMap<P> {
             map.starts[i] += map.starts[i - 1];
         }
         let mut next = map.starts.clone();
-        for (i, &h) in hashes.iter().enumerate() {
-            map.order[next[h] as usize] = i as u32;
+        for (i, (&h, p)) in hashes.iter().zip(&photons).enumerate() {
+            map.entries[next[h] as usize] = Entry {
+                position: p.position().into(),
+                index: i as u32,
+            };
             next[h] += 1;
         }
         map.photons = photons;
@@ -199,10 +211,12 @@ impl<P: Stored> PhotonMap<P> {
                 continue;
             }
             seen[k as usize] = h;
-            for &i in &self.order[self.starts[h] as usize..self.starts[h + 1] as usize] {
-                let p = &self.photons[i as usize];
-                if (p.position() - point).length_squared() <= r2 && p.facing().dot(normal) > 0.0 {
-                    visit(i, p);
+            for e in &self.entries[self.starts[h] as usize..self.starts[h + 1] as usize] {
+                if (Vec3A::from(e.position) - point).length_squared() <= r2 {
+                    let p = &self.photons[e.index as usize];
+                    if p.facing().dot(normal) > 0.0 {
+                        visit(e.index, p);
+                    }
                 }
             }
         }
