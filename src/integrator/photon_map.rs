@@ -117,7 +117,7 @@ struct Entry {
     index: u32,
 }
 
-impl<P: Stored> PhotonMap<P> {
+impl<P: Stored + Sync> PhotonMap<P> {
     /// A map of `photons` for lookups of radius at most `radius`.
     pub fn build(photons: Vec<P>, radius: f32) -> PhotonMap<P> {
         let buckets = photons.len().next_power_of_two().max(1);
@@ -129,7 +129,7 @@ impl<P: Stored> PhotonMap<P> {
             radius,
         };
         let hashes: Vec<usize> = photons
-            .iter()
+            .par_iter()
             .map(|p| map.hash(map.cell_of(p.position())))
             .collect();
         for &h in &hashes {
@@ -275,8 +275,7 @@ pub fn shoot(
     keep: impl Fn(PhotonPath) -> (bool, bool) + Sync,
     counts: &mut RayCounts,
 ) -> (Vec<Photon>, Vec<Photon>) {
-    const CHUNK: u32 = 4096;
-    let chunks = count.div_ceil(CHUNK);
+    let chunks = count.div_ceil(PARTICLE_CHUNK);
     let key = hash_combine(key, 0x5048_4f54_4f4e);
     let results: Vec<(Vec<Photon>, Vec<Photon>, u64)> = (0..chunks)
         .into_par_iter()
@@ -284,8 +283,8 @@ pub fn shoot(
             let mut sampler = Sampler::new(SamplerKind::Independent, key, 0);
             let (mut first, mut second) = (Vec::new(), Vec::new());
             let mut rays = RayCounts::default();
-            let end = ((chunk + 1) * CHUNK).min(count);
-            for index in chunk * CHUNK..end {
+            let end = ((chunk + 1) * PARTICLE_CHUNK).min(count);
+            for index in chunk * PARTICLE_CHUNK..end {
                 sampler.start(index, 0);
                 trace_photon(
                     scene,
@@ -306,13 +305,38 @@ pub fn shoot(
             (first, second, rays.bounce)
         })
         .collect();
-    let (mut first, mut second) = (Vec::new(), Vec::new());
-    for (a, b, rays) in results {
-        first.extend(a);
-        second.extend(b);
-        counts.bounce += rays;
-    }
+    counts.bounce += results.iter().map(|r| r.2).sum::<u64>();
+    let first = concat(&results.iter().map(|r| r.0.as_slice()).collect::<Vec<_>>());
+    let second = concat(&results.iter().map(|r| r.1.as_slice()).collect::<Vec<_>>());
     (first, second)
+}
+
+/// Particles (photons, VCM's light paths) traced per parallel task: small
+/// enough that the last tasks of a pass leave few of 16 threads idle, large
+/// enough that a task's set-up is nothing beside its paths.
+pub(crate) const PARTICLE_CHUNK: u32 = 1024;
+
+/// The parts one after another, copied in parallel: at 16 threads a serial
+/// copy of a pass's photons or light vertices would be a large share of the
+/// pass.
+pub(crate) fn concat<T: Copy + Send + Sync>(parts: &[&[T]]) -> Vec<T> {
+    let total = parts.iter().map(|p| p.len()).sum();
+    let mut out = Vec::with_capacity(total);
+    let mut rest = &mut out.spare_capacity_mut()[..total];
+    let mut places = Vec::with_capacity(parts.len());
+    for part in parts {
+        let (place, tail) = rest.split_at_mut(part.len());
+        places.push(place);
+        rest = tail;
+    }
+    places.into_par_iter().zip(parts).for_each(|(place, part)| {
+        for (slot, &item) in place.iter_mut().zip(part.iter()) {
+            slot.write(item);
+        }
+    });
+    // SAFETY: the places cover the first `total` slots, each written above.
+    unsafe { out.set_len(total) };
+    out
 }
 
 /// Traces one photon from the lights and hands every landing on a

@@ -27,7 +27,7 @@
 //! the scene at the shutter's opening, as the photon mappers do.
 
 use super::light::{importance_weight, sample_particle};
-use super::photon_map::{self, PhotonMap, Stored};
+use super::photon_map::{self, PARTICLE_CHUNK, PhotonMap, Stored, concat};
 use super::{MisHeuristic, MultiPassEstimator, PathLength, RayCounts, Settings, Technique};
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::film::splats::{PendingSplats, SplatBuffer};
@@ -501,9 +501,9 @@ impl MultiPassEstimator for Vcm {
             vc_factor: self.mis(1.0 / eta),
             time: scene.camera.shutter_open,
         };
-        const CHUNK: u32 = 4096;
         let key = hash_combine(hash_combine(seed, u64::from(pass)), 0x56_434d);
-        let chunks: Vec<(Vec<LightVertex>, Vec<u32>, RayCounts)> = (0..paths.div_ceil(CHUNK))
+        let chunks: Vec<(Vec<LightVertex>, Vec<u32>, RayCounts)> = (0..paths
+            .div_ceil(PARTICLE_CHUNK))
             .into_par_iter()
             .map(|chunk| {
                 let mut sampler = Sampler::new(SamplerKind::Independent, key, 0);
@@ -511,7 +511,7 @@ impl MultiPassEstimator for Vcm {
                 let mut ends = Vec::new();
                 let mut rays = RayCounts::default();
                 let mut splats = PendingSplats::new();
-                for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(paths) {
+                for index in chunk * PARTICLE_CHUNK..((chunk + 1) * PARTICLE_CHUNK).min(paths) {
                     sampler.start(index, 0);
                     self.trace_light_path(
                         scene,
@@ -527,16 +527,16 @@ impl MultiPassEstimator for Vcm {
                 (vertices, ends, rays)
             })
             .collect();
-        let mut vertices = Vec::new();
         let mut starts = Vec::with_capacity(paths as usize + 1);
         starts.push(0);
-        for (chunk, ends, rays) in chunks {
-            let offset = vertices.len() as u32;
+        let mut offset = 0;
+        for (chunk, ends, rays) in &chunks {
             starts.extend(ends.iter().map(|e| e + offset));
-            vertices.extend(chunk);
+            offset += chunk.len() as u32;
             counts.bounce += rays.bounce;
             counts.shadow += rays.shadow;
         }
+        let vertices = concat(&chunks.iter().map(|c| c.0.as_slice()).collect::<Vec<_>>());
         iteration.starts = starts;
         iteration.map = PhotonMap::build(vertices, radius);
         iteration
