@@ -522,6 +522,14 @@ impl DiffuseHit {
 mod tests {
     use super::*;
 
+    #[test]
+    fn concat_keeps_every_part_in_order() {
+        let parts: Vec<Vec<u32>> = vec![vec![], vec![1, 2, 3], vec![], vec![4], vec![5, 6]];
+        let slices: Vec<&[u32]> = parts.iter().map(Vec::as_slice).collect();
+        assert_eq!(concat(&slices), vec![1, 2, 3, 4, 5, 6]);
+        assert!(concat::<u32>(&[]).is_empty());
+    }
+
     fn cloud() -> Vec<Photon> {
         let mut state = 12345u64;
         let mut next = || {
