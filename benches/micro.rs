@@ -118,3 +118,33 @@ fn sampler_2d(bencher: Bencher, kind: SamplerKind) {
             sum
         });
 }
+
+/// One environment sample and its irradiance term on an upward plane, under
+/// the tests' sky (its sun 800 times the sky): by the map's density, and by
+/// uniform directions. With the variance per sample that
+/// `tests/materials.rs` reports, the cost per sample gives the error at
+/// equal time (`docs/performance.md`).
+#[divan::bench(args = ["importance", "uniform"])]
+fn environment_sample(bencher: Bencher, kind: &str) {
+    use tracelab::scene::environment::{Environment, Radiance};
+    use tracelab::texture::Bitmap;
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/materials/sky.exr");
+    let sky = std::sync::Arc::new(Bitmap::read(&path, false).expect("the tests' sky"));
+    let mut env = Environment::new(Radiance::Map(sky), 1.0, glam::Mat3A::IDENTITY);
+    if kind == "uniform" {
+        env = env.with_uniform_sampling();
+    }
+    let us: Vec<Vec2> = (0..1024u64).map(|i| unit(i, 0x5eed)).collect();
+    bencher
+        .counter(divan::counter::ItemsCount::new(us.len()))
+        .bench_local(|| {
+            let mut sum = 0.0f32;
+            for &u in &us {
+                if let Some((d, le, pdf)) = env.sample(black_box(u)) {
+                    sum += le.x * d.y.max(0.0) / pdf;
+                }
+            }
+            sum
+        });
+}
