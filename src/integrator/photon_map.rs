@@ -3,8 +3,9 @@
 //! vertex connection and merging (`vcm/`, for its light vertices).
 //!
 //! Photons are found through a hash grid of cells of side 2R built once per
-//! map (a counting sort of photon indices by cell), R the largest radius a
-//! lookup may use: a query sphere then touches at most 2 x 2 x 2 cells.
+//! map (a counting sort of photon positions and indices by cell), R the
+//! largest radius a lookup may use: a query sphere then touches at most
+//! 2 x 2 x 2 cells.
 //! Every lookup of an iteration has the same largest radius and the map is
 //! rebuilt every iteration, so a k-d tree's balancing and general
 //! nearest-neighbour machinery buy nothing here; SmallVCM's hash grid works
