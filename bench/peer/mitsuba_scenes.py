@@ -14,6 +14,18 @@ Neither is given a thread count: both use every core.
 
 `--extra` adds other files (Bitterli's interiors, see bench/peer/load.py),
 rendered at their own resolution and max_depth.
+
+`--rmse` measures time to equal error instead, on the shipped scenes at a
+reduced resolution (`--rmse-size`): a reference by Mitsuba 3 at
+`--reference-spp` (seed 7), then both renderers at 1, 2, 4, ... spp up to
+`--max-spp`, each sampler (Mitsuba: independent, multijitter; tracelab:
+independent, sobol), RMSE against the reference, and the time to reach
+two targets (Mitsuba's independent sampler's RMSE at 16 and 64 spp) by
+log-log interpolation between checkpoints, as `bench/peer/mitsuba.py` does
+for the Cornell box. Times are render times (Mitsuba after a warm-up;
+tracelab's summary line). The reference's own noise is in every RMSE, the
+same for both: its floor is printed (the reference against a second one
+at a quarter of its spp, scaled down by the square root of 5).
 """
 
 import argparse
@@ -39,8 +51,18 @@ def main():
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--variant", default="llvm_ad_rgb")
     ap.add_argument("--extra", nargs="*", default=[])
+    ap.add_argument("--rmse", action="store_true", help="time to equal RMSE instead (see above)")
+    ap.add_argument("--rmse-size", default="veach-mis=320x180,veach-bidir=128x128")
+    ap.add_argument("--reference-spp", type=int, default=8192)
+    ap.add_argument("--max-spp", type=int, default=1024)
     args = ap.parse_args()
     mi.set_variant(args.variant)
+    if args.rmse:
+        for item in args.rmse_size.split(","):
+            name, size = item.split("=")
+            w, h = (int(v) for v in size.split("x"))
+            time_to_rmse(args, name, w, h)
+        return
     print("scene | resolution | spp | Mitsuba load s | Mitsuba render s | tracelab load s | tracelab render s | tracelab process s | render ratio")
     runs = [(name, os.path.join(REPO, "scenes", name, "scene.xml"), size)
             for name, size in SCENES.items()]
@@ -69,6 +91,88 @@ def main():
         ours_render = float(re.search(r"^spp \d+ \| ([0-9.]+) s", out.stdout + out.stderr, re.M).group(1))
         print(f"{name} | {w}x{h} | {args.spp} | {load:.2f} | {render:.2f} | {ours_load:.2f} | "
               f"{ours_render:.2f} | {process:.2f} | {render / ours_render:.2f}")
+
+
+def time_to_rmse(args, name, w, h):
+    path = os.path.join(REPO, "scenes", name, "scene.xml")
+
+    def mitsuba(spp, seed, sampler="independent", warm_up=True):
+        # The files fix their sampler: another is read from a copy beside them.
+        file = path
+        if sampler != "independent":
+            file = os.path.join(os.path.dirname(path), f".mitsuba3_{sampler}_scene.xml")
+            with open(file, "w") as f:
+                f.write(open(path).read().replace('<sampler type="independent"', f'<sampler type="{sampler}"'))
+        try:
+            scene = mi.load_file(file, integrator="path", resx=w, resy=h, spp=spp)
+        finally:
+            if file != path:
+                os.remove(file)
+        if warm_up:  # kernel compilation outside the timed render
+            np.array(mi.render(scene, seed=seed + 1000, spp=spp))
+        start = time.perf_counter()
+        image = np.array(mi.render(scene, seed=seed, spp=spp))[..., :3]
+        return image, time.perf_counter() - start
+
+    def tracelab(spp, sampler):
+        out = subprocess.run(
+            [args.tracelab, "render", path, "-D", f"resx={w}", "-D", f"resy={h}",
+             "--integrator", "path", "--sampler", sampler, "--spp", str(spp),
+             "--out", "/tmp/mitsuba_scenes_rmse.exr"],
+            capture_output=True, text=True, check=True)
+        seconds = float(re.search(r"^spp \d+ \| ([0-9.]+) s", out.stdout + out.stderr, re.M).group(1))
+        return np.array(mi.Bitmap("/tmp/mitsuba_scenes_rmse.exr"))[..., :3], seconds
+
+    def rmse(a, b):
+        return float(np.sqrt(np.mean((a - b) ** 2)))
+
+    reference, seconds = mitsuba(args.reference_spp, 7, warm_up=False)
+    quarter, _ = mitsuba(args.reference_spp // 4, 8, warm_up=False)
+    # E|q - r|² = σ²(1/n + 4/n) per pixel: the reference's own share is a fifth.
+    floor = rmse(quarter, reference) / np.sqrt(5.0)
+    print(f"\n{name} {w}x{h}: reference {args.reference_spp} spp in {seconds:.1f} s, its noise (RMSE) {floor:.5f}")
+    runs = [("mitsuba independent", lambda n: mitsuba(n, 1)),
+            ("mitsuba multijitter", lambda n: mitsuba(n, 1, "multijitter")),
+            ("tracelab independent", lambda n: tracelab(n, "independent")),
+            ("tracelab sobol", lambda n: tracelab(n, "sobol"))]
+    curves = {}
+    for label, render in runs:
+        points, spp = [], 1
+        while spp <= args.max_spp:
+            image, t = render(spp)
+            points.append((spp, t, rmse(image, reference)))
+            spp *= 2
+        curves[label] = points
+        print(f"{label}: " + ", ".join(f"{n} spp {t:.3f} s {e:.5f}" for n, t, e in points))
+    by_spp = {n: e for n, _, e in curves["mitsuba independent"]}
+    targets = [by_spp[16], by_spp[64]]
+    print("| configuration | " + " | ".join(f"time to RMSE {t:.4f}" for t in targets) + " |")
+    print("|---|---|---|")
+    best = {}
+    for label, points in curves.items():
+        times = [interpolate([(t, e) for _, t, e in points], target) for target in targets]
+        for i, t in enumerate(times):
+            key = (label.split()[0], i)
+            if t is not None and (key not in best or t < best[key]):
+                best[key] = t
+        print(f"| {label} | " + " | ".join(f"{t:.3f} s" if t else "not reached" for t in times) + " |")
+    for i, target in enumerate(targets):
+        if ("tracelab", i) in best and ("mitsuba", i) in best:
+            print(f"RMSE {target:.4f}: tracelab's best / Mitsuba's best time = "
+                  f"{best[('tracelab', i)] / best[('mitsuba', i)]:.2f} (issue 38 asks at most 0.8)")
+
+
+def interpolate(points, target):
+    """points: [(seconds, rmse)] by increasing spp; log-log between the two
+    checkpoints that bracket `target`."""
+    import math
+    if points and points[0][1] <= target:
+        return points[0][0]
+    for (ta, ea), (tb, eb) in zip(points, points[1:]):
+        if eb <= target < ea:
+            f = (math.log(target) - math.log(ea)) / (math.log(eb) - math.log(ea))
+            return math.exp(math.log(ta) + f * (math.log(tb) - math.log(ta)))
+    return None
 
 
 def load_copy(path):
