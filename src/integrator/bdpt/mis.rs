@@ -3,10 +3,10 @@
 //! (Veach 1997, 10.2), the ratios walked vertex by vertex from the stored
 //! forward and reverse densities (area measure), which stays finite for long
 //! paths where products of densities would not. The part of the sum that no
-//! connection changes is summed once per subpath. Here too: the densities
-//! (area) with which one vertex samples the next, which the weights read.
+//! connection changes is summed once per subpath. Here too: the density
+//! (area) with which a light point's particle reaches a vertex.
 
-use super::{Bdpt, Connection, Kind, Vertex};
+use super::{Bdpt, Connection, Vertex};
 use crate::integrator::MisHeuristic;
 use crate::scene::Scene;
 
@@ -116,28 +116,6 @@ impl Bdpt {
         let weight = 1.0 / (1.0 + camera_sum + light_sum);
         if weight.is_finite() { weight } else { 0.0 }
     }
-}
-
-/// The density (area, at `next`) with which vertex `v`, reached from
-/// `previous`, samples `next`.
-#[inline]
-pub(super) fn pdf(scene: &Scene, v: &Vertex, previous: Option<&Vertex>, next: &Vertex) -> f32 {
-    let d = next.point - v.point;
-    let dist = d.length();
-    if !(dist > 0.0) {
-        return 0.0;
-    }
-    let w = d / dist;
-    let pdf_direction = match v.kind {
-        Kind::Camera => scene.camera.pdf_direction(w),
-        Kind::Light => return light_direction_pdf(scene, v, next),
-        Kind::Surface => {
-            let wo = previous.map_or(v.wo, |p| (p.point - v.point).normalize_or_zero());
-            let frame = v.frame();
-            v.bsdf.pdf(frame.to_local(wo), frame.to_local(w))
-        }
-    };
-    v.area_density_at(pdf_direction, next)
 }
 
 /// The density (area, at `next`) with which a particle leaving the light

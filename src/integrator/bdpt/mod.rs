@@ -41,7 +41,7 @@ use std::cell::RefCell;
 mod mis;
 mod vertex;
 
-use mis::{light_direction_pdf, pdf};
+use mis::light_direction_pdf;
 use vertex::{Kind, Local, Subpath, Vertex, emission_of, origin_density, surface_vertex};
 
 /// The deepest path bidirectional path tracing makes: subpaths live in
@@ -522,7 +522,7 @@ impl Bdpt {
             return Some(Connection {
                 value,
                 film: Some(c.film),
-                qs_rev: pdf(scene, &lens, None, qs),
+                qs_rev: lens.area_density_at(scene.camera.pdf_direction(-c.wi), qs),
                 qs_minus_rev: pdf_back * light_local[s - 1].to_previous,
                 // The lens point's own densities are never read.
                 pt_rev: 0.0,
