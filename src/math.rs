@@ -120,7 +120,7 @@ pub fn next_float_down(v: f32) -> f32 {
 /// away from `p`, puts the origin strictly on that side of the surface, so the
 /// new ray cannot hit the surface it starts on; no epsilon, at any scale
 /// (pbrt-v4, 6.8.6 "Robust Spawned Ray Origins").
-#[inline]
+#[inline(always)]
 pub fn offset_ray_origin(p: Vec3A, p_error: Vec3A, n: Vec3A, w: Vec3A) -> Vec3A {
     let d = n.abs().dot(p_error);
     let mut offset = d * n;

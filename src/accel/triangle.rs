@@ -19,7 +19,7 @@ pub struct ShearedRay {
 /// Axes (kx, ky, kz) of the watertight test: kz is the direction's dominant
 /// axis, and kx, ky are swapped when it points down kz so that the sheared
 /// triangle keeps its winding.
-#[inline]
+#[inline(always)]
 pub fn permuted_axes(d: Vec3A) -> (usize, usize, usize) {
     // The largest |d| component, the first of equal ones (as glam's
     // `max_position`), chosen by selects: every ray does this once.

@@ -3,7 +3,7 @@
 //! One-sided unless the material says otherwise (the dispatch flips).
 
 use super::BsdfSample;
-use super::fresnel::fresnel_conductor;
+use super::fresnel::{fresnel_conductor, fresnel_conductor_normal};
 use crate::math::Rgb;
 use glam::Vec3A;
 
@@ -35,6 +35,6 @@ impl Conductor {
 
     /// Reflectance at normal incidence, the hint for roulette and lobe choice.
     pub fn albedo_hint(&self) -> f32 {
-        (self.tint * fresnel_conductor(1.0, self.eta, self.k)).max_element()
+        (self.tint * fresnel_conductor_normal(self.eta, self.k)).max_element()
     }
 }

@@ -67,6 +67,16 @@ pub fn fresnel_conductor(cos_i: f32, eta: Rgb, k: Rgb) -> Rgb {
     (0.5 * (rs + rp)).clamp(Rgb::ZERO, Rgb::ONE)
 }
 
+/// [`fresnel_conductor`] at normal incidence, ((η − 1)² + k²) / ((η + 1)² + k²):
+/// the same value without the square roots, for tests made at every hit.
+#[inline]
+pub fn fresnel_conductor_normal(eta: Rgb, k: Rgb) -> Rgb {
+    let k2 = k * k;
+    let below = (eta - Rgb::ONE) * (eta - Rgb::ONE) + k2;
+    let above = (eta + Rgb::ONE) * (eta + Rgb::ONE) + k2;
+    below / above.max(Rgb::splat(1e-30))
+}
+
 /// Fraction of uniformly diffuse light that a smooth interface of relative
 /// IOR `eta` reflects: 2 ∫ F(cos) cos d(cos). The polynomial fits of d'Eon
 /// and Irving that Mitsuba uses, so that plastics match it.
@@ -113,6 +123,10 @@ mod tests {
         let expected = ((eta - 1.0).powi(2) + k * k) / ((eta + 1.0).powi(2) + k * k);
         let c = fresnel_conductor(1.0, Rgb::splat(eta), Rgb::splat(k));
         assert!((c.x - expected).abs() < 1e-5);
+        let n = fresnel_conductor_normal(Rgb::new(eta, 1.0, 1.5), Rgb::new(k, 0.0, 0.0));
+        assert!((n.x - expected).abs() < 1e-6);
+        assert_eq!(n.y, 0.0, "eta 1, k 0 reflects nothing");
+        assert!((n.z - 0.04).abs() < 1e-6);
         assert!(fresnel_conductor(0.0, Rgb::splat(eta), Rgb::splat(k)).x > 0.999);
     }
 

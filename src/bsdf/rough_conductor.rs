@@ -4,7 +4,7 @@
 //! One-sided unless the material says otherwise (the dispatch flips).
 
 use super::BsdfSample;
-use super::fresnel::fresnel_conductor;
+use super::fresnel::{fresnel_conductor, fresnel_conductor_normal};
 use super::microfacet::Microfacet;
 use crate::math::Rgb;
 use glam::{Vec2, Vec3A};
@@ -76,6 +76,6 @@ impl RoughConductor {
     }
 
     pub fn albedo_hint(&self) -> f32 {
-        (self.tint * fresnel_conductor(1.0, self.eta, self.k)).max_element()
+        (self.tint * fresnel_conductor_normal(self.eta, self.k)).max_element()
     }
 }
