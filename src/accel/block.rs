@@ -92,22 +92,38 @@ impl Block {
         }
     }
 
-    /// True when a triangle of this block is hit in (0, t_max).
+    /// True when a triangle of this block that `accept` (called with its
+    /// index) accepts is hit in (0, t_max).
     #[inline(always)]
-    pub fn any(&self, axes: &Axes, ray: &Ray, triangles: &[[Vec3A; 3]], t_max: f32) -> bool {
+    pub fn any_where(
+        &self,
+        axes: &Axes,
+        ray: &Ray,
+        triangles: &[[Vec3A; 3]],
+        t_max: f32,
+        accept: &mut impl FnMut(usize) -> bool,
+    ) -> bool {
         let Some(hits) = block_hits(self, axes, t_max) else {
             return false;
         };
-        if hits.mask != 0 {
-            return true;
+        let first = self.first as usize;
+        let mut lanes = hits.mask;
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            if accept(first + lane) {
+                return true;
+            }
         }
         let mut lanes = hits.ambiguous;
         while lanes != 0 {
             let lane = lanes.trailing_zeros() as usize;
             lanes &= lanes - 1;
+            let index = first + lane;
             if ShearedRay::new(ray)
-                .intersect(&triangles[self.first as usize + lane], t_max)
+                .intersect(&triangles[index], t_max)
                 .is_some()
+                && accept(index)
             {
                 return true;
             }

@@ -45,6 +45,16 @@ impl Masks {
         by_material.iter().any(|o| *o != Opacity::Opaque)
     }
 
+    /// True when every hit on `material` is kept.
+    #[inline]
+    pub fn is_opaque(&self, material: u32) -> bool {
+        match self.by_material.get(material as usize) {
+            None | Some(Opacity::Opaque) => true,
+            Some(Opacity::Constant(a)) => *a >= 1.0,
+            Some(Opacity::Texture(_)) => false,
+        }
+    }
+
     /// True when the hit of `ray` at `point` on `material`, with texture
     /// coordinates from `uv`, is kept.
     #[inline]

@@ -556,19 +556,48 @@ impl Geometry {
     /// (shadow rays).
     #[inline(always)]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let blocked = self.occluded_static(ray)
-            || (!self.instances.is_empty() && self.instances.any(ray))
+        if let Some(masks) = &self.masks {
+            return self.occluded_masked(ray, masks);
+        }
+        self.occluded_static(ray) || self.occluded_elsewhere(ray)
+    }
+
+    /// Occlusion where masks cut holes: one any-hit traversal that counts
+    /// only opaque triangles settles most shadow rays; a ray that met a
+    /// masked triangle, or is blocked by anything but triangles at rest, is
+    /// followed through the hits by closest-hit queries (out of line: only
+    /// scenes with masks come here).
+    #[inline(never)]
+    fn occluded_masked(&self, ray: &Ray, masks: &Masks) -> bool {
+        let mut met_mask = false;
+        let mut opaque = |i: usize| {
+            let opaque = masks.is_opaque(self.tri_shading[i].material);
+            met_mask |= !opaque;
+            opaque
+        };
+        let (vertices, t_max) = (&self.tri_vertices, ray.t_max);
+        let opaque_triangle = match &self.tri_index {
+            TriangleIndex::Empty => false,
+            TriangleIndex::Soup(soup) => soup.any_where(ray, t_max, vertices, &mut opaque),
+            TriangleIndex::Bvh(bvh) => bvh.any_where(ray, t_max, vertices, &mut opaque),
+        };
+        if opaque_triangle {
+            return true;
+        }
+        let maybe = met_mask || self.spheres_block(ray) || self.occluded_elsewhere(ray);
+        maybe && self.intersect_masked(ray, masks).is_some()
+    }
+
+    /// Occlusion by instances and moving objects.
+    #[inline(always)]
+    fn occluded_elsewhere(&self, ray: &Ray) -> bool {
+        (!self.instances.is_empty() && self.instances.any(ray))
             || self.moving.iter().any(|m| {
                 m.geometry.occluded_static(&Ray {
                     origin: ray.origin - ray.time * m.velocity,
                     ..*ray
                 })
-            });
-        // Masks only remove hits: a ray nothing blocks stays unblocked.
-        match &self.masks {
-            Some(masks) if blocked => self.intersect_masked(ray, masks).is_some(),
-            _ => blocked,
-        }
+            })
     }
 
     #[inline(always)]
@@ -578,9 +607,12 @@ impl Geometry {
             TriangleIndex::Soup(soup) => soup.any(ray, ray.t_max, &self.tri_vertices),
             TriangleIndex::Bvh(bvh) => bvh.any(ray, ray.t_max, &self.tri_vertices),
         };
-        if triangle_blocks {
-            return true;
-        }
+        triangle_blocks || self.spheres_block(ray)
+    }
+
+    /// True when a sphere at rest is hit in (0, ray.t_max).
+    #[inline(always)]
+    fn spheres_block(&self, ray: &Ray) -> bool {
         if self.sphere_bvh.is_none() {
             return self.spheres.iter().any(|s| {
                 intersect_sphere(ray.origin, ray.direction, s.center, s.radius, ray.t_max).is_some()

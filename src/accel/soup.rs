@@ -157,6 +157,18 @@ impl TriangleSoup {
     /// True when any triangle is hit in (0, t_max).
     #[inline(always)]
     pub fn any(&self, ray: &Ray, t_max: f32, triangles: &[[Vec3A; 3]]) -> bool {
+        self.any_where(ray, t_max, triangles, &mut |_| true)
+    }
+
+    /// True when a triangle that `accept` accepts is hit in (0, t_max).
+    #[inline(always)]
+    pub fn any_where(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        triangles: &[[Vec3A; 3]],
+        accept: &mut impl FnMut(usize) -> bool,
+    ) -> bool {
         let axes = Axes::new(ray);
         let blocks = if self.inner_blocks < self.blocks.len() && self.segment_inside(ray, t_max) {
             &self.blocks[..self.inner_blocks]
@@ -164,7 +176,7 @@ impl TriangleSoup {
             &self.blocks[..]
         };
         for block in blocks {
-            if block.any(&axes, ray, triangles, t_max) {
+            if block.any_where(&axes, ray, triangles, t_max, accept) {
                 return true;
             }
         }

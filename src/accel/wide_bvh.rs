@@ -176,6 +176,19 @@ impl WideBvh {
     /// True when any triangle is hit in (0, t_max).
     #[inline]
     pub fn any(&self, ray: &Ray, t_max: f32, triangles: &[[Vec3A; 3]]) -> bool {
+        self.any_where(ray, t_max, triangles, &mut |_| true)
+    }
+
+    /// True when a triangle that `accept` (called with its index) accepts
+    /// is hit in (0, t_max).
+    #[inline(always)]
+    pub fn any_where(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        triangles: &[[Vec3A; 3]],
+        accept: &mut impl FnMut(usize) -> bool,
+    ) -> bool {
         let axes = Axes::new(ray);
         let slabs = SlabAxes::new(ray);
         let mut stack = [0u32; STACK_SIZE];
@@ -185,7 +198,8 @@ impl WideBvh {
             top -= 1;
             let child = stack[top];
             if child & LEAF_BIT != 0 {
-                if self.leaves[(child & !LEAF_BIT) as usize].any(&axes, ray, triangles, t_max) {
+                let leaf = &self.leaves[(child & !LEAF_BIT) as usize];
+                if leaf.any_where(&axes, ray, triangles, t_max, accept) {
                     return true;
                 }
                 continue;
