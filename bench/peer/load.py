@@ -13,10 +13,13 @@ BVH) and the process's peak RSS for a 1-spp render at 64 x 64.
     pip install mitsuba   # and apt-get install libllvm19
     python3 bench/peer/load.py SCENE.xml [SCENE.xml ...] [--tracelab target/release/tracelab]
 
-Bitterli's interiors in Mitsuba 0.6 form (staircase, living-room; CC-BY,
-credits in each folder's LICENSE.txt) come with
+Bitterli's interiors in Mitsuba 0.6 form (staircase, living-room, kitchen;
+CC-BY, credits in each folder's LICENSE.txt) come with
 github.com/jgarciapueyo/mitsuba2-transient-scenes; Mitsuba 3 reads their
-0.5 camelCase names after upgrading them, as tracelab does.
+0.5 camelCase names after upgrading them, as tracelab does. That
+repository lacks 6 of the kitchen's mesh files (Mesh054, 090, 145, 273,
+275, 294): measure a copy of its scene.xml without the shapes that name
+them.
 """
 
 import argparse

@@ -45,9 +45,24 @@ pub(super) fn build_bvh2(aabbs: &[Aabb]) -> Bvh2 {
 /// The triangles' 8-wide BVH and the order to store them in, or None when
 /// the tree would be deeper than its traversal stack (many nearly coincident
 /// triangles, found by fuzzing, make PLOC produce chains).
+#[cfg(test)]
 pub(super) fn build_wide_bvh(triangles: &[[Vec3A; 3]]) -> Option<(WideBvh, Vec<usize>)> {
-    let aabbs: Vec<Aabb> = triangles.iter().map(|t| Aabb::from_points(t)).collect();
-    WideBvh::from_bvh2(&build_bvh2(&aabbs), triangles)
+    build_wide_bvh_with(triangles.len(), &|i| triangles[i])
+}
+
+/// [`build_wide_bvh`] over `count` triangles read by index, so that a
+/// caller need not copy them into an array first.
+pub(super) fn build_wide_bvh_with(
+    count: usize,
+    vertices: &dyn Fn(usize) -> [Vec3A; 3],
+) -> Option<(WideBvh, Vec<usize>)> {
+    let aabbs: Vec<Aabb> = (0..count)
+        .map(|i| Aabb::from_points(&vertices(i)))
+        .collect();
+    let bvh2 = build_bvh2(&aabbs);
+    // Gone before the collapse allocates the tree.
+    drop(aabbs);
+    WideBvh::from_bvh2(&bvh2, count, vertices)
 }
 
 /// A CWBVH over `aabbs` (spheres), or None when it would be too deep to
@@ -132,8 +147,10 @@ impl Geometry {
             return Vec::new();
         }
         if !use_soup {
-            let vertices: Vec<[Vec3A; 3]> = triangles.iter().map(|t| t.vertices).collect();
-            if let Some((bvh, order)) = build_wide_bvh(&vertices) {
+            // Read in place: a copy of the vertices would add 48 bytes a
+            // triangle to the build's peak.
+            let built = build_wide_bvh_with(triangles.len(), &|i| triangles[i].vertices);
+            if let Some((bvh, order)) = built {
                 self.store_in_order(triangles, &order);
                 self.tri_index = TriangleIndex::Bvh(bvh);
                 return order;

@@ -268,6 +268,11 @@ impl Geometry {
     /// arrays at their length, not capacity), for the memory-per-triangle
     /// figure of `cargo bench --bench scaling`.
     pub fn memory_bytes(&self) -> usize {
+        self.memory_parts().iter().map(|(_, bytes)| bytes).sum()
+    }
+
+    /// [`Geometry::memory_bytes`] by part, for the render summary.
+    pub fn memory_parts(&self) -> [(&'static str, usize); 7] {
         use std::mem::size_of_val;
         let bvh = |b: &CwBvh| {
             size_of_val(&b.nodes[..])
@@ -281,17 +286,24 @@ impl Geometry {
             TriangleIndex::Soup(soup) => soup.memory_bytes(),
             TriangleIndex::Bvh(b) => b.memory_bytes(),
         };
-        size_of_val(&self.tri_vertices[..])
-            + size_of_val(&self.tri_shading[..])
-            + index
-            + self.sphere_bvh.as_ref().map_or(0, bvh)
-            + size_of_val(&self.spheres[..])
-            + self
-                .moving
-                .iter()
-                .map(|m| m.geometry.memory_bytes())
-                .sum::<usize>()
-            + self.instances.memory_bytes()
+        let elsewhere = self
+            .moving
+            .iter()
+            .map(|m| m.geometry.memory_bytes())
+            .sum::<usize>()
+            + self.instances.memory_bytes();
+        [
+            ("vertices", size_of_val(&self.tri_vertices[..])),
+            ("normals and materials", size_of_val(&self.tri_shading[..])),
+            ("uv", size_of_val(&self.tri_uvs[..])),
+            ("shading normals", size_of_val(&self.tri_normals[..])),
+            ("BVH", index),
+            (
+                "spheres",
+                self.sphere_bvh.as_ref().map_or(0, bvh) + size_of_val(&self.spheres[..]),
+            ),
+            ("instances and moving objects", elsewhere),
+        ]
     }
 
     /// Triangle vertices in BVH order.

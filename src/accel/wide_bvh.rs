@@ -46,21 +46,26 @@ pub struct WideBvh {
 }
 
 impl WideBvh {
-    /// Collapses `bvh2` (built over `triangles`). Returns the tree and the
-    /// order in which the caller must store the triangles (tree triangle i is
-    /// `triangles[order[i]]`), or None when the tree would be deeper than the
+    /// Collapses `bvh2` (built over `count` triangles, triangle i's
+    /// corners `vertices(i)`). Returns the tree and the order in which the
+    /// caller must store the triangles (tree triangle i is triangle
+    /// `order[i]`), or None when the tree would be deeper than the
     /// traversal stack allows.
-    pub fn from_bvh2(bvh2: &Bvh2, triangles: &[[Vec3A; 3]]) -> Option<(Self, Vec<usize>)> {
+    pub fn from_bvh2(
+        bvh2: &Bvh2,
+        count: usize,
+        vertices: &dyn Fn(usize) -> [Vec3A; 3],
+    ) -> Option<(Self, Vec<usize>)> {
         if bvh2.nodes.is_empty() {
             return None;
         }
         let mut builder = Builder {
             bvh2,
             counts: subtree_counts(bvh2),
-            triangles,
+            vertices,
             nodes: Vec::new(),
             leaves: Vec::new(),
-            order: Vec::with_capacity(triangles.len()),
+            order: Vec::with_capacity(count),
             scratch: Vec::with_capacity(LEAF_MAX),
         };
         let root = builder.collapse(0, 1)?;
@@ -222,7 +227,7 @@ struct Builder<'a> {
     bvh2: &'a Bvh2,
     /// Primitives below each binary node.
     counts: Vec<u32>,
-    triangles: &'a [[Vec3A; 3]],
+    vertices: &'a dyn Fn(usize) -> [Vec3A; 3],
     nodes: Vec<Node>,
     leaves: Vec<Block>,
     order: Vec<usize>,
@@ -253,7 +258,7 @@ impl Builder<'_> {
     fn push_leaf(&mut self, prims: &[usize]) -> u32 {
         let mut vertices = [[Vec3A::ZERO; 3]; LANES];
         for (v, &p) in vertices.iter_mut().zip(prims) {
-            *v = self.triangles[p];
+            *v = (self.vertices)(p);
         }
         let first = self.order.len();
         self.order.extend_from_slice(prims);
@@ -320,7 +325,7 @@ impl Builder<'_> {
         }
         self.push_node(chunks.len(), |builder, lane| {
             let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-            for p in chunks[lane].iter().flat_map(|&p| builder.triangles[p]) {
+            for p in chunks[lane].iter().flat_map(|&p| (builder.vertices)(p)) {
                 (lo, hi) = (lo.min(p), hi.max(p));
             }
             Some(((lo, hi), builder.push_leaf(&chunks[lane])))
@@ -492,7 +497,7 @@ mod tests {
             })
             .collect();
         let aabbs: Vec<Aabb> = input.iter().map(|t| Aabb::from_points(t)).collect();
-        let (bvh, _) = WideBvh::from_bvh2(&build_bvh2(&aabbs), &input).unwrap();
+        let (bvh, _) = WideBvh::from_bvh2(&build_bvh2(&aabbs), input.len(), &|i| input[i]).unwrap();
         // Collapsing makes far fewer nodes than a binary tree's n - 1.
         assert!(bvh.nodes.len() < 1000 / 4, "{} nodes", bvh.nodes.len());
         assert!(bvh.leaves.len() < 1000 / 2, "{} leaves", bvh.leaves.len());

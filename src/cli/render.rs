@@ -413,6 +413,21 @@ fn print_flagged(flagged: &[FlaggedPixel], non_finite: u64, width: u32, seed: &s
     );
 }
 
+/// What the scene holds, by part: "scene memory: 412 MB (vertices 50, ...)",
+/// parts under 0.5 MB left out.
+fn memory_line(scene: &Scene) -> String {
+    let mb = |bytes: usize| bytes as f64 / (1024.0 * 1024.0);
+    let mut parts: Vec<(&str, usize)> = scene.geometry.memory_parts().to_vec();
+    parts.push(("textures", scene.texture_bytes()));
+    let total: usize = parts.iter().map(|(_, bytes)| bytes).sum();
+    let shown: Vec<String> = parts
+        .iter()
+        .filter(|(_, bytes)| mb(*bytes) >= 0.5)
+        .map(|(name, bytes)| format!("{name} {:.0}", mb(*bytes)))
+        .collect();
+    format!("scene memory: {:.0} MiB ({})", mb(total), shown.join(", "))
+}
+
 fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
     let seconds = stats.render_time.as_secs_f64();
     let rays = stats.rays.total();
@@ -424,6 +439,7 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         session.threads(),
         load_time.as_secs_f64()
     );
+    eprintln!("{}", memory_line(session.scene()));
     let pixels = f64::from(session.scene().camera.width) * f64::from(session.scene().camera.height);
     let per_pixel = |n: u64| n as f64 / pixels;
     eprintln!(

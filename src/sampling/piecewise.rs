@@ -80,6 +80,11 @@ impl Piecewise1D {
         self.len() == 0
     }
 
+    /// Bytes of the table.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(&self.cells[..])
+    }
+
     /// A point x with its density and cell.
     #[inline]
     pub fn sample(&self, u: f32) -> (f32, f32, usize) {
@@ -132,6 +137,16 @@ impl Piecewise2D {
             .collect();
         let marginal = Piecewise1D::new(&rows.iter().map(|r| r.integral).collect::<Vec<_>>());
         Piecewise2D { rows, marginal }
+    }
+
+    /// Bytes of the tables.
+    pub fn memory_bytes(&self) -> usize {
+        self.marginal.memory_bytes()
+            + self
+                .rows
+                .iter()
+                .map(Piecewise1D::memory_bytes)
+                .sum::<usize>()
     }
 
     /// A point (x, y) and its density.

@@ -148,6 +148,19 @@ impl Environment {
     }
 
     /// Power, for choosing between lights: π R² ∫ luminance(L) dω.
+    /// Bytes of the map's texels and its sampling table.
+    pub fn memory_bytes(&self) -> usize {
+        let texels = match &self.radiance {
+            Radiance::Constant(_) => 0,
+            Radiance::Map(map) => map.memory_bytes(),
+        };
+        texels
+            + self
+                .distribution
+                .as_ref()
+                .map_or(0, Piecewise2D::memory_bytes)
+    }
+
     pub fn power(&self) -> f32 {
         let mean = match &self.radiance {
             Radiance::Constant(c) => luminance(*c) * 4.0 * PI,

@@ -229,6 +229,23 @@ fn flat_light_corners(lights: &Lights) -> Vec<Option<Vec<Vec3A>>> {
 }
 
 impl Scene {
+    /// Bytes of the bitmaps (each once, however many textures share it)
+    /// and of the environment's map and sampling table.
+    pub fn texture_bytes(&self) -> usize {
+        let mut seen = std::collections::HashSet::new();
+        let bitmaps: usize = self
+            .textures
+            .iter()
+            .filter_map(|t| match t {
+                Texture::Bitmap { image, .. } => seen
+                    .insert(Arc::as_ptr(image))
+                    .then(|| image.memory_bytes()),
+                _ => None,
+            })
+            .sum();
+        bitmaps + self.lights.environment().map_or(0, |e| e.memory_bytes())
+    }
+
     /// Loads a scene file with the default limits.
     pub fn load(path: &Path) -> Result<Scene> {
         Self::load_with_limits(path, &Limits::default())
@@ -318,6 +335,8 @@ impl Scene {
                 || m.normal_map.is_some()
         });
         let mut geometry = Geometry::build_full(&triangles, spheres, AccelChoice::Auto, textured);
+        // The geometry holds its own copy, in leaf order.
+        drop(triangles);
         // An emitter is sampled where it is, mask or not: it stays whole.
         for m in input.materials.iter_mut() {
             if m.opacity != Opacity::Opaque && m.is_emissive() {

@@ -58,6 +58,7 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         .triangles
         .reserve(expected.min(options.limits.max_triangles));
     let camera = importer.scene()?;
+    prefetch::release_freed_memory();
     options.check_strict(&importer.warnings)?;
     Ok(SceneInput {
         camera,
