@@ -320,6 +320,9 @@ impl PathTracer {
             };
             let u_light = sampler.get_2d_for(vertex_dim + 1, Domain::Light);
             let u_bsdf = sampler.get_2d_for(vertex_dim + 3, Domain::Bsdf);
+            if !DIFFUSE_ONLY && self.nee {
+                scene.lights.prefetch_sample(u_light_select, u_light);
+            }
             // The camera ray tests only its pixel's candidates, if known.
             let hit = scene
                 .geometry

@@ -110,6 +110,23 @@ impl Piecewise1D {
         (x, c[i].func / self.integral, i)
     }
 
+    /// Asks the cache for the guide entry that [`Piecewise1D::sample`]
+    /// reads first for `u`: a hint, for a caller that knows u early.
+    #[inline(always)]
+    pub fn prefetch(&self, u: f32) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            let n = self.len();
+            let k = ((u * n as f32) as usize).min(n.saturating_sub(1));
+            if let Some(cell) = self.cells.get(k) {
+                // SAFETY: prefetching is a hint; it never faults, and the
+                // address is that of a live element.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>((cell as *const Cell).cast::<i8>()) };
+            }
+        }
+    }
+
     /// The density at x.
     #[inline]
     pub fn pdf(&self, x: f32) -> f32 {
@@ -155,6 +172,14 @@ impl Piecewise2D {
         let (y, pdf_y, row) = self.marginal.sample(u.y);
         let (x, pdf_x, _) = self.rows[row].sample(u.x);
         (Vec2::new(x, y), pdf_x * pdf_y)
+    }
+
+    /// Asks the cache for the row entry that [`Piecewise2D::sample`] reads
+    /// first for `u` (the marginal, small, stays cached).
+    #[inline(always)]
+    pub fn prefetch(&self, u: Vec2) {
+        let (_, _, row) = self.marginal.sample(u.y);
+        self.rows[row].prefetch(u.x);
     }
 
     /// The density at `p`.

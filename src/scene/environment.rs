@@ -134,6 +134,16 @@ impl Environment {
     }
 
     /// Density of [`Environment::sample`] at direction `d`.
+    /// Asks the cache for the table entry that [`Environment::sample`]
+    /// reads first for `u`: the caller knows u before it traces the ray
+    /// whose hit the sample lights, and the entry arrives meanwhile.
+    #[inline(always)]
+    pub fn prefetch_sample(&self, u: Vec2) {
+        if let Some(distribution) = &self.distribution {
+            distribution.prefetch(u);
+        }
+    }
+
     #[inline]
     pub fn pdf(&self, d: Vec3A) -> f32 {
         let Some(distribution) = &self.distribution else {

@@ -154,6 +154,25 @@ impl Lights {
         (s.pdf > 0.0 && s.pdf.is_finite() && s.distance > 0.0).then_some(s)
     }
 
+    /// A hint before [`Lights::sample`] with the same numbers: where that
+    /// sample would be the environment's, its first table entry is fetched
+    /// into the cache while the caller traces (living-room: the entry was
+    /// a cache miss that held 14% of path tracing's time).
+    #[inline(always)]
+    pub fn prefetch_sample(&self, u_select: f32, u: Vec2) {
+        let (Some(environment), Some(table)) = (&self.environment, &self.selection) else {
+            return;
+        };
+        let index = if self.has_choice() {
+            table.sample(u_select).0
+        } else {
+            0
+        };
+        if index >= self.lights.len() {
+            environment.prefetch_sample(u);
+        }
+    }
+
     /// Chooses a light by power and samples a particle leaving it (light tracing).
     #[inline]
     pub fn sample_emission(
