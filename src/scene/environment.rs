@@ -106,10 +106,16 @@ impl Environment {
     pub fn le(&self, d: Vec3A) -> Rgb {
         match &self.radiance {
             Radiance::Constant(c) => *c * self.scale,
-            Radiance::Map(map) => {
-                let uv = direction_to_uv(self.to_local * d);
-                lookup(map, uv) * self.scale
-            }
+            Radiance::Map(_) => self.le_at(direction_to_uv(self.to_local * d)),
+        }
+    }
+
+    /// Radiance at map coordinates `uv`.
+    #[inline]
+    fn le_at(&self, uv: Vec2) -> Rgb {
+        match &self.radiance {
+            Radiance::Constant(c) => *c * self.scale,
+            Radiance::Map(map) => lookup(map, uv) * self.scale,
         }
     }
 
@@ -129,11 +135,12 @@ impl Environment {
         let d = (self.to_world * local).normalize();
         // The density read back from the direction, as MIS reads it: at a
         // cell's edge rounding may move the direction into its neighbour.
-        let pdf = self.pdf(d);
-        (pdf > 0.0).then(|| (d, self.le(d), pdf))
+        // The radiance from the same coordinates (one atan2 and acos).
+        let uv = direction_to_uv(self.to_local * d);
+        let pdf = pdf_at(distribution, uv);
+        (pdf > 0.0).then(|| (d, self.le_at(uv), pdf))
     }
 
-    /// Density of [`Environment::sample`] at direction `d`.
     /// Asks the cache for the table entry that [`Environment::sample`]
     /// reads first for `u`: the caller knows u before it traces the ray
     /// whose hit the sample lights, and the entry arrives meanwhile.
@@ -144,17 +151,13 @@ impl Environment {
         }
     }
 
+    /// Density of [`Environment::sample`] at direction `d`.
     #[inline]
     pub fn pdf(&self, d: Vec3A) -> f32 {
         let Some(distribution) = &self.distribution else {
             return 1.0 / (4.0 * PI);
         };
-        let uv = direction_to_uv(self.to_local * d);
-        let sin_theta = (uv.y * PI).sin();
-        if sin_theta <= 0.0 {
-            return 0.0;
-        }
-        distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)
+        pdf_at(distribution, direction_to_uv(self.to_local * d))
     }
 
     /// Power, for choosing between lights: π R² ∫ luminance(L) dω.
@@ -211,6 +214,16 @@ impl Environment {
 /// places them (checked against its `eval` to 1e-5 of the peak): texel
 /// (i, j) at u = (i + 1/2) / width (wrapping), v = j / (height − 1), so the
 /// first and last rows are the poles.
+/// Density per solid angle of `distribution` at map coordinates `uv`.
+#[inline]
+fn pdf_at(distribution: &Piecewise2D, uv: Vec2) -> f32 {
+    let sin_theta = (uv.y * PI).sin();
+    if sin_theta <= 0.0 {
+        return 0.0;
+    }
+    distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)
+}
+
 #[inline]
 fn lookup(map: &Bitmap, uv: Vec2) -> Rgb {
     if !uv.is_finite() {
