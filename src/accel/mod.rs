@@ -587,13 +587,7 @@ impl Geometry {
             met_mask |= !opaque;
             opaque
         };
-        let (vertices, t_max) = (&self.tri_vertices, ray.t_max);
-        let opaque_triangle = match &self.tri_index {
-            TriangleIndex::Empty => false,
-            TriangleIndex::Soup(soup) => soup.any_where(ray, t_max, vertices, &mut opaque),
-            TriangleIndex::Bvh(bvh) => bvh.any_where(ray, t_max, vertices, &mut opaque),
-        };
-        if opaque_triangle {
+        if self.triangle_blocks(ray, &mut opaque) {
             return true;
         }
         let maybe = met_mask || self.spheres_block(ray) || self.occluded_elsewhere(ray);
@@ -614,12 +608,19 @@ impl Geometry {
 
     #[inline(always)]
     fn occluded_static(&self, ray: &Ray) -> bool {
-        let triangle_blocks = match &self.tri_index {
+        self.triangle_blocks(ray, &mut |_| true) || self.spheres_block(ray)
+    }
+
+    /// True when a triangle at rest that `accept` (called with its index)
+    /// accepts is hit in (0, ray.t_max).
+    #[inline(always)]
+    fn triangle_blocks(&self, ray: &Ray, accept: &mut impl FnMut(usize) -> bool) -> bool {
+        let (vertices, t_max) = (&self.tri_vertices, ray.t_max);
+        match &self.tri_index {
             TriangleIndex::Empty => false,
-            TriangleIndex::Soup(soup) => soup.any(ray, ray.t_max, &self.tri_vertices),
-            TriangleIndex::Bvh(bvh) => bvh.any(ray, ray.t_max, &self.tri_vertices),
-        };
-        triangle_blocks || self.spheres_block(ray)
+            TriangleIndex::Soup(soup) => soup.any_where(ray, t_max, vertices, accept),
+            TriangleIndex::Bvh(bvh) => bvh.any_where(ray, t_max, vertices, accept),
+        }
     }
 
     /// True when a sphere at rest is hit in (0, ray.t_max).

@@ -154,12 +154,6 @@ impl TriangleSoup {
         t.min_element() * (1.0 - 64.0 * f32::EPSILON)
     }
 
-    /// True when any triangle is hit in (0, t_max).
-    #[inline(always)]
-    pub fn any(&self, ray: &Ray, t_max: f32, triangles: &[[Vec3A; 3]]) -> bool {
-        self.any_where(ray, t_max, triangles, &mut |_| true)
-    }
-
     /// True when a triangle that `accept` accepts is hit in (0, t_max).
     #[inline(always)]
     pub fn any_where(
@@ -211,7 +205,7 @@ mod tests {
                 "ray {i}"
             );
             assert_eq!(
-                soup.any(&ray, 1.0, &triangles),
+                soup.any_where(&ray, 1.0, &triangles, &mut |_| true),
                 expected.is_some_and(|h| h.1 < 1.0),
                 "ray {i}"
             );
@@ -266,7 +260,11 @@ mod tests {
             skipped += usize::from(soup.segment_inside(&ray, t_max));
             let sheared = ShearedRay::new(&ray);
             let expected = stored.iter().any(|t| sheared.intersect(t, t_max).is_some());
-            assert_eq!(soup.any(&ray, t_max, &stored), expected, "ray {i}");
+            assert_eq!(
+                soup.any_where(&ray, t_max, &stored, &mut |_| true),
+                expected,
+                "ray {i}"
+            );
             // Closest hits, which skip the faces once an inner hit is nearer
             // than the box's exit, agree too.
             let closest = closest_by_scalar_test(&ray, &stored);

@@ -178,12 +178,6 @@ impl WideBvh {
         }
     }
 
-    /// True when any triangle is hit in (0, t_max).
-    #[inline]
-    pub fn any(&self, ray: &Ray, t_max: f32, triangles: &[[Vec3A; 3]]) -> bool {
-        self.any_where(ray, t_max, triangles, &mut |_| true)
-    }
-
     /// True when a triangle that `accept` (called with its index) accepts
     /// is hit in (0, t_max).
     #[inline(always)]
@@ -423,10 +417,16 @@ mod tests {
                 assert_eq!(own.map(|h| h.0), Some(t), "ray {i}");
                 hits += 1;
             }
-            assert_eq!(bvh.any(&ray, f32::INFINITY, &triangles), expected.is_some());
+            assert_eq!(
+                bvh.any_where(&ray, f32::INFINITY, &triangles, &mut |_| true),
+                expected.is_some()
+            );
             if let Some(t) = expected {
                 // Nothing is nearer than the nearest hit.
-                assert!(!bvh.any(&ray, t * 0.999, &triangles), "ray {i}");
+                assert!(
+                    !bvh.any_where(&ray, t * 0.999, &triangles, &mut |_| true),
+                    "ray {i}"
+                );
             }
         }
         assert!(hits > 100, "the rays must exercise hits ({hits})");
