@@ -413,8 +413,8 @@ fn print_flagged(flagged: &[FlaggedPixel], non_finite: u64, width: u32, seed: &s
     );
 }
 
-/// What the scene holds, by part: "scene memory: 412 MB (vertices 50, ...)",
-/// parts under 0.5 MB left out.
+/// What the scene holds, by part: "scene memory: 240 MiB (vertices 48, ...)",
+/// parts under 0.5 MiB left out.
 fn memory_line(scene: &Scene) -> String {
     let mb = |bytes: usize| bytes as f64 / (1024.0 * 1024.0);
     let mut parts: Vec<(&str, usize)> = scene.geometry.memory_parts().to_vec();
