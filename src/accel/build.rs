@@ -3,11 +3,13 @@
 //! 8-wide nodes; small meshes stay a soup; many spheres get a CWBVH.
 
 use super::*;
+use glam::Vec3;
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
 use obvhs::ploc::PlocBuilder;
+use rayon::prelude::*;
 
 fn build_params() -> BvhBuildParams {
     BvhBuildParams::medium_build()
@@ -28,13 +30,15 @@ fn cwbvh_depth(bvh: &CwBvh, node: usize) -> u32 {
     1 + deepest_child
 }
 
-/// obvhs's binary BVH over `aabbs`: PLOC, then reinsertion.
-pub(super) fn build_bvh2(aabbs: &[Aabb]) -> Bvh2 {
+/// obvhs's binary BVH over `prims`: PLOC, then reinsertion.
+pub(super) fn build_bvh2<T: obvhs::Boundable>(prims: &[T]) -> Bvh2 {
     let params = build_params();
-    let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
+    // `new`, not `with_capacity`: that sizes the Morton codes' buffer for
+    // 128-bit codes, twice what the 64-bit sort uses.
+    let mut bvh2 = PlocBuilder::new().build(
         params.ploc_search_distance,
-        aabbs,
-        (0..aabbs.len() as u32).collect::<Vec<_>>(),
+        prims,
+        (0..prims.len() as u32).collect::<Vec<_>>(),
         params.sort_precision,
         params.search_depth_threshold,
     );
@@ -42,27 +46,31 @@ pub(super) fn build_bvh2(aabbs: &[Aabb]) -> Bvh2 {
     bvh2
 }
 
+/// Triangles are bounded where they lie: an array of boxes beside them
+/// was 32 bytes a triangle more at the build's peak.
+impl obvhs::Boundable for TriangleInput {
+    fn aabb(&self) -> Aabb {
+        Aabb::from_points(&self.vertices)
+    }
+}
+
 /// The triangles' 8-wide BVH and the order to store them in, or None when
 /// the tree would be deeper than its traversal stack (many nearly coincident
 /// triangles, found by fuzzing, make PLOC produce chains).
 #[cfg(test)]
 pub(super) fn build_wide_bvh(triangles: &[[Vec3A; 3]]) -> Option<(WideBvh, Vec<usize>)> {
-    build_wide_bvh_with(triangles.len(), &|i| triangles[i])
+    let aabbs: Vec<Aabb> = triangles.iter().map(|t| Aabb::from_points(t)).collect();
+    build_wide_bvh_with(&aabbs, &|i| triangles[i])
 }
 
-/// [`build_wide_bvh`] over `count` triangles read by index, so that a
-/// caller need not copy them into an array first.
-pub(super) fn build_wide_bvh_with(
-    count: usize,
+/// [`build_wide_bvh`] over `prims` (triangle i bounded by `prims[i]`, its
+/// corners `vertices(i)`), so that a caller need not copy them first.
+pub(super) fn build_wide_bvh_with<T: obvhs::Boundable>(
+    prims: &[T],
     vertices: &dyn Fn(usize) -> [Vec3A; 3],
 ) -> Option<(WideBvh, Vec<usize>)> {
-    let aabbs: Vec<Aabb> = (0..count)
-        .map(|i| Aabb::from_points(&vertices(i)))
-        .collect();
-    let bvh2 = build_bvh2(&aabbs);
-    // Gone before the collapse allocates the tree.
-    drop(aabbs);
-    WideBvh::from_bvh2(&bvh2, count, vertices)
+    let bvh2 = build_bvh2(prims);
+    WideBvh::from_bvh2(&bvh2, prims.len(), vertices)
 }
 
 /// A CWBVH over `aabbs` (spheres), or None when it would be too deep to
@@ -87,13 +95,14 @@ impl Geometry {
         spheres: Vec<Sphere>,
         choice: AccelChoice,
     ) -> Self {
-        Self::build_full(triangles, spheres, choice, false)
+        Self::build_full(triangles.to_vec(), spheres, choice, false)
     }
 
     /// Builds, keeping texture coordinates for hits when `keep_uvs` (a
     /// material reads a texture): only then do they cost memory and time.
+    /// The triangles are moved into the geometry's arrays, not copied.
     pub fn build_full(
-        triangles: &[TriangleInput],
+        triangles: Vec<TriangleInput>,
         spheres: Vec<Sphere>,
         choice: AccelChoice,
         keep_uvs: bool,
@@ -139,26 +148,28 @@ impl Geometry {
         geometry
     }
 
-    /// Stores `triangles[i]` for each i of `order`: the order hit indices refer to.
     /// Stores the triangles as a soup or under a BVH; returns per stored
     /// triangle its index in `triangles`.
-    fn store_triangles(&mut self, triangles: &[TriangleInput], use_soup: bool) -> Vec<usize> {
+    fn store_triangles(&mut self, triangles: Vec<TriangleInput>, use_soup: bool) -> Vec<usize> {
         if triangles.is_empty() {
             return Vec::new();
         }
+        let packed = Packed::new(triangles, self.keep_uvs, self.keep_normals);
         if !use_soup {
-            // Read in place: a copy of the vertices would add 48 bytes a
-            // triangle to the build's peak.
-            let built = build_wide_bvh_with(triangles.len(), &|i| triangles[i].vertices);
+            let built = build_wide_bvh_with(&packed.corners, &|i| packed.corners[i].get());
             if let Some((bvh, order)) = built {
-                self.store_in_order(triangles, &order);
                 self.tri_index = TriangleIndex::Bvh(bvh);
+                self.store_in_order(packed, &order);
                 return order;
             }
             // Correct at any depth, if slow: better than missed hits.
             self.bvh_too_deep = true;
         }
-        self.store_soup(triangles)
+        let vertices: Vec<[Vec3A; 3]> = packed.corners.iter().map(Corners::get).collect();
+        let order = TriangleSoup::order(&vertices);
+        self.store_in_order(packed, &order);
+        self.tri_index = TriangleIndex::Soup(TriangleSoup::new(&self.tri_vertices));
+        order
     }
 
     /// A copy in which triangle `i` is replaced by `pieces[i]` where that
@@ -217,7 +228,8 @@ impl Geometry {
             instances: self.instances.clone(),
             ..Geometry::default()
         };
-        let order = geometry.store_triangles(&inputs, inputs.len() <= SOUP_MAX_TRIANGLES);
+        let use_soup = inputs.len() <= SOUP_MAX_TRIANGLES;
+        let order = geometry.store_triangles(inputs, use_soup);
         let from: Vec<u32> = order.iter().map(|&k| origin[k]).collect();
         for (slot, &old) in from.iter().enumerate() {
             geometry.tri_shading[slot].light = self.tri_shading[old as usize].light;
@@ -296,7 +308,8 @@ impl Geometry {
             masks: self.masks.clone(),
             ..Geometry::default()
         };
-        let order = geometry.store_triangles(&inputs, inputs.len() <= SOUP_MAX_TRIANGLES);
+        let use_soup = inputs.len() <= SOUP_MAX_TRIANGLES;
+        let order = geometry.store_triangles(inputs, use_soup);
         geometry.bvh_too_deep |= self.bvh_too_deep;
         for (slot, &k) in order.iter().enumerate() {
             geometry.tri_shading[slot].light = lights[k];
@@ -304,35 +317,96 @@ impl Geometry {
         geometry
     }
 
-    fn store_in_order(&mut self, triangles: &[TriangleInput], order: &[usize]) {
-        self.tri_vertices.reserve_exact(order.len());
-        self.tri_shading.reserve_exact(order.len());
-        self.tri_uvs
-            .reserve_exact(if self.keep_uvs { order.len() } else { 0 });
-        self.tri_normals
-            .reserve_exact(if self.keep_normals { order.len() } else { 0 });
-        for &i in order {
-            let (t, shading) = (&triangles[i], TriangleShading::new(&triangles[i]));
-            self.tri_vertices.push(t.vertices);
-            if self.keep_uvs {
-                let barycentric = [Vec2::ZERO, Vec2::X, Vec2::Y];
-                self.tri_uvs.push(t.uvs.unwrap_or(barycentric));
-            }
-            if self.keep_normals {
-                self.tri_normals
-                    .push(t.normals.unwrap_or([shading.normal; 3]));
-            }
-            self.tri_shading.push(shading);
+    /// Stores `packed`'s triangle `order[i]` as triangle i, one array at
+    /// a time on every core, each source array dropped once read.
+    fn store_in_order(&mut self, packed: Packed, order: &[usize]) {
+        let Packed {
+            corners,
+            materials,
+            uvs,
+            normals,
+        } = packed;
+        let order = || order.par_iter().with_min_len(4096);
+        self.tri_vertices = order().map(|&i| corners[i].get()).collect();
+        drop(corners);
+        self.tri_shading = (order().zip(&self.tri_vertices))
+            .map(|(&i, v)| TriangleShading::new(v, materials[i]))
+            .collect();
+        drop(materials);
+        if self.keep_uvs {
+            self.tri_uvs = order().map(|&i| uvs[i]).collect();
+        }
+        drop(uvs);
+        if self.keep_normals {
+            self.tri_normals = order().map(|&i| normals[i].map(Vec3A::from)).collect();
         }
     }
+}
 
-    /// Stores the triangles for a soup (those in a face of their bounding
-    /// box last) and tests them all.
-    fn store_soup(&mut self, triangles: &[TriangleInput]) -> Vec<usize> {
-        let vertices: Vec<[Vec3A; 3]> = triangles.iter().map(|t| t.vertices).collect();
-        let order: Vec<usize> = TriangleSoup::order(&vertices).into_iter().collect();
-        self.store_in_order(triangles, &order);
-        self.tri_index = TriangleIndex::Soup(TriangleSoup::new(&self.tri_vertices));
-        order
+/// A triangle's corners unaligned: 36 bytes, not 48.
+#[derive(Clone, Copy)]
+struct Corners([Vec3; 3]);
+
+impl Corners {
+    fn get(&self) -> [Vec3A; 3] {
+        self.0.map(Vec3A::from)
+    }
+}
+
+impl obvhs::Boundable for Corners {
+    fn aabb(&self) -> Aabb {
+        Aabb::from_points(&self.get())
+    }
+}
+
+/// The triangles in input order while the BVH is built, 100 bytes a
+/// triangle with normals and uv against `TriangleInput`'s 144 (on a
+/// million triangles the build's peak; docs/performance.md, "Loading").
+struct Packed {
+    corners: Vec<Corners>,
+    materials: Vec<u32>,
+    /// Empty unless kept.
+    uvs: Vec<[Vec2; 3]>,
+    /// Empty unless kept; a triangle without gets its geometric normal.
+    normals: Vec<[Vec3; 3]>,
+}
+
+impl Packed {
+    /// Moves `triangles` in from the back a block at a time, the list
+    /// shrinking behind (glibc shrinks a large block's mapping in place),
+    /// so that the two are never held whole together.
+    fn new(mut triangles: Vec<TriangleInput>, keep_uvs: bool, keep_normals: bool) -> Packed {
+        let count = triangles.len();
+        let kept = |keep: bool| if keep { count } else { 0 };
+        let mut packed = Packed {
+            corners: Vec::with_capacity(count),
+            materials: Vec::with_capacity(count),
+            uvs: Vec::with_capacity(kept(keep_uvs)),
+            normals: Vec::with_capacity(kept(keep_normals)),
+        };
+        const BLOCK: usize = 1 << 16;
+        while !triangles.is_empty() {
+            let rest = triangles.len().saturating_sub(BLOCK);
+            for t in triangles.drain(rest..).rev() {
+                packed.corners.push(Corners(t.vertices.map(Vec3::from)));
+                packed.materials.push(t.material);
+                if keep_uvs {
+                    let barycentric = [Vec2::ZERO, Vec2::X, Vec2::Y];
+                    packed.uvs.push(t.uvs.unwrap_or(barycentric));
+                }
+                if keep_normals {
+                    let geometric = || [TriangleShading::new(&t.vertices, 0).normal; 3];
+                    packed
+                        .normals
+                        .push(t.normals.unwrap_or_else(geometric).map(Vec3::from));
+                }
+            }
+            triangles.shrink_to_fit();
+        }
+        packed.corners.reverse();
+        packed.materials.reverse();
+        packed.uvs.reverse();
+        packed.normals.reverse();
+        packed
     }
 }

@@ -135,11 +135,10 @@ struct TriangleShading {
 }
 
 impl TriangleShading {
-    fn new(t: &TriangleInput) -> Self {
-        let [p0, p1, p2] = t.vertices;
+    fn new(&[p0, p1, p2]: &[Vec3A; 3], material: u32) -> Self {
         TriangleShading {
             normal: (p1 - p0).cross(p2 - p0).normalize(),
-            material: t.material,
+            material,
             light: NO_LIGHT,
         }
     }

@@ -197,9 +197,9 @@ fn instances_answer_as_their_copies_do() {
         .iter()
         .flat_map(|(_, m)| crate::scene::InstancesInput::copy(&grid, *m))
         .collect();
-    let flat = Geometry::build_full(&copies, vec![], AccelChoice::Auto, true);
+    let flat = Geometry::build_full(copies.clone(), vec![], AccelChoice::Auto, true);
     let mut shared = Geometry::default();
-    let prototype = Geometry::build_full(&grid, vec![], AccelChoice::Auto, true);
+    let prototype = Geometry::build_full(grid.clone(), vec![], AccelChoice::Auto, true);
     shared.add_instances(vec![prototype], &placements);
     assert_eq!(shared.triangles_drawn(), flat.triangle_count());
     assert!(shared.memory_bytes() * 8 < flat.memory_bytes());

@@ -63,12 +63,18 @@ impl WideBvh {
             bvh2,
             counts: subtree_counts(bvh2),
             vertices,
-            nodes: Vec::new(),
-            leaves: Vec::new(),
+            // Leaves hold 5–6 triangles and nodes 3–4 leaves on Bitterli's
+            // interiors: reserved above that, the arrays are not copied
+            // and faulted in again at each doubling, and the address
+            // space reserved costs no memory until it is written.
+            nodes: Vec::with_capacity(count / 12 + 1),
+            leaves: Vec::with_capacity(count / 4 + 1),
             order: Vec::with_capacity(count),
             scratch: Vec::with_capacity(LEAF_MAX),
         };
         let root = builder.collapse(0, 1)?;
+        // Not shrunk: the unused capacity was never written, so it holds no
+        // memory, and shrinking these cache-aligned arrays would copy them.
         let Builder {
             nodes,
             leaves,

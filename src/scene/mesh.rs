@@ -63,19 +63,23 @@ impl MeshData {
         let mirrored = to_world.determinant() < 0.0;
         let reverse = flip ^ (mirrored && orientation == Orientation::Normal);
         let normal_sign = if flip { -1.0 } else { 1.0 };
-        let normals = self.normals.as_ref().filter(|_| !face_normals);
+        // Each vertex transformed once, not once per corner: a mesh's
+        // triangles share most of its vertices.
+        let positions: Vec<Vec3A> = (self.positions.iter())
+            .map(|&p| to_world.transform_point3a(Vec3A::from(p)))
+            .collect();
+        let normals: Option<Vec<Vec3A>> =
+            self.normals.as_ref().filter(|_| !face_normals).map(|n| {
+                n.iter()
+                    .map(|&n| (normal_matrix * Vec3A::from(n)).normalize_or_zero() * normal_sign)
+                    .collect()
+            });
         out.reserve(self.indices.len());
         for &[a, b, c] in &self.indices {
             let order = if reverse { [a, c, b] } else { [a, b, c] };
-            let vertices =
-                order.map(|i| to_world.transform_point3a(Vec3A::from(self.positions[i as usize])));
-            let normals = normals
-                .map(|n| {
-                    order.map(|i| {
-                        (normal_matrix * Vec3A::from(n[i as usize])).normalize_or_zero()
-                            * normal_sign
-                    })
-                })
+            let vertices = order.map(|i| positions[i as usize]);
+            let normals = (normals.as_ref())
+                .map(|n| order.map(|i| n[i as usize]))
                 .filter(|n| n.iter().all(|v| *v != Vec3A::ZERO && v.is_finite()));
             let uvs = self.uvs.as_ref().map(|uv| order.map(|i| uv[i as usize]));
             out.push(TriangleInput {

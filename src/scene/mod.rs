@@ -334,9 +334,7 @@ impl Scene {
                 || matches!(m.opacity, Opacity::Texture(_))
                 || m.normal_map.is_some()
         });
-        let mut geometry = Geometry::build_full(&triangles, spheres, AccelChoice::Auto, textured);
-        // The geometry holds its own copy, in leaf order.
-        drop(triangles);
+        let mut geometry = Geometry::build_full(triangles, spheres, AccelChoice::Auto, textured);
         // An emitter is sampled where it is, mask or not: it stays whole.
         for m in input.materials.iter_mut() {
             if m.opacity != Opacity::Opaque && m.is_emissive() {
@@ -358,7 +356,7 @@ impl Scene {
         }
         if !placements.is_empty() {
             let prototypes = prototypes
-                .iter()
+                .into_iter()
                 .map(|p| Geometry::build_full(p, Vec::new(), AccelChoice::Auto, textured))
                 .collect();
             geometry.add_instances(prototypes, &placements);

@@ -8,7 +8,8 @@
 use crate::error::{Error, Result};
 use crate::math::Rgb;
 use crate::scene::material::{Bsdf, Material};
-use glam::{Vec2, Vec3A};
+use crate::scene::mesh::MeshData;
+use glam::{Vec2, Vec3, Vec3A};
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
@@ -32,13 +33,19 @@ pub struct ObjMesh {
     pub materials: Vec<Material>,
 }
 
-/// Reads and validates an OBJ file and its MTL libraries.
-pub fn load_obj(path: &Path) -> Result<ObjMesh> {
+/// The models and converted materials of an OBJ file, parsed by tobj after
+/// the checks it does not make.
+/// With `single_index`, a vertex is a (position, texture coordinates,
+/// normal) triple indexed once; without, each has its own indices.
+fn parse(path: &Path, single_index: bool) -> Result<(Vec<tobj::Model>, Vec<Material>)> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| Error::at(path, None, format!("cannot read OBJ file: {e}")))?;
-    scan_obj_text(path, &text, false)?;
+    if !quick_scan(&text) {
+        scan_obj_text(path, &text, false)?;
+    }
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let options = tobj::LoadOptions {
+        single_index,
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
@@ -82,6 +89,12 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh> {
         .map(|m| convert_material(&mtl_path, m))
         .collect::<Result<Vec<_>>>()?;
 
+    Ok((models, materials))
+}
+
+/// Reads and validates an OBJ file and its MTL libraries.
+pub fn load_obj(path: &Path) -> Result<ObjMesh> {
+    let (models, materials) = parse(path, false)?;
     let mut triangles = Vec::new();
     for model in &models {
         let mesh = &model.mesh;
@@ -131,6 +144,53 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh> {
     })
 }
 
+/// An OBJ file as one indexed mesh in file units, its groups merged and its
+/// materials ignored (Mitsuba reads an OBJ as one shape); `flip_v` maps v
+/// to 1 − v, as Mitsuba does by default. A vertex is one (position,
+/// texture coordinates, normal) triple of the faces, shared by the faces
+/// that name it: a third of an unindexed mesh's size where exporters write
+/// smooth meshes. As [`load_obj`], normals and texture coordinates are
+/// kept only when every face has valid ones.
+pub fn load_obj_mesh(path: &Path, flip_v: bool) -> Result<MeshData> {
+    let (models, _) = parse(path, true)?;
+    let mut mesh = MeshData::default();
+    let (mut normals, mut uvs) = (Some(Vec::new()), Some(Vec::new()));
+    for model in &models {
+        let m = &model.mesh;
+        let count = m.positions.len() / 3;
+        // A face without them gives its new vertices none, which leaves
+        // the arrays short.
+        let has_normals = m.normals.len() == 3 * count
+            && m.normals.chunks_exact(3).all(|n| {
+                let n = Vec3A::new(n[0], n[1], n[2]).normalize_or_zero();
+                n != Vec3A::ZERO && n.is_finite()
+            });
+        let has_uvs = m.texcoords.len() == 2 * count && m.texcoords.iter().all(|x| x.is_finite());
+        if !has_normals {
+            normals = None;
+        }
+        if !has_uvs {
+            uvs = None;
+        }
+        let base = mesh.positions.len() as u32;
+        let vec3 = |p: &[f32]| Vec3::new(p[0], p[1], p[2]);
+        mesh.positions.extend(m.positions.chunks_exact(3).map(vec3));
+        if let Some(normals) = normals.as_mut() {
+            normals.extend(m.normals.chunks_exact(3).map(vec3));
+        }
+        if let Some(uvs) = uvs.as_mut() {
+            let uv = |t: &[f32]| Vec2::new(t[0], if flip_v { 1.0 - t[1] } else { t[1] });
+            uvs.extend(m.texcoords.chunks_exact(2).map(uv));
+        }
+        let corners = m.indices.chunks_exact(3);
+        mesh.indices
+            .extend(corners.map(|c| [c[0], c[1], c[2]].map(|i| base + i)));
+    }
+    mesh.normals = normals.filter(|n| !n.is_empty());
+    mesh.uvs = uvs.filter(|t| !t.is_empty());
+    Ok(mesh)
+}
+
 /// The first `mtllib` file name, if any.
 fn mtl_library(text: &str) -> Option<&str> {
     text.lines()
@@ -140,6 +200,90 @@ fn mtl_library(text: &str) -> Option<&str> {
 /// Line scan for what tobj accepts silently or reports without a line.
 pub fn check_obj_text(path: &Path, text: &str) -> Result<()> {
     scan_obj_text(path, text, true)
+}
+
+/// The common case of [`scan_obj_text`] in one pass over the bytes (its
+/// word splitting cost a third of an OBJ's decoding): true when every face
+/// passes as the full scan would pass it. A line it cannot vouch for (a face
+/// index out of range, `mtllib`, a `+` sign, a byte outside ASCII) gives
+/// false, and the full scan decides and names the line. Vertex lines are
+/// only counted: tobj refuses one with fewer than three numbers, and the
+/// full scan then names it.
+fn quick_scan(text: &str) -> bool {
+    let b = text.as_bytes();
+    // `split_whitespace` also splits at Unicode spaces and vertical tabs.
+    if !text.is_ascii() || b.contains(&0x0b) {
+        return false;
+    }
+    let space = |c: u8| matches!(c, b' ' | b'\t' | b'\r' | 0x0c);
+    let skip_spaces = |mut i: usize| {
+        while i < b.len() && space(b[i]) {
+            i += 1;
+        }
+        i
+    };
+    // Vertices, texture coordinates and normals defined so far.
+    let mut defined = [0u64; 3];
+    let mut i = 0;
+    while i < b.len() {
+        let key = skip_spaces(i);
+        i = key;
+        while i < b.len() && !space(b[i]) && b[i] != b'\n' {
+            i += 1;
+        }
+        match &b[key..i] {
+            b"v" => defined[0] += 1,
+            b"vt" => defined[1] += 1,
+            b"vn" => defined[2] += 1,
+            b"f" => {
+                let mut corners = 0;
+                loop {
+                    i = skip_spaces(i);
+                    if i == b.len() || b[i] == b'\n' {
+                        break;
+                    }
+                    corners += 1;
+                    // `v`, `v/vt`, `v//vn` or `v/vt/vn`, each index 1-based or
+                    // counting back from the last when negative.
+                    let mut part = 0;
+                    loop {
+                        let negative = b[i] == b'-';
+                        i += usize::from(negative);
+                        let (start, mut value) = (i, 0u64);
+                        while i < b.len() && b[i].is_ascii_digit() && i - start < 18 {
+                            value = value * 10 + u64::from(b[i] - b'0');
+                            i += 1;
+                        }
+                        let empty = i == start && !negative;
+                        let known = part >= 3
+                            || (part > 0 && empty)
+                            || (1..=defined[part]).contains(&value);
+                        if !known {
+                            return false;
+                        }
+                        if i < b.len() && b[i] == b'/' {
+                            (i, part) = (i + 1, part + 1);
+                        } else {
+                            break;
+                        }
+                    }
+                    if i < b.len() && !space(b[i]) && b[i] != b'\n' {
+                        return false;
+                    }
+                }
+                if corners < 3 {
+                    return false;
+                }
+            }
+            b"mtllib" => return false,
+            _ => {}
+        }
+        match b[i..].iter().position(|&c| c == b'\n') {
+            Some(k) => i += k + 1,
+            None => break,
+        }
+    }
+    true
 }
 
 /// [`check_obj_text`]; without `coordinates`, vertex lines are only
@@ -396,6 +540,62 @@ mod tests {
             e.message(),
             "m.obj:4: face texture coordinate index 1 is out of range: 0 defined so far"
         );
+    }
+
+    #[test]
+    fn the_quick_scan_vouches_only_for_what_the_full_scan_passes() {
+        let valid = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nvn 0 1 0\nf 1 2 3\r\nf -3 -2 -1\n\tf 1/1/1 2//2 3/-1/-2 \n# f 9 9 9\ng x\n";
+        assert!(quick_scan(valid));
+        check(valid).unwrap();
+        let triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        for face in [
+            "f 1 2 4",
+            "f 1 -5 1",
+            "f 1/1 2/1 3/1",
+            "f 1 2",
+            "f 0 1 2",
+            "f 1 2 3x",
+            "f 1 2 99999999999999999999",
+            "f 1 2 /3",
+        ] {
+            let bad = format!("{triangle}{face}\n");
+            assert!(!quick_scan(&bad), "{face}");
+            assert!(check(&bad).is_err(), "{face}");
+        }
+        // Valid, but left to the full scan.
+        for unsure in [
+            format!("{triangle}f +1 2 3\n"),
+            format!("{triangle}v 0 0 0\u{a0}\n"),
+        ] {
+            assert!(!quick_scan(&unsure), "{unsure:?}");
+            check(&unsure).unwrap();
+        }
+    }
+
+    #[test]
+    fn an_obj_mesh_shares_the_vertices_its_faces_share() {
+        let dir = std::env::temp_dir().join(format!("tracelab-obj-mesh-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("quad.obj");
+        let quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 2\n";
+        std::fs::write(&path, format!("{quad}f 1/1/1 2/2/1 3/3/1 4/4/1\n")).unwrap();
+        let mesh = load_obj_mesh(&path, true).unwrap();
+        // The quad's two triangles share two of its four corners.
+        assert_eq!((mesh.positions.len(), mesh.indices.len()), (4, 2));
+        let (normals, uvs) = (mesh.normals.unwrap(), mesh.uvs.unwrap());
+        let obj = load_obj(&path).unwrap();
+        for (t, &corners) in obj.triangles.iter().zip(&mesh.indices) {
+            let corners = corners.map(|i| i as usize);
+            assert_eq!(t.vertices, corners.map(|i| Vec3A::from(mesh.positions[i])));
+            assert_eq!(t.uvs.unwrap(), corners.map(|i| uvs[i]));
+            // Normalised when placed.
+            let normal = |i: usize| Vec3A::from(normals[i]).normalize();
+            assert_eq!(t.normals.unwrap(), corners.map(normal));
+        }
+        // One face without normals: the mesh has none.
+        std::fs::write(&path, format!("{quad}f 1//1 2//1 3//1\nf 1 3 4\n")).unwrap();
+        assert!(load_obj_mesh(&path, true).unwrap().normals.is_none());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

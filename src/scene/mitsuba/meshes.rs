@@ -4,7 +4,6 @@ use super::props::Props;
 use super::xml::{Document, Element};
 use crate::error::Result;
 use crate::scene::mesh::MeshData;
-use glam::Vec2;
 use std::path::PathBuf;
 
 /// Which reader a mesh file takes.
@@ -66,28 +65,5 @@ impl MeshFile {
 
 /// An OBJ file as an indexed mesh (its MTL materials are Mitsuba's to ignore).
 fn obj_mesh(path: &std::path::Path, flip_uv: bool) -> Result<MeshData> {
-    let obj = crate::scene::obj::load_obj(path)?;
-    let mut mesh = MeshData::default();
-    let has_normals =
-        obj.triangles.iter().all(|t| t.normals.is_some()) && !obj.triangles.is_empty();
-    let has_uvs = obj.triangles.iter().all(|t| t.uvs.is_some()) && !obj.triangles.is_empty();
-    let (mut normals, mut uvs) = (Vec::new(), Vec::new());
-    for t in &obj.triangles {
-        let base = mesh.positions.len() as u32;
-        mesh.positions.extend(t.vertices.map(glam::Vec3::from));
-        if has_normals {
-            normals.extend(t.normals.unwrap().map(glam::Vec3::from));
-        }
-        if has_uvs {
-            // load_obj flips v as Mitsuba does by default; undo on request.
-            uvs.extend(t.uvs.unwrap().map(|uv| match flip_uv {
-                true => uv,
-                false => Vec2::new(uv.x, 1.0 - uv.y),
-            }));
-        }
-        mesh.indices.push([base, base + 1, base + 2]);
-    }
-    mesh.normals = has_normals.then_some(normals);
-    mesh.uvs = has_uvs.then_some(uvs);
-    Ok(mesh)
+    crate::scene::obj::load_obj_mesh(path, flip_uv)
 }

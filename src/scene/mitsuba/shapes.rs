@@ -74,20 +74,16 @@ impl<'a> Importer<'a> {
                     let local = Mat4::from_translation(p0)
                         * Mat4::from_quat(rotation)
                         * Mat4::from_scale(glam::Vec3::new(radius, radius, axis.length()));
-                    let mut out = Vec::new();
-                    MeshData::cylinder(SEGMENTS).triangles(
-                        to_world * local,
-                        Orientation::Normal,
-                        flip,
-                        false,
-                        material,
-                        &mut out,
-                    );
+                    let cylinder = MeshData::cylinder(SEGMENTS);
+                    let placement = (to_world * local, Orientation::Normal, flip, false);
+                    self.place_mesh(e, &cylinder, placement, material)?;
                     self.warn(
                         &e.loc,
-                        &format!("cylinder tessellated into {} triangles", out.len()),
+                        &format!(
+                            "cylinder tessellated into {} triangles",
+                            cylinder.indices.len()
+                        ),
                     );
-                    self.push_triangles(e, out)?;
                     p.unused(&mut self.warnings);
                     return Ok(());
                 };
@@ -138,16 +134,12 @@ impl<'a> Importer<'a> {
             }
         };
         mesh.validate().map_err(|m| e.loc.error(m))?;
-        let mut out = Vec::new();
-        mesh.triangles(
-            to_world,
-            orientation,
-            flip,
-            face_normals,
+        self.place_mesh(
+            e,
+            &mesh,
+            (to_world, orientation, flip, face_normals),
             material,
-            &mut out,
-        );
-        self.push_triangles(e, out)?;
+        )?;
         debug_assert!(self.triangles.len() >= start);
         p.unused(&mut self.warnings);
         Ok(())
@@ -221,19 +213,40 @@ impl<'a> Importer<'a> {
         Ok(())
     }
 
-    fn push_triangles(&mut self, e: &Element, out: Vec<crate::accel::TriangleInput>) -> Result<()> {
-        if self.triangles.len() + out.len() > self.limits.max_triangles {
+    /// Appends `mesh`'s triangles placed by (to_world, orientation, flip,
+    /// face_normals) (see [`MeshData::triangles`]), checked against the
+    /// triangle limit before and the coordinate range after.
+    fn place_mesh(
+        &mut self,
+        e: &Element,
+        mesh: &MeshData,
+        (to_world, orientation, flip, face_normals): (Mat4, Orientation, bool, bool),
+        material: u32,
+    ) -> Result<()> {
+        if self.triangles.len() + mesh.indices.len() > self.limits.max_triangles {
             return Err(e.loc.error(format!(
                 "more than {} triangles (raise the limit with --max-triangles)",
                 self.limits.max_triangles
             )));
         }
-        if !out.iter().all(|t| t.vertices.iter().all(|&v| in_range(v))) {
+        let start = self.triangles.len();
+        mesh.triangles(
+            to_world,
+            orientation,
+            flip,
+            face_normals,
+            material,
+            &mut self.triangles,
+        );
+        if !self.triangles[start..]
+            .iter()
+            .all(|t| t.vertices.iter().all(|&v| in_range(v)))
+        {
+            self.triangles.truncate(start);
             return Err(e.loc.error(format!(
                 "after its transform, the shape reaches beyond ±{MAX_COORDINATE:e}"
             )));
         }
-        self.triangles.extend(out);
         Ok(())
     }
 
