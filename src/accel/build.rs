@@ -46,14 +46,6 @@ pub(super) fn build_bvh2<T: obvhs::Boundable>(prims: &[T]) -> Bvh2 {
     bvh2
 }
 
-/// Triangles are bounded where they lie: an array of boxes beside them
-/// was 32 bytes a triangle more at the build's peak.
-impl obvhs::Boundable for TriangleInput {
-    fn aabb(&self) -> Aabb {
-        Aabb::from_points(&self.vertices)
-    }
-}
-
 /// The triangles' 8-wide BVH and the order to store them in, or None when
 /// the tree would be deeper than its traversal stack (many nearly coincident
 /// triangles, found by fuzzing, make PLOC produce chains).
@@ -353,6 +345,8 @@ impl Corners {
     }
 }
 
+/// Bounded where they lie: an array of boxes beside them was 32 bytes a
+/// triangle more at the build's peak.
 impl obvhs::Boundable for Corners {
     fn aabb(&self) -> Aabb {
         Aabb::from_points(&self.get())
