@@ -247,7 +247,8 @@ fn quick_scan(text: &str) -> bool {
                     // counting back from the last when negative.
                     let mut part = 0;
                     loop {
-                        let negative = b[i] == b'-';
+                        // After a final `/`, i is past the end.
+                        let negative = b.get(i) == Some(&b'-');
                         i += usize::from(negative);
                         let (start, mut value) = (i, 0u64);
                         while i < b.len() && b[i].is_ascii_digit() && i - start < 18 {
@@ -562,6 +563,11 @@ mod tests {
             assert!(!quick_scan(&bad), "{face}");
             assert!(check(&bad).is_err(), "{face}");
         }
+        // A corner ending in `/` at the end of the file (no newline): read
+        // without going past the end.
+        let ends_in_slash = format!("{triangle}f 1 2 3/");
+        assert!(quick_scan(&ends_in_slash));
+        assert!(check(&ends_in_slash).is_ok());
         // Valid, but left to the full scan.
         for unsure in [
             format!("{triangle}f +1 2 3\n"),
