@@ -317,6 +317,15 @@ fn radiosity_controls_drive_the_solver() {
     let mut harness = Harness::builder()
         .with_size(SIZE)
         .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 4)));
+    // Every solver runs on a coarse mesh (206 uniform elements), for time.
+    harness
+        .state_mut()
+        .app
+        .settings
+        .a
+        .integrator
+        .radiosity
+        .patch_size = 0.3;
     click(&mut harness, "Radiosity");
     click(&mut harness, "hierarchical");
     click(&mut harness, "flat");
@@ -353,16 +362,8 @@ fn radiosity_controls_drive_the_solver() {
     // for the last one to reach the screen.
     harness.run_steps(2);
     harness.get_by_label_contains("links");
-    // Another solver restarts from its own mesh (a coarse one, for time).
-    // Progressive refinement converges over thousands of shots: 50 here.
-    harness
-        .state_mut()
-        .app
-        .settings
-        .a
-        .integrator
-        .radiosity
-        .patch_size = 0.3;
+    // Another solver restarts from its own mesh. Progressive refinement
+    // converges over thousands of shots: 50 here.
     harness
         .state_mut()
         .app
