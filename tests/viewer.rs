@@ -11,6 +11,7 @@ use egui_kittest::{Harness, SnapshotOptions};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use tracelab::integrator::IntegratorKind;
+use tracelab::integrator::radiosity::Radiosity;
 use tracelab::lab::Experiment;
 use tracelab::render::Adaptive;
 use tracelab::sampling::SamplerKind;
@@ -67,6 +68,11 @@ fn click(harness: &mut Harness<'_, Window>, label: &str) {
     }
     harness.get_by_label(label).click();
     harness.step();
+}
+
+/// View A's radiosity settings, for what a test sets without clicking.
+fn radiosity<'a>(harness: &'a mut Harness<'_, Window>) -> &'a mut Radiosity {
+    &mut harness.state_mut().app.settings.a.integrator.radiosity
 }
 
 /// The renderer shows the current settings and has finished them.
@@ -318,14 +324,7 @@ fn radiosity_controls_drive_the_solver() {
         .with_size(SIZE)
         .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 4)));
     // Every solver runs on a coarse mesh (206 uniform elements), for time.
-    harness
-        .state_mut()
-        .app
-        .settings
-        .a
-        .integrator
-        .radiosity
-        .patch_size = 0.3;
+    radiosity(&mut harness).patch_size = 0.3;
     click(&mut harness, "Radiosity");
     click(&mut harness, "hierarchical");
     click(&mut harness, "flat");
@@ -364,14 +363,7 @@ fn radiosity_controls_drive_the_solver() {
     harness.get_by_label_contains("links");
     // Another solver restarts from its own mesh. Progressive refinement
     // converges over thousands of shots: 50 here.
-    harness
-        .state_mut()
-        .app
-        .settings
-        .a
-        .integrator
-        .radiosity
-        .iterations = 50;
+    radiosity(&mut harness).iterations = 50;
     click(&mut harness, "progressive");
     let ambient = harness.state().app.settings.a.integrator.radiosity.ambient;
     click(&mut harness, "Ambient term");
@@ -384,24 +376,10 @@ fn radiosity_controls_drive_the_solver() {
     );
     // Gauss-Seidel with a round of adaptive subdivision and the wireframe:
     // the converged mesh has more elements than the uniform one (206).
-    harness
-        .state_mut()
-        .app
-        .settings
-        .a
-        .integrator
-        .radiosity
-        .iterations = 0;
+    radiosity(&mut harness).iterations = 0;
     click(&mut harness, "gauss-seidel");
     harness.get_by_role_and_label(egui::accesskit::Role::Slider, "Adaptive subdivision rounds");
-    harness
-        .state_mut()
-        .app
-        .settings
-        .a
-        .integrator
-        .radiosity
-        .adaptive_rounds = 1;
+    radiosity(&mut harness).adaptive_rounds = 1;
     click(&mut harness, "Wireframe (colour by level)");
     step_until(&mut harness, "the adaptive solution", finished);
     assert!(
