@@ -4,6 +4,7 @@
 use crate::filter::PixelFilter;
 use crate::math::Rgb;
 use glam::Vec2;
+use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Per-pixel sums of light-tracing splats in 32.32 fixed point: integer
@@ -26,7 +27,9 @@ impl SplatBuffer {
 
     /// A buffer whose splats spread over the pixels `filter` covers.
     pub(crate) fn with_filter(width: u32, height: u32, filter: PixelFilter) -> Self {
+        // Filled in parallel: a pass makes one before any thread can start.
         let sums = (0..width as usize * height as usize)
+            .into_par_iter()
             .map(|_| [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)])
             .collect();
         SplatBuffer {

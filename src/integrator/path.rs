@@ -13,6 +13,7 @@ use super::{
     survives_roulette,
 };
 use crate::accel::{NO_LIGHT, SurfaceHit};
+use crate::bsdf::lambert;
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
@@ -455,22 +456,22 @@ impl PathTracer {
     }
 }
 
-/// BSDF evaluation; Lambertian inline when the scene has nothing else.
+/// BSDF evaluation, the Lambertian model inline: the only one where the
+/// scene has nothing else, and the most common one where it has.
 #[inline(always)]
 fn eval<const DIFFUSE_ONLY: bool>(bsdf: &Bsdf, wo: Vec3A, wi: Vec3A) -> Rgb {
-    if DIFFUSE_ONLY && let Bsdf::Diffuse { albedo } = *bsdf {
-        return if wo.z * wi.z > 0.0 {
-            albedo * FRAC_1_PI
-        } else {
-            Rgb::ZERO
-        };
+    if let Bsdf::Diffuse { albedo } = *bsdf {
+        return lambert::eval(albedo, wo, wi);
     }
     bsdf.eval(wo, wi)
 }
 
 #[inline(always)]
 fn pdf<const DIFFUSE_ONLY: bool>(bsdf: &Bsdf, wo: Vec3A, wi: Vec3A) -> f32 {
-    if DIFFUSE_ONLY && matches!(bsdf, Bsdf::Diffuse { .. }) {
+    if matches!(bsdf, Bsdf::Diffuse { .. }) {
+        if !DIFFUSE_ONLY {
+            return lambert::pdf(wo, wi);
+        }
         return if wo.z * wi.z > 0.0 {
             wi.z.abs() * FRAC_1_PI
         } else {

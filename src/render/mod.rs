@@ -465,7 +465,9 @@ impl Session {
         let scene = &*self.scene;
         let settings = &self.settings;
         let (width, height) = (self.film.width(), self.film.height());
-        let splats = SplatBuffer::with_filter(width, height, scene.camera.filter);
+        let splats = self
+            .pool
+            .install(|| SplatBuffer::with_filter(width, height, scene.camera.filter));
         self.pool.install(|| {
             self.film
                 .tiles()
@@ -505,15 +507,17 @@ impl Session {
             return;
         }
         let particles = f64::from(width) * f64::from(height) * f64::from(spp);
-        for tile in self.film.tiles() {
-            let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
-            let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
-            for (i, pixel) in tile.pixels.iter_mut().enumerate() {
-                let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
-                let estimate = splats.get(y * width + x).map(|v| v / particles);
-                pixel.add_repeated(estimate, spp);
-            }
-        }
+        self.pool.install(|| {
+            self.film.tiles().par_iter().for_each(|tile| {
+                let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
+                let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
+                for (i, pixel) in tile.pixels.iter_mut().enumerate() {
+                    let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
+                    let estimate = splats.get(y * width + x).map(|v| v / particles);
+                    pixel.add_repeated(estimate, spp);
+                }
+            });
+        });
     }
 
     fn add_counts(&self, samples: u64, counts: &RayCounts, non_finite: u64) {

@@ -503,12 +503,20 @@ impl Scene {
     }
 
     /// The BSDF at `hit`, its textures read.
-    #[inline]
+    #[inline(always)]
     pub fn bsdf_at(&self, hit: &SurfaceHit) -> crate::bsdf::Bsdf {
         let material = &self.materials[hit.material as usize];
         if material.textures.is_empty() {
             return material.bsdf;
         }
+        self.textured_bsdf_at(material, hit)
+    }
+
+    /// [`Scene::bsdf_at`] where a texture is read, out of line: with it
+    /// inlined LLVM kept the whole lookup out of the integrators' loops,
+    /// a call and a copy of the model at every hit of untextured scenes.
+    #[inline(never)]
+    fn textured_bsdf_at(&self, material: &Material, hit: &SurfaceHit) -> crate::bsdf::Bsdf {
         material.bsdf_at(&self.textures, self.geometry.uv(hit))
     }
 
