@@ -639,7 +639,14 @@ impl Radiosity {
             state.settled = true;
             return;
         };
-        let steep = m.mesh.steep(&m.solution.radiance, self.adaptive_tolerance);
+        let lines = state
+            .meshed
+            .as_ref()
+            .map(Meshed::line_edges)
+            .unwrap_or_default();
+        let steep = m
+            .mesh
+            .steep(&m.solution.radiance, self.adaptive_tolerance, &lines);
         let added = 3 * steep.iter().filter(|&&s| s).count();
         if added == 0 {
             state.settled = true;

@@ -272,8 +272,15 @@ impl Mesh {
     /// Neighbours are the smooth display's ([`super::reconstruct`]): they
     /// share a vertex, lie in the same plane (walls meeting at a corner may
     /// differ) and emit alike; across a T-vertex only the elements that have
-    /// it count.
-    pub fn steep(&self, radiance: &[Rgb], tolerance: f32) -> Vec<bool> {
+    /// it count; where discontinuity `lines` pass through a vertex, only
+    /// the elements on the same side (the mesh already holds that jump, and
+    /// splitting along it spends elements for nothing).
+    pub fn steep(
+        &self,
+        radiance: &[Rgb],
+        tolerance: f32,
+        lines: &[super::reconstruct::LineEdge],
+    ) -> Vec<bool> {
         use std::collections::HashMap;
         let reflected: Vec<Rgb> = self
             .elements
@@ -289,10 +296,13 @@ impl Mesh {
             .map(|(e, l)| e.area * *l)
             .sum::<Rgb>()
             / area;
+        let crossing = super::reconstruct::LinesAtVertices::new(self.elements.iter(), lines);
         let mut range: HashMap<_, (Rgb, Rgb)> = HashMap::new();
         for (e, &l) in self.elements.iter().zip(&reflected) {
             for v in e.vertices {
-                let r = range.entry(vertex_key(v, e)).or_insert((l, l));
+                let r = range
+                    .entry((vertex_key(v, e), crossing.side(v, e)))
+                    .or_insert((l, l));
                 *r = (r.0.min(l), r.1.max(l));
             }
         }
@@ -302,7 +312,7 @@ impl Mesh {
             .iter()
             .map(|e| {
                 e.vertices.iter().any(|&v| {
-                    let (low, high) = range[&vertex_key(v, e)];
+                    let (low, high) = range[&(vertex_key(v, e), crossing.side(v, e))];
                     (high - low).cmpgt(limit).any()
                 })
             })
@@ -418,6 +428,31 @@ pub(crate) fn unpatched_lights(scene: &Scene) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two halves of a square, bright and dark, meet along a line: without
+    /// the line every element is steep; with it each side is uniform and
+    /// none is (the mesh already holds the jump).
+    #[test]
+    fn adaptive_subdivision_does_not_split_across_a_discontinuity_line() {
+        let p = |x: f32, y: f32| Vec3A::new(x, y, 0.0);
+        let element = |v| Element::new(0, v, Rgb::splat(0.5), Rgb::ZERO);
+        let mesh = Mesh {
+            elements: vec![
+                element([p(-1.0, 0.0), p(0.0, 0.0), p(0.0, 1.0)]),
+                element([p(-1.0, 0.0), p(0.0, 1.0), p(-1.0, 1.0)]),
+                element([p(0.0, 0.0), p(1.0, 0.0), p(0.0, 1.0)]),
+                element([p(1.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)]),
+            ],
+            ..Mesh::default()
+        };
+        let radiance = [1.0, 1.0, 0.2, 0.2].map(Rgb::splat);
+        let line = super::super::reconstruct::LineEdge {
+            ends: [p(0.0, 0.0), p(0.0, 1.0)],
+            normal: Vec3A::Z,
+        };
+        assert_eq!(mesh.steep(&radiance, 0.5, &[]), [true; 4]);
+        assert_eq!(mesh.steep(&radiance, 0.5, &[line]), [false; 4]);
+    }
 
     #[test]
     fn element_lookup_finds_the_element_containing_the_point() {

@@ -37,7 +37,7 @@ pub fn vertex_radiance<'a>(
         }
     }
     let centroid = |e: &Element| (e.vertices[0] + e.vertices[1] + e.vertices[2]) / 3.0;
-    let crossing = LinesAtVertices::new(&elements, lines);
+    let crossing = LinesAtVertices::new(elements.iter().map(|(e, _)| *e), lines);
     let mut neighbours = Vec::new();
     let gradients: Vec<[Vec3A; 3]> = elements
         .iter()
@@ -98,15 +98,18 @@ pub struct LineEdge {
 /// Per vertex that discontinuity lines pass through (at an edge's end, or
 /// inside it where subdivision put a midpoint), the lines' directions away
 /// from it in its plane.
-struct LinesAtVertices(HashMap<VertexKey, Vec<Vec3A>>);
+pub(crate) struct LinesAtVertices(HashMap<VertexKey, Vec<Vec3A>>);
 
 impl LinesAtVertices {
-    fn new(elements: &[(&Element, Rgb)], lines: &[LineEdge]) -> LinesAtVertices {
+    pub(crate) fn new<'a>(
+        elements: impl Iterator<Item = &'a Element>,
+        lines: &[LineEdge],
+    ) -> LinesAtVertices {
         let mut at = HashMap::new();
         if lines.is_empty() {
             return LinesAtVertices(at);
         }
-        for (e, _) in elements {
+        for e in elements {
             for v in e.vertices {
                 let key = vertex_key(v, e);
                 if at.contains_key(&key) {
@@ -146,6 +149,18 @@ impl LinesAtVertices {
 
     fn directions(&self, key: &VertexKey) -> Option<&[Vec3A]> {
         self.0.get(key).map(Vec::as_slice)
+    }
+
+    /// Which side of the lines through its vertex `v` element `e` lies on
+    /// (the sector its centroid is in; 0 where no line passes through `v`).
+    pub(crate) fn side(&self, v: Vec3A, e: &Element) -> usize {
+        match self.directions(&vertex_key(v, e)) {
+            Some(directions) => {
+                let centroid = (e.vertices[0] + e.vertices[1] + e.vertices[2]) / 3.0;
+                sector(e.normal, directions, centroid - v)
+            }
+            None => 0,
+        }
     }
 }
 
