@@ -462,61 +462,62 @@ impl Session {
     /// as `spp` samples of equal value, so the film's mean is exact and its
     /// standard error is estimated across passes (exact for 1-spp passes).
     fn splat_pass(&self, estimator: &SplattingIntegrator, first: u32, spp: u32) {
+        // In the pool throughout: the buffer's fill and the film's update
+        // are parallel loops over every pixel too.
+        self.pool
+            .install(|| self.splat_pass_in_pool(estimator, first, spp));
+    }
+
+    fn splat_pass_in_pool(&self, estimator: &SplattingIntegrator, first: u32, spp: u32) {
         let scene = &*self.scene;
         let settings = &self.settings;
         let (width, height) = (self.film.width(), self.film.height());
-        let splats = self
-            .pool
-            .install(|| SplatBuffer::with_filter(width, height, scene.camera.filter));
-        self.pool.install(|| {
-            self.film
-                .tiles()
-                .par_iter()
-                .with_max_len(1)
-                .for_each(|tile| {
-                    if self.cancelled.load(Ordering::Relaxed) {
-                        return;
+        let splats = SplatBuffer::with_filter(width, height, scene.camera.filter);
+        self.film
+            .tiles()
+            .par_iter()
+            .with_max_len(1)
+            .for_each(|tile| {
+                if self.cancelled.load(Ordering::Relaxed) {
+                    return;
+                }
+                let (x0, y0, tile_width, tile_height) = {
+                    let t = tile.lock().unwrap_or_else(|e| e.into_inner());
+                    (t.x0, t.y0, t.width, t.height)
+                };
+                let mut sampler =
+                    Sampler::new(settings.sampler, settings.seed, settings.planned_spp)
+                        .with_domains(settings.domains);
+                let mut counts = RayCounts::default();
+                let mut pending = PendingSplats::new();
+                for i in 0..tile_width * tile_height {
+                    let (x, y) = (x0 + i % tile_width, y0 + i / tile_width);
+                    for s in first..first + spp {
+                        sampler.start(y * width + x, s);
+                        estimator.trace(scene, (x, y), &mut sampler, &mut counts, |splat| {
+                            pending.push(&splats, splat.film, splat.value)
+                        });
+                        pending.flush(&splats);
                     }
-                    let (x0, y0, tile_width, tile_height) = {
-                        let t = tile.lock().unwrap_or_else(|e| e.into_inner());
-                        (t.x0, t.y0, t.width, t.height)
-                    };
-                    let mut sampler =
-                        Sampler::new(settings.sampler, settings.seed, settings.planned_spp)
-                            .with_domains(settings.domains);
-                    let mut counts = RayCounts::default();
-                    let mut pending = PendingSplats::new();
-                    for i in 0..tile_width * tile_height {
-                        let (x, y) = (x0 + i % tile_width, y0 + i / tile_width);
-                        for s in first..first + spp {
-                            sampler.start(y * width + x, s);
-                            estimator.trace(scene, (x, y), &mut sampler, &mut counts, |splat| {
-                                pending.push(&splats, splat.film, splat.value)
-                            });
-                            pending.flush(&splats);
-                        }
-                    }
-                    self.add_counts(
-                        u64::from(tile_width * tile_height * spp),
-                        &counts,
-                        pending.rejected,
-                    );
-                });
-        });
+                }
+                self.add_counts(
+                    u64::from(tile_width * tile_height * spp),
+                    &counts,
+                    pending.rejected,
+                );
+            });
         if self.cancelled.load(Ordering::Relaxed) {
             return;
         }
         let particles = f64::from(width) * f64::from(height) * f64::from(spp);
-        self.pool.install(|| {
-            self.film.tiles().par_iter().for_each(|tile| {
-                let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
-                let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
-                for (i, pixel) in tile.pixels.iter_mut().enumerate() {
-                    let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
-                    let estimate = splats.get(y * width + x).map(|v| v / particles);
-                    pixel.add_repeated(estimate, spp);
-                }
-            });
+        self.film.tiles().par_iter().for_each(|tile| {
+            let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
+            let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
+            for (i, pixel) in tile.pixels.iter_mut().enumerate() {
+                let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
+                let estimate = splats.get(y * width + x).map(|v| v / particles);
+                pixel.add_repeated(estimate, spp);
+            }
         });
     }
 
