@@ -46,21 +46,16 @@ pub fn vertex_radiance<'a>(
             neighbours.clear();
             let c = centroid(e);
             for v in e.vertices {
-                let key = vertex_key(v, e);
-                let around = &at_vertex[&key];
-                match crossing.directions(&key) {
-                    // A discontinuity line through the vertex: the fit takes
-                    // the neighbours on this element's side only, as the
-                    // radiance's slope jumps across it.
-                    Some(directions) => {
-                        let side = sector(e.normal, directions, c - v);
-                        neighbours.extend(around.iter().copied().filter(|&n| {
-                            let other = centroid(elements[n as usize].0) - v;
-                            sector(e.normal, directions, other) == side
-                        }))
-                    }
-                    None => neighbours.extend(around.iter().copied()),
-                }
+                // Where a discontinuity line passes through the vertex, the
+                // fit takes the neighbours on this element's side only, as
+                // the radiance's slope jumps across it.
+                let side = crossing.side(v, e);
+                neighbours.extend(
+                    at_vertex[&vertex_key(v, e)]
+                        .iter()
+                        .copied()
+                        .filter(|&n| crossing.side(v, elements[n as usize].0) == side),
+                );
             }
             neighbours.sort_unstable();
             neighbours.dedup();
