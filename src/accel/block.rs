@@ -26,6 +26,15 @@ pub struct Block {
 }
 
 impl Block {
+    /// A block of no triangles, a slot before it is filled.
+    pub fn empty() -> Self {
+        Block {
+            v: [[f32x8::ZERO; 3]; 3],
+            first: 0,
+            lanes: 0,
+        }
+    }
+
     /// The block of `triangles` (at most [`LANES`]), the first of which has
     /// index `first`.
     pub fn new(triangles: &[[Vec3A; 3]], first: usize) -> Self {

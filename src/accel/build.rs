@@ -59,7 +59,7 @@ pub(super) fn build_wide_bvh(triangles: &[[Vec3A; 3]]) -> Option<(WideBvh, Vec<u
 /// corners `vertices(i)`), so that a caller need not copy them first.
 pub(super) fn build_wide_bvh_with<T: obvhs::Boundable>(
     prims: &[T],
-    vertices: &dyn Fn(usize) -> [Vec3A; 3],
+    vertices: &(dyn Fn(usize) -> [Vec3A; 3] + Sync),
 ) -> Option<(WideBvh, Vec<usize>)> {
     let bvh2 = build_bvh2(prims);
     WideBvh::from_bvh2(&bvh2, prims.len(), vertices)
@@ -101,7 +101,7 @@ impl Geometry {
     ) -> Self {
         let mut geometry = Geometry {
             keep_uvs,
-            keep_normals: triangles.iter().any(|t| t.normals.is_some()),
+            keep_normals: triangles.par_iter().any(|t| t.normals.is_some()),
             ..Geometry::default()
         };
         let use_soup = match choice {
@@ -381,20 +381,26 @@ impl Packed {
         const BLOCK: usize = 1 << 16;
         while !triangles.is_empty() {
             let rest = triangles.len().saturating_sub(BLOCK);
-            for t in triangles.drain(rest..).rev() {
-                packed.corners.push(Corners(t.vertices.map(Vec3::from)));
-                packed.materials.push(t.material);
-                if keep_uvs {
-                    let barycentric = [Vec2::ZERO, Vec2::X, Vec2::Y];
-                    packed.uvs.push(t.uvs.unwrap_or(barycentric));
-                }
-                if keep_normals {
-                    let geometric = || [TriangleShading::new(&t.vertices, 0).normal; 3];
-                    packed
-                        .normals
-                        .push(t.normals.unwrap_or_else(geometric).map(Vec3::from));
-                }
+            // On every core: the new arrays' first touch (page faults) was
+            // most of the packing's time.
+            let block = || triangles[rest..].par_iter().rev().with_min_len(1 << 10);
+            packed
+                .corners
+                .par_extend(block().map(|t| Corners(t.vertices.map(Vec3::from))));
+            packed.materials.par_extend(block().map(|t| t.material));
+            if keep_uvs {
+                let barycentric = [Vec2::ZERO, Vec2::X, Vec2::Y];
+                packed
+                    .uvs
+                    .par_extend(block().map(|t| t.uvs.unwrap_or(barycentric)));
             }
+            if keep_normals {
+                packed.normals.par_extend(block().map(|t| {
+                    let geometric = || [TriangleShading::new(&t.vertices, 0).normal; 3];
+                    t.normals.unwrap_or_else(geometric).map(Vec3::from)
+                }));
+            }
+            triangles.truncate(rest);
             triangles.shrink_to_fit();
         }
         packed.corners.reverse();

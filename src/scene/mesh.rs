@@ -27,6 +27,38 @@ pub enum Orientation {
     Normal,
 }
 
+/// Where a mesh's triangles go: see [`MeshData::triangles`].
+#[derive(Clone, Copy, Debug)]
+pub struct Placement {
+    to_world: Mat4,
+    normal_matrix: Mat3A,
+    /// Corners taken in the other order.
+    reverse: bool,
+    normal_sign: f32,
+    face_normals: bool,
+    material: u32,
+}
+
+impl Placement {
+    pub fn new(
+        to_world: Mat4,
+        orientation: Orientation,
+        flip: bool,
+        face_normals: bool,
+        material: u32,
+    ) -> Placement {
+        let mirrored = to_world.determinant() < 0.0;
+        Placement {
+            to_world,
+            normal_matrix: Mat3A::from_mat4(to_world).inverse().transpose(),
+            reverse: flip ^ (mirrored && orientation == Orientation::Normal),
+            normal_sign: if flip { -1.0 } else { 1.0 },
+            face_normals,
+            material,
+        }
+    }
+}
+
 impl MeshData {
     /// Checks indices and values; the message says what is wrong.
     pub fn validate(&self) -> Result<(), String> {
@@ -59,35 +91,34 @@ impl MeshData {
         material: u32,
         out: &mut Vec<TriangleInput>,
     ) {
-        let normal_matrix = Mat3A::from_mat4(to_world).inverse().transpose();
-        let mirrored = to_world.determinant() < 0.0;
-        let reverse = flip ^ (mirrored && orientation == Orientation::Normal);
-        let normal_sign = if flip { -1.0 } else { 1.0 };
-        // Each vertex transformed once, not once per corner: a mesh's
-        // triangles share most of its vertices.
-        let positions: Vec<Vec3A> = (self.positions.iter())
-            .map(|&p| to_world.transform_point3a(Vec3A::from(p)))
-            .collect();
-        let normals: Option<Vec<Vec3A>> =
-            self.normals.as_ref().filter(|_| !face_normals).map(|n| {
-                n.iter()
-                    .map(|&n| (normal_matrix * Vec3A::from(n)).normalize_or_zero() * normal_sign)
-                    .collect()
-            });
-        out.reserve(self.indices.len());
-        for &[a, b, c] in &self.indices {
-            let order = if reverse { [a, c, b] } else { [a, b, c] };
-            let vertices = order.map(|i| positions[i as usize]);
-            let normals = (normals.as_ref())
-                .map(|n| order.map(|i| n[i as usize]))
-                .filter(|n| n.iter().all(|v| *v != Vec3A::ZERO && v.is_finite()));
-            let uvs = self.uvs.as_ref().map(|uv| order.map(|i| uv[i as usize]));
-            out.push(TriangleInput {
-                vertices,
-                material,
-                uvs,
-                normals,
-            });
+        let at = Placement::new(to_world, orientation, flip, face_normals, material);
+        out.extend((0..self.indices.len()).map(|f| self.triangle(&at, f)));
+    }
+
+    /// Face `f` placed by `at`, made on its own so that an importer can
+    /// make a scene's triangles on every core (transforming a corner costs
+    /// less than writing the triangle).
+    #[inline]
+    pub fn triangle(&self, at: &Placement, f: usize) -> TriangleInput {
+        let [a, b, c] = self.indices[f];
+        let order = if at.reverse { [a, c, b] } else { [a, b, c] };
+        let vertices =
+            order.map(|i| (at.to_world).transform_point3a(Vec3A::from(self.positions[i as usize])));
+        let normals = (self.normals.as_ref())
+            .filter(|_| !at.face_normals)
+            .map(|n| {
+                order.map(|i| {
+                    (at.normal_matrix * Vec3A::from(n[i as usize])).normalize_or_zero()
+                        * at.normal_sign
+                })
+            })
+            .filter(|n| n.iter().all(|v| *v != Vec3A::ZERO && v.is_finite()));
+        let uvs = self.uvs.as_ref().map(|uv| order.map(|i| uv[i as usize]));
+        TriangleInput {
+            vertices,
+            material: at.material,
+            uvs,
+            normals,
         }
     }
 

@@ -34,6 +34,7 @@ use emitters::EmitterShape;
 use glam::Vec3A;
 use light::{Light, LightSampling, Lights, PlanarEmitter};
 use material::{Material, Opacity};
+use rayon::prelude::*;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -304,7 +305,7 @@ impl Scene {
         }
         let triangle_out_of_range = |t: &TriangleInput| !t.vertices.iter().all(|&v| in_range(v));
         let sphere_out_of_range = |s: &Sphere| !in_range(s.center) || !(s.radius <= MAX_COORDINATE);
-        let out_of_range = triangles.iter().any(triangle_out_of_range)
+        let out_of_range = triangles.par_iter().any(triangle_out_of_range)
             || spheres.iter().any(sphere_out_of_range)
             || moving.iter().any(|(t, s, v)| {
                 t.iter().any(triangle_out_of_range)
@@ -318,8 +319,8 @@ impl Scene {
             )));
         }
         if let Some(bad) = triangles
-            .iter()
-            .find(|t| t.material as usize >= input.materials.len())
+            .par_iter()
+            .find_any(|t| t.material as usize >= input.materials.len())
         {
             return Err(Error::new(format!(
                 "internal: triangle refers to material {}",

@@ -81,6 +81,10 @@ fn parse(path: &Path, single_index: bool) -> Result<(Vec<tobj::Model>, Vec<Mater
     }
     let materials = materials
         .map_err(|e| Error::at(path, None, format!("cannot load its material library: {e}")))?;
+    if materials.is_empty() {
+        // Finding the library's name reads every line.
+        return Ok((models, Vec::new()));
+    }
     let mtl_path = mtl_library(&text)
         .map(|m| dir.join(m))
         .unwrap_or_else(|| path.to_path_buf());
@@ -279,7 +283,9 @@ fn quick_scan(text: &str) -> bool {
             b"mtllib" => return false,
             _ => {}
         }
-        match b[i..].iter().position(|&c| c == b'\n') {
+        // `str::find` of one byte is a memchr: most lines are vertices,
+        // passed over whole.
+        match text[i..].find('\n') {
             Some(k) => i += k + 1,
             None => break,
         }

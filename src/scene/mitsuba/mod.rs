@@ -43,6 +43,8 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
         textures: Vec::new(),
         texture_ids: HashMap::new(),
         triangles: Vec::new(),
+        pending: Vec::new(),
+        pending_triangles: 0,
         spheres: Vec::new(),
         instances: Default::default(),
         groups: HashMap::new(),
@@ -103,6 +105,10 @@ pub(super) struct Importer<'a> {
     textures: Vec<Texture>,
     texture_ids: HashMap<*const Element, u32>,
     triangles: Vec<TriangleInput>,
+    /// Meshes of the top level waiting to be placed, in file order, and
+    /// their triangles (see `place_pending`).
+    pending: Vec<shapes::Pending<'a>>,
+    pending_triangles: usize,
     spheres: Vec<Sphere>,
     instances: crate::scene::InstancesInput,
     /// Per shapegroup, its prototype, or None where it must be copied
@@ -141,6 +147,7 @@ impl<'a> Importer<'a> {
                 other => self.warn(&e.loc, &format!("<{other}> ignored")),
             }
         }
+        self.place_pending()?;
         match sensor {
             Some(s) => self.sensor(s),
             None => {

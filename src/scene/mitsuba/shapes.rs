@@ -8,9 +8,18 @@ use super::props::{Colour, Props};
 use super::xml::Element;
 use crate::accel::{NO_LIGHT, Sphere};
 use crate::error::Result;
-use crate::scene::mesh::{MeshData, Orientation};
+use crate::scene::mesh::{MeshData, Orientation, Placement};
 use crate::scene::{MAX_COORDINATE, in_range};
 use glam::{Mat4, Vec3A};
+use rayon::prelude::*;
+
+/// A mesh waiting to be placed (see [`Importer::place_pending`]).
+pub(super) struct Pending<'a> {
+    mesh: MeshData,
+    at: Placement,
+    /// The shape, for errors.
+    e: &'a Element,
+}
 
 /// Segments of a tessellated disk or cylinder.
 const SEGMENTS: u32 = 128;
@@ -45,7 +54,6 @@ impl<'a> Importer<'a> {
             self.warn(&medium.loc, "participating medium ignored");
         }
         let material = self.material(bsdf, emission)?;
-        let start = self.triangles.len();
         let (mesh, orientation, face_normals) = match kind {
             "obj" | "ply" | "serialized" => {
                 let file = MeshFile::of(e, &p, self.doc)?.expect("a mesh shape");
@@ -75,8 +83,6 @@ impl<'a> Importer<'a> {
                         * Mat4::from_quat(rotation)
                         * Mat4::from_scale(glam::Vec3::new(radius, radius, axis.length()));
                     let cylinder = MeshData::cylinder(SEGMENTS);
-                    let placement = (to_world * local, Orientation::Normal, flip, false);
-                    self.place_mesh(e, &cylinder, placement, material)?;
                     self.warn(
                         &e.loc,
                         &format!(
@@ -84,6 +90,8 @@ impl<'a> Importer<'a> {
                             cylinder.indices.len()
                         ),
                     );
+                    let placement = (to_world * local, Orientation::Normal, flip, false);
+                    self.place_mesh(e, cylinder, placement, material)?;
                     p.unused(&mut self.warnings);
                     return Ok(());
                 };
@@ -133,14 +141,12 @@ impl<'a> Importer<'a> {
                 return Ok(());
             }
         };
-        mesh.validate().map_err(|m| e.loc.error(m))?;
         self.place_mesh(
             e,
-            &mesh,
+            mesh,
             (to_world, orientation, flip, face_normals),
             material,
         )?;
-        debug_assert!(self.triangles.len() >= start);
         p.unused(&mut self.warnings);
         Ok(())
     }
@@ -158,6 +164,8 @@ impl<'a> Importer<'a> {
             _ if self.reading_group => None,
             Some(&p) => p,
             None => {
+                // The group's triangles are read into a list of their own.
+                self.place_pending()?;
                 let triangles = std::mem::take(&mut self.triangles);
                 let spheres = self.spheres.len();
                 self.reading_group = true;
@@ -213,37 +221,73 @@ impl<'a> Importer<'a> {
         Ok(())
     }
 
-    /// Appends `mesh`'s triangles placed by (to_world, orientation, flip,
+    /// The triangles placed so far and waiting to be placed.
+    fn triangle_count(&self) -> usize {
+        self.triangles.len() + self.pending_triangles
+    }
+
+    /// Adds `mesh`'s triangles placed by (to_world, orientation, flip,
     /// face_normals) (see [`MeshData::triangles`]), checked against the
-    /// triangle limit before and the coordinate range after.
+    /// triangle limit. A mesh of the top level waits for
+    /// [`Importer::place_pending`]; one in a shape group, read into its
+    /// prototype, is placed now.
     fn place_mesh(
         &mut self,
-        e: &Element,
-        mesh: &MeshData,
+        e: &'a Element,
+        mesh: MeshData,
         (to_world, orientation, flip, face_normals): (Mat4, Orientation, bool, bool),
         material: u32,
     ) -> Result<()> {
-        if self.triangles.len() + mesh.indices.len() > self.limits.max_triangles {
+        if self.triangle_count() + mesh.indices.len() > self.limits.max_triangles {
             return Err(e.loc.error(format!(
                 "more than {} triangles (raise the limit with --max-triangles)",
                 self.limits.max_triangles
             )));
         }
-        let start = self.triangles.len();
-        mesh.triangles(
-            to_world,
-            orientation,
-            flip,
-            face_normals,
-            material,
-            &mut self.triangles,
-        );
-        if !self.triangles[start..]
-            .iter()
-            .all(|t| t.vertices.iter().all(|&v| in_range(v)))
-        {
-            self.triangles.truncate(start);
-            return Err(e.loc.error(format!(
+        let at = Placement::new(to_world, orientation, flip, face_normals, material);
+        self.pending_triangles += mesh.indices.len();
+        self.pending.push(Pending { at, mesh, e });
+        if self.reading_group {
+            self.place_pending()?;
+        }
+        Ok(())
+    }
+
+    /// Places the waiting meshes into `triangles`, in file order, on every
+    /// core: on a scene of a million triangles, making them on one thread
+    /// was a tenth of the load (docs/performance.md, "Loading and memory").
+    /// An error names the first shape, in file order, whose mesh is
+    /// invalid or lands out of range.
+    pub(super) fn place_pending(&mut self) -> Result<()> {
+        let pending = std::mem::take(&mut self.pending);
+        self.pending_triangles = 0;
+        let invalid = (pending.par_iter())
+            .map(|p| p.mesh.validate())
+            .position_first(|r| r.is_err());
+        if let Some(i) = invalid {
+            let message = pending[i].mesh.validate().unwrap_err();
+            return Err(pending[i].e.loc.error(message));
+        }
+        // Where each mesh's triangles start, past the end.
+        let mut starts = Vec::with_capacity(pending.len() + 1);
+        let mut total = 0;
+        for p in &pending {
+            starts.push(total);
+            total += p.mesh.indices.len();
+        }
+        let mesh_of = |k: usize| starts.partition_point(|&s| s <= k) - 1;
+        let base = self.triangles.len();
+        self.triangles
+            .par_extend((0..total).into_par_iter().with_min_len(1 << 12).map(|k| {
+                let i = mesh_of(k);
+                pending[i].mesh.triangle(&pending[i].at, k - starts[i])
+            }));
+        let outside = self.triangles[base..]
+            .par_iter()
+            .position_first(|t| !t.vertices.iter().all(|&v| in_range(v)));
+        if let Some(k) = outside {
+            self.triangles.truncate(base);
+            return Err(pending[mesh_of(k)].e.loc.error(format!(
                 "after its transform, the shape reaches beyond ±{MAX_COORDINATE:e}"
             )));
         }
