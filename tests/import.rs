@@ -297,6 +297,16 @@ fn mistakes_name_file_line_and_column() {
         e.contains("scene.xml:2:") && e.contains("\"big\" is not a number"),
         "{e}"
     );
+    // Meshes are placed after the walk, in parallel: the error still names
+    // the shape that goes out of range, not its neighbours.
+    let e = error(
+        "range",
+        "<scene version=\"3.0.0\">\n<shape type=\"rectangle\"/>\n<shape type=\"cube\">\n  <transform name=\"to_world\"><scale value=\"1e30\"/></transform>\n</shape>\n<shape type=\"cube\"/>\n</scene>",
+    );
+    assert!(
+        e.contains("scene.xml:3:1:") && e.contains("reaches beyond"),
+        "{e}"
+    );
 }
 
 #[test]
