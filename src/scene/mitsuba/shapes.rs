@@ -268,8 +268,8 @@ impl<'a> Importer<'a> {
             let message = pending[i].mesh.validate().unwrap_err();
             return Err(pending[i].e.loc.error(message));
         }
-        // Where each mesh's triangles start, past the end.
-        let mut starts = Vec::with_capacity(pending.len() + 1);
+        // Where each mesh's triangles start.
+        let mut starts = Vec::with_capacity(pending.len());
         let mut total = 0;
         for p in &pending {
             starts.push(total);
