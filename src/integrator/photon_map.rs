@@ -151,11 +151,12 @@ impl<P: Stored + Sync> PhotonMap<P> {
         map
     }
 
+    /// The bucket of cell `c`: rows of cells along x fill consecutive
+    /// buckets, so that a lookup's two cells of a row are read as one run
+    /// of memory (its 2 x 2 x 2 cells are four runs, not eight places).
     fn hash(&self, c: [i32; 3]) -> usize {
-        let h = (c[0] as u32).wrapping_mul(73856093)
-            ^ (c[1] as u32).wrapping_mul(19349663)
-            ^ (c[2] as u32).wrapping_mul(83492791);
-        h as usize % (self.starts.len() - 1)
+        let row = (c[1] as u32).wrapping_mul(19349663) ^ (c[2] as u32).wrapping_mul(83492791);
+        (c[0] as u32).wrapping_add(row) as usize & (self.starts.len() - 2)
     }
 
     fn cell_of(&self, p: Vec3A) -> [i32; 3] {
