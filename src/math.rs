@@ -267,6 +267,22 @@ pub fn reflect(w: Vec3A, n: Vec3A) -> Vec3A {
     2.0 * w.dot(n) * n - w
 }
 
+/// Asks the cache for the line holding `value`: a hint for a caller that
+/// knows an address well before it reads it, so that work done meanwhile
+/// hides the miss.
+#[inline(always)]
+pub fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        // SAFETY: prefetching is a hint; it never faults, and the address
+        // is that of a live value.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>((value as *const T).cast::<i8>()) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
+}
+
 /// The error function (Abramowitz and Stegun 7.1.26, |error| < 1.5e-7).
 pub fn erf(x: f32) -> f32 {
     let t = 1.0 / (1.0 + 0.327_591_1 * x.abs());

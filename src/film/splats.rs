@@ -46,19 +46,10 @@ impl SplatBuffer {
     /// SmallVCM's scene, 512 x 512).
     #[inline]
     fn prefetch(&self, film: Vec2) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            let (x, y) = (film.x as u32, film.y as u32);
-            if x < self.width && y < self.height {
-                let sums = &self.sums[(y * self.width + x) as usize];
-                // SAFETY: prefetching is a hint; it never faults, and the
-                // address is an element of a live vector.
-                unsafe { _mm_prefetch::<_MM_HINT_T0>(sums.as_ptr() as *const i8) };
-            }
+        let (x, y) = (film.x as u32, film.y as u32);
+        if x < self.width && y < self.height {
+            crate::math::prefetch(&self.sums[(y * self.width + x) as usize]);
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = film;
     }
 
     /// Adds `value` to the pixel containing `film`; false (and nothing added)

@@ -15,7 +15,7 @@
 use super::RayCounts;
 use super::light::importance_weight;
 use crate::accel::{NO_LIGHT, SurfaceHit};
-use crate::math::{Frame, Ray, Rgb, ray_between};
+use crate::math::{Frame, Ray, Rgb, prefetch, ray_between};
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Sampler, SamplerKind};
 use crate::scene::Scene;
@@ -219,6 +219,40 @@ impl<P: Stored + Sync> PhotonMap<P> {
                     if p.facing().dot(normal) > 0.0 {
                         visit(e.index, p);
                     }
+                }
+            }
+        }
+    }
+
+    /// The first bucket of each row of two cells that a lookup at `point`
+    /// reads (the 2 x 2 x 2 cells nearest it are four such rows).
+    #[inline(always)]
+    fn rows(&self, point: Vec3A) -> [usize; 4] {
+        let base = (point / self.cell - Vec3A::splat(0.5)).floor();
+        let (x, y, z) = (base.x as i32, base.y as i32, base.z as i32);
+        [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(dy, dz)| self.hash([x, y + dy, z + dz]))
+    }
+
+    /// Asks the cache for the bucket bounds that a lookup at `point` reads
+    /// first: a lookup's reads are cache misses (its cells are anywhere in
+    /// the map), which the caller's work until the lookup can hide.
+    #[inline(always)]
+    pub fn prefetch_buckets(&self, point: Vec3A) {
+        if !self.photons.is_empty() {
+            for h in self.rows(point) {
+                prefetch(&self.starts[h]);
+            }
+        }
+    }
+
+    /// Asks the cache for the first entries of those buckets: call it once
+    /// [`PhotonMap::prefetch_buckets`] has had time to bring their bounds.
+    #[inline(always)]
+    pub fn prefetch_entries(&self, point: Vec3A) {
+        if !self.photons.is_empty() {
+            for h in self.rows(point) {
+                if let Some(e) = self.entries.get(self.starts[h] as usize) {
+                    prefetch(e);
                 }
             }
         }

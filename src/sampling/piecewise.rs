@@ -114,16 +114,10 @@ impl Piecewise1D {
     /// reads first for `u`: a hint, for a caller that knows u early.
     #[inline(always)]
     pub fn prefetch(&self, u: f32) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            let n = self.len();
-            let k = ((u * n as f32) as usize).min(n.saturating_sub(1));
-            if let Some(cell) = self.cells.get(k) {
-                // SAFETY: prefetching is a hint; it never faults, and the
-                // address is that of a live element.
-                unsafe { _mm_prefetch::<_MM_HINT_T0>((cell as *const Cell).cast::<i8>()) };
-            }
+        let n = self.len();
+        let k = ((u * n as f32) as usize).min(n.saturating_sub(1));
+        if let Some(cell) = self.cells.get(k) {
+            crate::math::prefetch(cell);
         }
     }
 

@@ -580,6 +580,9 @@ impl MultiPassEstimator for Vcm {
                 radiance += walk.beta * self.environment(scene, &ray, segments, &walk);
                 break;
             };
+            // The merge's reads miss the cache: they are started now and
+            // arrive while the light sample and the connections trace.
+            iteration.map.prefetch_buckets(hit.point);
             let wo_world = -ray.direction;
             let material = &scene.materials[hit.material as usize];
             if hit.light != NO_LIGHT {
@@ -615,6 +618,7 @@ impl MultiPassEstimator for Vcm {
             if !bsdf.is_specular() {
                 radiance +=
                     walk.beta * self.light_sample(scene, iteration, &at, &walk, sampler, counts);
+                iteration.map.prefetch_entries(at.point);
                 for light in &iteration.map.items()[light_path.clone()] {
                     if light.segments + segments <= self.max_depth {
                         radiance +=
