@@ -35,6 +35,7 @@ use crate::accel::NO_LIGHT;
 use crate::math::{Ray, Rgb, ray_between};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
+use crate::scene::material::Bsdf;
 use glam::{Vec2, Vec3A};
 use std::cell::RefCell;
 
@@ -346,9 +347,11 @@ impl Bdpt {
         let mut relative = Rgb::ONE;
         let mut bounces = 0;
         while path.len() < max_vertices {
-            let u_lobe = sampler.next_1d_for(Domain::Bsdf);
+            // The lobe and roulette numbers are computed only where used
+            // (their dimensions are kept either way).
+            let lobe_dim = sampler.skip();
             let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
-            let u_roulette = sampler.next_1d_for(Domain::Other);
+            let roulette_dim = sampler.skip();
             let (u_select, u_connect) = match transport {
                 Transport::Radiance => (
                     sampler.next_1d_for(Domain::Light),
@@ -414,6 +417,11 @@ impl Bdpt {
                 break;
             }
 
+            let u_lobe = if matches!(bsdf, Bsdf::Diffuse { .. }) {
+                0.0
+            } else {
+                sampler.get_1d_for(lobe_dim, Domain::Bsdf)
+            };
             let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
                 break;
             };
@@ -438,7 +446,7 @@ impl Bdpt {
             bounces += 1;
             if self.russian_roulette && bounces > self.rr_depth {
                 let q = relative.max_element().min(1.0);
-                if u_roulette >= q {
+                if sampler.get_1d_for(roulette_dim, Domain::Other) >= q {
                     break;
                 }
                 beta /= q;
