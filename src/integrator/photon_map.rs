@@ -156,7 +156,12 @@ impl<P: Stored + Sync> PhotonMap<P> {
     /// of memory (its 2 x 2 x 2 cells are four runs, not eight places).
     fn hash(&self, c: [i32; 3]) -> usize {
         let row = (c[1] as u32).wrapping_mul(19349663) ^ (c[2] as u32).wrapping_mul(83492791);
-        (c[0] as u32).wrapping_add(row) as usize & (self.starts.len() - 2)
+        (c[0] as u32).wrapping_add(row) as usize & self.mask()
+    }
+
+    /// Buckets − 1 (their number is a power of two).
+    fn mask(&self) -> usize {
+        self.starts.len() - 2
     }
 
     fn cell_of(&self, p: Vec3A) -> [i32; 3] {
@@ -197,27 +202,23 @@ impl<P: Stored + Sync> PhotonMap<P> {
         if self.photons.is_empty() {
             return;
         }
-        // The 2 x 2 x 2 cells nearest the point cover its sphere.
-        let base = (point / self.cell - Vec3A::splat(0.5)).floor();
+        // The 2 x 2 x 2 cells nearest the point cover its sphere; a row's
+        // second cell is the bucket after its first.
         let r2 = self.radius * self.radius;
         let mut seen = [usize::MAX; 8];
-        for k in 0..8 {
-            let c = [
-                base.x as i32 + (k & 1),
-                base.y as i32 + ((k >> 1) & 1),
-                base.z as i32 + ((k >> 2) & 1),
-            ];
-            let h = self.hash(c);
-            // Two cells may share a hash; visit each bucket once.
-            if seen[..k as usize].contains(&h) {
-                continue;
-            }
-            seen[k as usize] = h;
-            for e in &self.entries[self.starts[h] as usize..self.starts[h + 1] as usize] {
-                if (Vec3A::from(e.position) - point).length_squared() <= r2 {
-                    let p = &self.photons[e.index as usize];
-                    if p.facing().dot(normal) > 0.0 {
-                        visit(e.index, p);
+        for (row, first) in self.rows(point).into_iter().enumerate() {
+            for (k, h) in [(2 * row, first), (2 * row + 1, (first + 1) & self.mask())] {
+                // Two cells may share a bucket; visit each bucket once.
+                if seen[..k].contains(&h) {
+                    continue;
+                }
+                seen[k] = h;
+                for e in &self.entries[self.starts[h] as usize..self.starts[h + 1] as usize] {
+                    if (Vec3A::from(e.position) - point).length_squared() <= r2 {
+                        let p = &self.photons[e.index as usize];
+                        if p.facing().dot(normal) > 0.0 {
+                            visit(e.index, p);
+                        }
                     }
                 }
             }
