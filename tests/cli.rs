@@ -3,7 +3,7 @@
 
 use crate::common::{repo_path, temp_dir};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
 
 pub(crate) fn tracelab(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_tracelab"))
@@ -567,4 +567,24 @@ fn the_summary_says_which_shortcuts_apply_and_why_not() {
         off.contains("lights seen directly: sampled (switched off)"),
         "{off}"
     );
+}
+
+/// Output piped into a reader that stops early (`tracelab compare a b |
+/// head -1`) ends the process quietly: the print after the reader left
+/// panicked ("failed printing to stdout: Broken pipe").
+#[test]
+fn output_into_a_pipe_closed_early_is_not_a_panic() {
+    let exr = repo_path("tests/data/cornell_box_direct_ref.exr");
+    let exr = exr.to_str().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tracelab"))
+        .args(["compare", exr, exr])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    // The reader is gone before the comparison (two EXR files) is printed.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("binary ends");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "panic: {err}");
 }

@@ -129,6 +129,17 @@ struct ViewArgs {
     strict: bool,
 }
 
+impl Cli {
+    /// True when the command opens the viewer's window rather than
+    /// printing to the terminal.
+    pub fn opens_window(&self) -> bool {
+        #[cfg(feature = "viewer")]
+        return matches!(self.command, None | Some(Command::View(_)));
+        #[cfg(not(feature = "viewer"))]
+        false
+    }
+}
+
 /// Runs the parsed command line.
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
