@@ -252,6 +252,10 @@ fn mitsuba_06_names_read_as_mitsuba_3s() {
         scene.materials[0].bsdf,
         tracelab::bsdf::Bsdf::RoughPlastic { .. }
     ));
+    // Mitsuba 0.x also spells the step `<lookAt>` (its own veach_mi scene).
+    let camel = xml.replace("<lookat ", "<lookAt ");
+    let camel = load("v06-lookAt", &camel, &[], false).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(camel.camera, scene.camera);
 }
 
 #[test]

@@ -90,7 +90,14 @@ impl Document {
             "file `{name}` not found (looked in {})",
             self.search_paths
                 .iter()
-                .map(|p| p.display().to_string())
+                // The scene's folder is empty when it was named without one.
+                .map(|p| {
+                    if p.as_os_str().is_empty() {
+                        ".".to_string()
+                    } else {
+                        p.display().to_string()
+                    }
+                })
                 .collect::<Vec<_>>()
                 .join(", ")
         )))
@@ -207,6 +214,12 @@ impl Reader {
             };
             attrs.push((a.name().to_string(), value));
         }
+        // Mitsuba 0.x's schema takes the look-at step in both spellings
+        // (its own veach_mi scene says `<lookAt>`).
+        let tag = match (tag, self.major_version) {
+            ("lookAt", 0..=2) => "lookat",
+            _ => tag,
+        };
         let element = Element {
             tag: tag.to_string(),
             attrs,
@@ -314,6 +327,28 @@ mod tests {
         );
         assert_eq!(camel_to_snake("alphaU"), "alpha_u");
         assert_eq!(camel_to_snake("max_depth"), "max_depth");
+    }
+
+    #[test]
+    fn a_missing_file_names_the_folders_searched() {
+        let loc = Loc {
+            file: Arc::from(Path::new("scene.xml")),
+            line: 2,
+            col: 1,
+        };
+        // `tracelab render scene.xml` from the scene's folder: its folder is "".
+        let document = Document {
+            root: Element {
+                tag: "scene".into(),
+                attrs: Vec::new(),
+                children: Vec::new(),
+                loc: loc.clone(),
+            },
+            search_paths: vec![PathBuf::new(), PathBuf::from("textures")],
+            major_version: 0,
+        };
+        let e = document.resolve("none.jpg", &loc).unwrap_err().to_string();
+        assert!(e.ends_with("(looked in ., textures)"), "{e}");
     }
 
     #[test]
