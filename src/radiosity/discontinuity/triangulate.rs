@@ -13,7 +13,8 @@ use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 /// spade's Delaunay refinement to angles of at least [`MIN_ANGLE`].
 ///
 /// With `max_edge` (scene units; the matrix solvers' element size), every
-/// receiver is meshed so, lines or not, into pieces of about that size:
+/// receiver is meshed, lines or not, with points at most that far apart
+/// along its edges and lines, the interior refined for angles only:
 /// the triangle's edges are cut at points that depend only on the edge,
 /// so the triangle across it, meshed on its own, has the same ones and
 /// the mesh has no T-vertices. Without (the hierarchy, which subdivides
@@ -221,15 +222,14 @@ fn split_triangle(v: [Vec3A; 3], segments: &[Segment], max_edge: Option<f32>) ->
             cdt.add_constraint_and_split(pair[0], pair[1], |p| p);
         }
     }
-    let mut parameters = RefinementParameters::<f64>::new()
+    // Angles only: the points on the edges and lines already space the
+    // pieces by `max_edge`. An area bound of an equilateral piece of that
+    // edge (in this frame's units) made the Cornell box's pieces smaller but
+    // not its error at equal element count (docs/validation.md).
+    let parameters = RefinementParameters::<f64>::new()
         .keep_constraint_edges()
         .with_angle_limit(AngleLimit::from_deg(MIN_ANGLE))
         .with_max_additional_vertices(10 * cdt.num_vertices() + 1000);
-    if let Some(max_edge) = max_edge {
-        // An equilateral triangle's area at that edge length.
-        let m = max_edge as f64;
-        parameters = parameters.with_max_allowed_area(0.433 * m * m);
-    }
     cdt.refine(parameters);
     // Whether the edge from p to q lies on one of the lines.
     let on_a_line = |p: Point2<f64>, q: Point2<f64>| {
@@ -275,6 +275,34 @@ fn split_triangle(v: [Vec3A; 3], segments: &[Segment], max_edge: Option<f32>) ->
 mod tests {
     use super::*;
     use crate::radiosity::discontinuity::Event;
+
+    #[test]
+    fn pieces_do_not_depend_on_the_scenes_units() {
+        // A receiver in metres and the same in millimetres, with a line
+        // and element size 0.15 m; an area bound in scene units once
+        // refined the first and not the second.
+        let mesh = |scale: f32| {
+            let v = [
+                Vec3A::ZERO,
+                Vec3A::new(0.55, 0.0, 0.0),
+                Vec3A::new(0.0, 0.0, 0.55),
+            ]
+            .map(|p| scale * p);
+            let line = Segment {
+                ends: [Vec3A::new(0.1, 0.0, 0.0), Vec3A::new(0.0, 0.0, 0.3)].map(|p| scale * p),
+                event: Event::VertexEdge,
+            };
+            split_triangle(v, &[line], Some(0.15 * scale))
+        };
+        let (metres, millimetres) = (mesh(1.0), mesh(1000.0));
+        assert_eq!(metres.len(), millimetres.len());
+        for (a, b) in metres.iter().zip(&millimetres) {
+            for (p, q) in a.vertices.iter().zip(&b.vertices) {
+                assert!((1000.0 * *p - *q).abs().max_element() < 1e-3, "{p} {q}");
+            }
+            assert_eq!(a.on_line, b.on_line);
+        }
+    }
 
     #[test]
     fn a_crossing_pair_splits_a_triangle_into_pieces_that_tile_it() {
