@@ -19,6 +19,23 @@ pub fn default_camera(
     spheres: &[Sphere],
     instances: &super::InstancesInput,
 ) -> Camera {
+    let (lo, hi) =
+        bounds(triangles, spheres, instances).unwrap_or((Vec3A::splat(-1.0), Vec3A::ONE));
+    let center = 0.5 * (lo + hi);
+    let radius = (0.5 * (hi - lo).length()).max(1e-3);
+    let fov_y: f32 = 40.0;
+    let distance = radius / (0.5 * fov_y.to_radians()).sin();
+    let eye = center + Vec3A::new(0.0, 0.3, 1.0).normalize() * distance;
+    Camera::look_at(eye, center, Vec3A::Y, fov_y, 512, 512, 0.0, distance)
+}
+
+/// The box around the triangles, the spheres and the instances' placed
+/// boxes; None for an empty scene.
+pub fn bounds(
+    triangles: &[TriangleInput],
+    spheres: &[Sphere],
+    instances: &super::InstancesInput,
+) -> Option<(Vec3A, Vec3A)> {
     let mut lo = Vec3A::splat(f32::INFINITY);
     let mut hi = Vec3A::splat(f32::NEG_INFINITY);
     for v in triangles.iter().flat_map(|t| t.vertices) {
@@ -30,15 +47,7 @@ pub fn default_camera(
     for s in spheres {
         (lo, hi) = (lo.min(s.center - s.radius), hi.max(s.center + s.radius));
     }
-    if !(lo.is_finite() && hi.is_finite()) {
-        (lo, hi) = (Vec3A::splat(-1.0), Vec3A::ONE);
-    }
-    let center = 0.5 * (lo + hi);
-    let radius = (0.5 * (hi - lo).length()).max(1e-3);
-    let fov_y: f32 = 40.0;
-    let distance = radius / (0.5 * fov_y.to_radians()).sin();
-    let eye = center + Vec3A::new(0.0, 0.3, 1.0).normalize() * distance;
-    Camera::look_at(eye, center, Vec3A::Y, fov_y, 512, 512, 0.0, distance)
+    (lo.is_finite() && hi.is_finite()).then_some((lo, hi))
 }
 
 /// A mesh file on its own: grey diffuse, a constant white environment.

@@ -423,7 +423,8 @@ impl<'a> Importer<'a> {
         } else {
             (0.0, 1.0)
         };
-        for quiet in ["near_clip", "far_clip", "shutter_open", "shutter_close"] {
+        let clips = (p.float("near_clip")?, p.float("far_clip")?);
+        for quiet in ["shutter_open", "shutter_close"] {
             let _ = p.float(quiet)?;
         }
         let mut camera = Camera::look_at(
@@ -441,8 +442,47 @@ impl<'a> Importer<'a> {
         if Vec3A::from(m.x_axis.truncate()).dot(camera.right) > 0.0 {
             camera.right = -camera.right;
         }
+        for note in self.clipping(&camera, clips) {
+            self.warn(&e.loc, &note);
+        }
         p.unused(&mut self.warnings);
         Ok(camera)
+    }
+
+    /// What the file's `near_clip` and `far_clip` would cut away, which
+    /// tracelab's camera does not: a note for each that the scene's box
+    /// crosses, by depth along the view (Mitsuba clips by depth).
+    fn clipping(&self, camera: &Camera, (near, far): (Option<f32>, Option<f32>)) -> Vec<String> {
+        let Some((lo, hi)) =
+            super::framing::bounds(&self.triangles, &self.spheres, &self.instances)
+        else {
+            return Vec::new();
+        };
+        let depths = (0..8).map(|k| {
+            let corner = Vec3A::select(
+                glam::BVec3A::new(k & 1 != 0, k & 2 != 0, k & 4 != 0),
+                hi,
+                lo,
+            );
+            (corner - camera.eye).dot(camera.forward)
+        });
+        let (nearest, farthest) = depths.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), d| {
+            (a.min(d), b.max(d))
+        });
+        let mut notes = Vec::new();
+        if let Some(near) = near.filter(|&near| nearest < near) {
+            notes.push(format!(
+                "near_clip {near} ignored: the scene's box comes to depth {nearest:.4} of the camera, \
+                 and surfaces nearer than near_clip are rendered, not clipped"
+            ));
+        }
+        if let Some(far) = far.filter(|&far| farthest > far) {
+            notes.push(format!(
+                "far_clip {far} ignored: the scene's box reaches depth {farthest:.4} of the camera, \
+                 and surfaces beyond far_clip are rendered, not clipped"
+            ));
+        }
+        notes
     }
 
     fn film(&mut self, e: &'a Element) -> Result<(u32, u32, PixelFilter)> {
