@@ -9,7 +9,12 @@ use tracelab::integrator::{Integrator, PathTracer};
 use tracelab::sampling::SamplerKind;
 use tracelab::scene::{LoadOptions, Scene};
 
-fn load(name: &str, xml: &str, defines: &[(&str, &str)], strict: bool) -> tracelab::Result<Scene> {
+pub(crate) fn load(
+    name: &str,
+    xml: &str,
+    defines: &[(&str, &str)],
+    strict: bool,
+) -> tracelab::Result<Scene> {
     let dir = temp_dir(name);
     write_assets(&dir);
     let path = dir.join("scene.xml");
@@ -256,45 +261,6 @@ fn mitsuba_06_names_read_as_mitsuba_3s() {
     let camel = xml.replace("<lookat ", "<lookAt ");
     let camel = load("v06-lookAt", &camel, &[], false).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(camel.camera, scene.camera);
-}
-
-/// Mitsuba clips by depth along the view; tracelab does not, and says so
-/// only where the scene's box crosses the file's near_clip or far_clip
-/// (Mitsuba's cube, -1 to 1, seen from 5 away spans depths 4 to 6).
-#[test]
-fn near_and_far_clips_that_would_cut_the_scene_are_warnings() {
-    let warnings = |clips: &str| {
-        let xml = format!(
-            r#"<scene version="3.0.0">
-  <sensor type="perspective">{clips}
-    <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0"/></transform>
-  </sensor>
-  <shape type="cube"/>
-  <emitter type="constant"/>
-</scene>"#
-        );
-        let scene = load("clips", &xml, &[], false).unwrap_or_else(|e| panic!("{e}"));
-        scene.warnings
-    };
-    let clip = |near: f32, far: f32| {
-        format!(r#"<float name="near_clip" value="{near}"/><float name="far_clip" value="{far}"/>"#)
-    };
-    assert!(warnings("").is_empty());
-    assert!(
-        warnings(&clip(3.9, 6.1)).is_empty(),
-        "{:?}",
-        warnings(&clip(3.9, 6.1))
-    );
-    let w = warnings(&clip(4.5, 6.1));
-    assert!(
-        w.len() == 1 && w[0].contains("near_clip 4.5 ignored"),
-        "{w:?}"
-    );
-    let w = warnings(&clip(3.9, 5.5));
-    assert!(
-        w.len() == 1 && w[0].contains("far_clip 5.5 ignored"),
-        "{w:?}"
-    );
 }
 
 #[test]

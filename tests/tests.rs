@@ -11,6 +11,8 @@ mod material_references;
 mod bitterli;
 // Mitsuba XML, PLY and serialized import: every element, every error.
 mod import;
+// Mitsuba sensors: the clips the importer does not apply are warnings.
+mod import_sensor;
 // White furnace: closed sphere with known radiance Le / (1 - albedo).
 mod furnace;
 // Chi-square goodness of fit of every sampling routine against its pdf.
