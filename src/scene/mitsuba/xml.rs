@@ -329,13 +329,17 @@ mod tests {
         assert_eq!(camel_to_snake("max_depth"), "max_depth");
     }
 
+    fn loc(file: &str, line: u32, col: u32) -> Loc {
+        Loc {
+            file: Arc::from(Path::new(file)),
+            line,
+            col,
+        }
+    }
+
     #[test]
     fn a_missing_file_names_the_folders_searched() {
-        let loc = Loc {
-            file: Arc::from(Path::new("scene.xml")),
-            line: 2,
-            col: 1,
-        };
+        let loc = loc("scene.xml", 2, 1);
         // `tracelab render scene.xml` from the scene's folder: its folder is "".
         let document = Document {
             root: Element {
@@ -353,11 +357,7 @@ mod tests {
 
     #[test]
     fn parameters_substitute_and_unknown_ones_are_errors() {
-        let loc = Loc {
-            file: Arc::from(Path::new("s.xml")),
-            line: 3,
-            col: 5,
-        };
+        let loc = loc("s.xml", 3, 5);
         let params: HashMap<String, String> = [("spp".to_string(), "64".to_string())].into();
         assert_eq!(substitute("$spp", &params, &loc).unwrap(), "64");
         assert_eq!(substitute("a$spp.b", &params, &loc).unwrap(), "a64.b");
