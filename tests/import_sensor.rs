@@ -24,6 +24,9 @@ fn near_and_far_clips_that_would_cut_the_scene_are_warnings() {
         format!(r#"<float name="near_clip" value="{near}"/><float name="far_clip" value="{far}"/>"#)
     };
     assert!(warnings("").is_empty());
+    // A pinhole's focus distance changes nothing, in Mitsuba as here.
+    let focus = r#"<float name="focus_distance" value="6"/>"#;
+    assert!(warnings(focus).is_empty(), "{:?}", warnings(focus));
     assert!(
         warnings(&clip(3.9, 6.1)).is_empty(),
         "{:?}",

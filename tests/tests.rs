@@ -13,6 +13,8 @@ mod bitterli;
 mod import;
 // Mitsuba sensors: the clips the importer does not apply are warnings.
 mod import_sensor;
+// What Mitsuba 3's documentation scenes use: textured roughness, references.
+mod import_mitsuba_docs;
 // White furnace: closed sphere with known radiance Le / (1 - albedo).
 mod furnace;
 // Chi-square goodness of fit of every sampling routine against its pdf.

@@ -219,6 +219,7 @@ pub(super) fn material_textures(
         diffuse: albedo.or(diffuse),
         specular,
         alpha,
+        alpha_v: alpha,
         coating: None,
     })
 }

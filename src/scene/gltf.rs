@@ -507,7 +507,7 @@ impl Importer<'_> {
                 d.specular_transmittance = Some(base_rgb);
                 d.distribution = Some(crate::bsdf::Distribution::Ggx);
                 d.alpha = Some(alpha);
-                textures.alpha = alpha_texture;
+                (textures.alpha, textures.alpha_v) = (alpha_texture, alpha_texture);
             }
         } else if metallic >= 0.5 {
             d.kind = match alpha > 1e-4 {
@@ -522,7 +522,7 @@ impl Importer<'_> {
             if d.kind == MaterialKind::RoughConductor {
                 d.distribution = Some(crate::bsdf::Distribution::Ggx);
                 d.alpha = Some(alpha);
-                textures.alpha = alpha_texture;
+                (textures.alpha, textures.alpha_v) = (alpha_texture, alpha_texture);
             }
         } else {
             d.kind = match alpha > 1e-4 {
@@ -536,7 +536,7 @@ impl Importer<'_> {
             if d.kind == MaterialKind::RoughPlastic {
                 d.distribution = Some(crate::bsdf::Distribution::Ggx);
                 d.alpha = Some(alpha);
-                textures.alpha = alpha_texture;
+                (textures.alpha, textures.alpha_v) = (alpha_texture, alpha_texture);
             }
         }
         let strength = m.emissive_strength().unwrap_or(1.0);

@@ -49,9 +49,13 @@ pub struct MaterialTextures {
     pub diffuse: Option<u32>,
     /// `specular_reflectance`: conductors' and coatings' tint.
     pub specular: Option<u32>,
-    /// `alpha`: a rough conductor's, dielectric's or plastic's roughness
-    /// (its first channel).
+    /// `alpha` (or `alpha_u`): a rough conductor's, dielectric's or
+    /// plastic's roughness (its first channel); along u where it is
+    /// anisotropic.
     pub alpha: Option<u32>,
+    /// `alpha_v`: the roughness along v. An isotropic textured roughness
+    /// names the same texture in both.
+    pub alpha_v: Option<u32>,
     /// A rough plastic's coating tables by roughness, where `alpha` is
     /// textured (glTF's roughness maps).
     pub coating: Option<&'static crate::bsdf::rough_plastic::CoatingLevels>,
@@ -61,7 +65,10 @@ impl MaterialTextures {
     /// True when no parameter is textured.
     #[inline]
     pub fn is_empty(&self) -> bool {
-        self.diffuse.is_none() && self.specular.is_none() && self.alpha.is_none()
+        self.diffuse.is_none()
+            && self.specular.is_none()
+            && self.alpha.is_none()
+            && self.alpha_v.is_none()
     }
 }
 
@@ -94,7 +101,17 @@ impl Material {
         }
         let read = |slot: Option<u32>| slot.map(|i| textures[i as usize].eval(uv));
         let (diffuse, specular) = (read(t.diffuse), read(t.specular));
-        let alpha = read(t.alpha).map(|a| a.x);
+        let alpha_u = read(t.alpha).map(|a| a.x);
+        let alpha_v = match t.alpha_v == t.alpha {
+            true => alpha_u,
+            false => read(t.alpha_v).map(|a| a.x),
+        };
+        let rough = |m: &mut Microfacet| {
+            if alpha_u.is_some() || alpha_v.is_some() {
+                let (u, v) = (alpha_u.unwrap_or(m.alpha_u), alpha_v.unwrap_or(m.alpha_v));
+                *m = Microfacet::new(m.distribution, u, v);
+            }
+        };
         let mut bsdf = self.bsdf;
         match &mut bsdf {
             Bsdf::Diffuse { albedo } => *albedo = diffuse.unwrap_or(*albedo),
@@ -106,7 +123,7 @@ impl Material {
             Bsdf::RoughPlastic { lobe, .. } => {
                 lobe.diffuse = diffuse.unwrap_or(lobe.diffuse);
                 lobe.specular = specular.unwrap_or(lobe.specular);
-                if let (Some(a), Some(levels)) = (alpha, t.coating) {
+                if let (Some(a), Some(levels)) = (alpha_u, t.coating) {
                     lobe.microfacet = Microfacet::new(lobe.microfacet.distribution, a, a);
                     lobe.tables = levels.nearest(a);
                 }
@@ -114,15 +131,11 @@ impl Material {
             Bsdf::Conductor { lobe, .. } => lobe.tint = specular.unwrap_or(lobe.tint),
             Bsdf::RoughConductor { lobe, .. } => {
                 lobe.tint = specular.unwrap_or(lobe.tint);
-                if let Some(a) = alpha {
-                    lobe.microfacet = Microfacet::new(lobe.microfacet.distribution, a, a);
-                }
+                rough(&mut lobe.microfacet);
             }
             Bsdf::RoughDielectric(lobe) => {
                 lobe.reflectance = specular.unwrap_or(lobe.reflectance);
-                if let Some(a) = alpha {
-                    lobe.microfacet = Microfacet::new(lobe.microfacet.distribution, a, a);
-                }
+                rough(&mut lobe.microfacet);
             }
             Bsdf::ThinDielectric(lobe) => lobe.reflectance = specular.unwrap_or(lobe.reflectance),
             Bsdf::Glossy { .. } | Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => {}

@@ -171,25 +171,6 @@ impl<'a> Importer<'a> {
             }
             Ok(p.float(name)?.map(IorDesc::Value))
         };
-        let rough = |p: &Props, d: &mut MaterialDesc| -> Result<()> {
-            d.distribution = match p.string("distribution")? {
-                None | Some("beckmann") => Some(crate::bsdf::Distribution::Beckmann),
-                Some("ggx") => Some(crate::bsdf::Distribution::Ggx),
-                Some(other) => {
-                    return Err(p
-                        .loc()
-                        .error(format!("distribution \"{other}\" is not beckmann or ggx")));
-                }
-            };
-            // Visible-normal sampling is always on: it changes noise, not the image.
-            let _ = p.bool("sample_visible")?;
-            d.alpha_u = p.float("alpha_u")?;
-            d.alpha_v = p.float("alpha_v")?;
-            if d.alpha_u.is_none() && d.alpha_v.is_none() {
-                d.alpha = Some(p.float("alpha")?.unwrap_or(0.1));
-            }
-            Ok(())
-        };
         match kind {
             "diffuse" | "roughdiffuse" => {
                 d.kind = match (kind, two_sided) {
@@ -234,8 +215,7 @@ impl<'a> Importer<'a> {
                 d.specular_reflectance =
                     Some(self.colour(&p, "specular_reflectance", 1.0, &mut textures.specular)?);
                 if kind == "roughconductor" {
-                    rough(&p, &mut d)?;
-                    self.alpha_texture(&p, &mut d, &mut textures)?;
+                    self.roughness(&p, &mut d, &mut textures)?;
                 }
             }
             "dielectric" => {
@@ -270,8 +250,7 @@ impl<'a> Importer<'a> {
                     .rgb("specular_transmittance", false)?
                     .map(|c| c.to_array());
                 if kind == "roughdielectric" {
-                    rough(&p, &mut d)?;
-                    self.alpha_texture(&p, &mut d, &mut textures)?;
+                    self.roughness(&p, &mut d, &mut textures)?;
                 }
             }
             "plastic" | "roughplastic" => {
@@ -287,7 +266,7 @@ impl<'a> Importer<'a> {
                     Some(self.colour(&p, "specular_reflectance", 1.0, &mut textures.specular)?);
                 d.nonlinear = p.bool("nonlinear")?;
                 if kind == "roughplastic" {
-                    rough(&p, &mut d)?;
+                    self.roughness(&p, &mut d, &mut textures)?;
                     if d.alpha.is_none() {
                         return Err(e.loc.error("roughplastic is isotropic: give `alpha`"));
                     }
@@ -338,18 +317,43 @@ impl<'a> Importer<'a> {
         }
     }
 
-    fn alpha_texture(
+    /// A microfacet model's distribution and roughness: `alpha`, or
+    /// `alpha_u` and `alpha_v`, each a number or a texture (read at each
+    /// hit; its mean stands for it where one value is read).
+    fn roughness(
         &mut self,
         p: &Props<'a>,
         d: &mut MaterialDesc,
         textures: &mut MaterialTextures,
     ) -> Result<()> {
-        if d.alpha.is_some() {
-            return Ok(());
-        }
-        if let Some(Colour::Texture(t)) = p.colour("alpha", false)? {
-            textures.alpha = Some(self.texture(t)?);
-            d.alpha = Some(self.textures[textures.alpha.unwrap() as usize].mean().x);
+        d.distribution = match p.string("distribution")? {
+            None | Some("beckmann") => Some(crate::bsdf::Distribution::Beckmann),
+            Some("ggx") => Some(crate::bsdf::Distribution::Ggx),
+            Some(other) => {
+                return Err(p
+                    .loc()
+                    .error(format!("distribution \"{other}\" is not beckmann or ggx")));
+            }
+        };
+        // Visible-normal sampling is always on: it changes noise, not the image.
+        let _ = p.bool("sample_visible")?;
+        let mut read = |name: &str, slot: &mut Option<u32>| -> Result<Option<f32>> {
+            let texture = match p.tag_of(name) {
+                Some("texture" | "ref") => p.colour(name, false)?,
+                _ => None,
+            };
+            let Some(Colour::Texture(t)) = texture else {
+                return p.float(name);
+            };
+            let id = self.texture(t)?;
+            *slot = Some(id);
+            Ok(Some(self.textures[id as usize].mean().x))
+        };
+        d.alpha_u = read("alpha_u", &mut textures.alpha)?;
+        d.alpha_v = read("alpha_v", &mut textures.alpha_v)?;
+        if d.alpha_u.is_none() && d.alpha_v.is_none() {
+            d.alpha = Some(read("alpha", &mut textures.alpha)?.unwrap_or(0.1));
+            textures.alpha_v = textures.alpha;
         }
         Ok(())
     }

@@ -24,7 +24,7 @@ use crate::scene::light::{Light, LightSampling, SpotCone};
 use crate::texture::{Bitmap, Texture};
 use glam::{Mat3A, Mat4, Vec3A};
 use props::Props;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use xml::{Document, Element, Loc};
 
@@ -80,6 +80,18 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
     })
 }
 
+/// The ids that some `<ref>` names.
+fn collect_references<'a>(e: &'a Element, ids: &mut HashSet<&'a str>) {
+    for c in &e.children {
+        if c.tag == "ref"
+            && let Some(id) = c.attr("id")
+        {
+            ids.insert(id);
+        }
+        collect_references(c, ids);
+    }
+}
+
 /// Every element with an `id`, for `<ref>`.
 fn collect_ids<'a>(e: &'a Element, ids: &mut HashMap<String, &'a Element>) -> Result<()> {
     for c in &e.children {
@@ -131,8 +143,15 @@ impl<'a> Importer<'a> {
     /// The top level, in file order; returns the camera.
     fn scene(&mut self) -> Result<Camera> {
         let root = &self.doc.root;
+        let mut referenced = HashSet::new();
+        collect_references(root, &mut referenced);
         let mut sensor = None;
         for e in &root.children {
+            // Declared here and used where a `<ref>` names it (Mitsuba's
+            // own scenes declare area emitters and samplers so).
+            if e.tag != "shape" && e.attr("id").is_some_and(|id| referenced.contains(id)) {
+                continue;
+            }
             match e.tag.as_str() {
                 "shape" => self.shape(e, Mat4::IDENTITY)?,
                 "emitter" => self.emitter(e)?,
@@ -194,17 +213,16 @@ impl<'a> Importer<'a> {
             }
         };
         self.hints.integrator = Some(technique.to_string());
-        // Mitsuba counts segments (1: emitters seen directly, -1: unbounded);
-        // tracelab counts bounces, one fewer.
+        // Mitsuba counts segments (1: emitters seen directly, -1: unbounded,
+        // every integrator's default); tracelab counts bounces, one fewer.
         let max_depth = match e.plugin() {
-            "direct" => Some(2),
-            _ => p.int("max_depth")?,
+            "direct" => 2,
+            _ => p.int("max_depth")?.unwrap_or(-1),
         };
         self.hints.max_depth = match max_depth {
-            None => None,
-            Some(-1) => Some(super::UNBOUNDED_DEPTH),
-            Some(d) if d >= 1 => Some((d - 1) as u32),
-            Some(d) => {
+            -1 => Some(super::UNBOUNDED_DEPTH),
+            d if d >= 1 => Some((d - 1) as u32),
+            d => {
                 return Err(e
                     .loc
                     .error(format!("max_depth must be -1 or >= 1, got {d}")));
@@ -421,6 +439,8 @@ impl<'a> Importer<'a> {
             }
             (a, f)
         } else {
+            // Read by Mitsuba's pinhole too, where it changes nothing.
+            let _ = p.float("focus_distance")?;
             (0.0, 1.0)
         };
         let clips = (p.float("near_clip")?, p.float("far_clip")?);

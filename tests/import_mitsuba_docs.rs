@@ -1,0 +1,137 @@
+//! What Mitsuba 3's documentation scenes use (mitsuba-data, `docs/scenes`):
+//! roughness read from textures, and objects declared at the top level and
+//! used where a `<ref>` names them.
+
+use crate::import::load;
+use glam::Vec2;
+use tracelab::bsdf::{Bsdf, Microfacet};
+use tracelab::scene::Scene;
+
+const SENSOR: &str = r#"<sensor type="perspective">
+    <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0"/></transform>
+  </sensor>"#;
+
+/// A checkerboard of two values, 4 × 4 squares over the unit square.
+fn checks(name: &str, a: f32, b: f32) -> String {
+    format!(
+        r#"<texture name="{name}" type="checkerboard">
+      <transform name="to_uv"><scale x="2" y="2"/></transform>
+      <float name="color0" value="{a}"/><float name="color1" value="{b}"/>
+    </texture>"#
+    )
+}
+
+/// The microfacet distribution of material `name` at `uv`.
+fn microfacet(scene: &Scene, name: &str, uv: Vec2) -> Microfacet {
+    let m = scene.materials.iter().find(|m| m.name == name).unwrap();
+    match m.bsdf_at(&scene.textures, uv) {
+        Bsdf::RoughConductor { lobe, .. } => lobe.microfacet,
+        Bsdf::RoughDielectric(lobe) => lobe.microfacet,
+        Bsdf::RoughPlastic { lobe, .. } => lobe.microfacet,
+        other => panic!("{name}: {other:?}"),
+    }
+}
+
+/// `alpha`, `alpha_u` and `alpha_v` as textures, as Mitsuba's
+/// `bsdf_roughconductor_textured_carbon.xml` and
+/// `bsdf_roughdielectric_textured.xml` give them: read at each hit, each
+/// axis from its own texture.
+#[test]
+fn roughness_textures_are_read_at_each_hit() {
+    let xml = format!(
+        r#"<scene version="3.0.0">
+  {SENSOR}
+  <bsdf type="roughconductor" id="carbon">
+    <string name="distribution" value="beckmann"/>
+    {}
+    {}
+    <string name="material" value="Al"/>
+  </bsdf>
+  <bsdf type="roughdielectric" id="frosted">{}</bsdf>
+  <bsdf type="roughplastic" id="plastic">{}</bsdf>
+  <shape type="rectangle"><ref id="carbon"/></shape>
+  <shape type="rectangle"><ref id="frosted"/></shape>
+  <shape type="rectangle"><ref id="plastic"/></shape>
+  <emitter type="constant"/>
+</scene>"#,
+        checks("alpha_u", 0.05, 0.3),
+        checks("alpha_v", 0.3, 0.05),
+        checks("alpha", 0.0, 0.4),
+        checks("alpha", 0.1, 0.2),
+    );
+    let scene = load("rough_textures", &xml, &[], true).unwrap_or_else(|e| panic!("{e}"));
+    // The checkerboard's first square (u, v < 1/4) is color0, the next
+    // along u is color1.
+    let (first, second) = (Vec2::new(0.1, 0.1), Vec2::new(0.35, 0.1));
+    let alphas = |name: &str, uv: Vec2| {
+        let m = microfacet(&scene, name, uv);
+        (m.alpha_u, m.alpha_v)
+    };
+    assert_eq!(alphas("carbon", first), (0.05, 0.3));
+    assert_eq!(alphas("carbon", second), (0.3, 0.05));
+    // α 0 is kept off the delta limit (the model's minimum), as untextured.
+    let smooth = alphas("frosted", first);
+    assert!(
+        smooth.0 == smooth.1 && smooth.0 > 0.0 && smooth.0 < 1e-3,
+        "{smooth:?}"
+    );
+    assert_eq!(alphas("frosted", second), (0.4, 0.4));
+    assert_eq!(alphas("plastic", first), (0.1, 0.1));
+    assert_eq!(alphas("plastic", second), (0.2, 0.2));
+    // One texture per roughness element, each loaded once.
+    assert_eq!(scene.textures.len(), 4);
+}
+
+/// Mitsuba's cbox and sampler scenes declare the area emitter and the
+/// sampler at the top level and name them by `<ref>` inside a shape and a
+/// sensor: used there, with no warning that they were skipped.
+#[test]
+fn declarations_used_by_reference_are_not_warned_about() {
+    let xml = r#"<scene version="3.0.0">
+  <sampler type="independent" id="my_sampler"><integer name="sample_count" value="16"/></sampler>
+  <sensor type="perspective">
+    <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0"/></transform>
+    <ref id="my_sampler"/>
+  </sensor>
+  <shape type="rectangle"><ref id="light"/></shape>
+  <emitter type="area" id="light"><rgb name="radiance" value="3"/></emitter>
+</scene>"#;
+    let scene = load("declared", xml, &[], true).unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(scene.hints.spp, Some(16));
+    assert_eq!(scene.lights.as_slice().len(), 1);
+    // Declared and named by nothing, it still says what was left out.
+    let unused = xml.replace(r#"<ref id="light"/>"#, "");
+    let scene = load("declared_unused", &unused, &[], false).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        scene.warnings.iter().any(|w| w.contains(":8:3:")),
+        "{:?}",
+        scene.warnings
+    );
+}
+
+/// Mitsuba's integrators default to `max_depth` -1, unbounded: the
+/// material previews (`include/matpreview.xml`) give only
+/// `<integrator type="path"/>`, and their glass lost a tenth of its light
+/// when that was read as tracelab's own default depth.
+#[test]
+fn an_integrator_without_max_depth_is_unbounded_as_in_mitsuba() {
+    let scene = |integrator: &str| {
+        let xml = format!(
+            r#"<scene version="3.0.0">{integrator}{SENSOR}<shape type="cube"/><emitter type="constant"/></scene>"#
+        );
+        load("default_depth", &xml, &[], true).unwrap_or_else(|e| panic!("{e}"))
+    };
+    for plugin in ["path", "volpath", "bdpt", "ptracer"] {
+        let hints = scene(&format!(r#"<integrator type="{plugin}"/>"#)).hints;
+        assert_eq!(
+            hints.max_depth,
+            Some(tracelab::scene::UNBOUNDED_DEPTH),
+            "{plugin}"
+        );
+    }
+    let given = r#"<integrator type="path"><integer name="max_depth" value="4"/></integrator>"#;
+    assert_eq!(scene(given).hints.max_depth, Some(3));
+    // No integrator at all: Mitsuba 3 refuses to render; tracelab's defaults.
+    assert_eq!(scene("").hints.max_depth, None);
+}
