@@ -5,6 +5,7 @@
 //! was done instead, and `strict` makes the first one an error.
 
 mod bsdfs;
+mod cie;
 mod meshes;
 mod prefetch;
 mod props;
