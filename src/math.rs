@@ -48,6 +48,10 @@ impl Ray {
     }
 }
 
+/// A stored frame that [`Frame::turned`] leaves as [`Frame::from_normal`]
+/// builds it (an isotropic surface, which may turn any way).
+pub const NO_TURN: u16 = u16::MAX;
+
 /// Orthonormal basis with `n` as the local +z axis.
 #[derive(Clone, Copy, Debug)]
 pub struct Frame {
@@ -68,6 +72,47 @@ impl Frame {
         let s = Vec3A::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
         let t = Vec3A::new(b, sign + n.y * n.y * a, -n.y);
         Frame { s, t, n }
+    }
+
+    /// The frame of normal `n` whose first axis is `tangent` made
+    /// perpendicular to `n` (Mitsuba's shading frame from dp/du); the
+    /// frame of [`Frame::from_normal`] where that is degenerate.
+    #[inline]
+    pub fn with_tangent(n: Vec3A, tangent: Vec3A) -> Self {
+        let s = (tangent - n * n.dot(tangent)).normalize_or_zero();
+        if s == Vec3A::ZERO {
+            return Frame::from_normal(n);
+        }
+        Frame {
+            s,
+            t: n.cross(s),
+            n,
+        }
+    }
+
+    /// How far `tangent`, seen in the frame's plane, turns from `s`, in
+    /// 65 535ths of a turn: what a stored vertex keeps (16 bits, 1e-4
+    /// radians) to rebuild [`Frame::with_tangent`] by [`Frame::turned`].
+    #[inline]
+    pub fn turn_towards(&self, tangent: Vec3A) -> u16 {
+        let phi = tangent.dot(self.t).atan2(tangent.dot(self.s));
+        ((phi / std::f32::consts::TAU).rem_euclid(1.0) * 65535.0).round() as u16 % 65535
+    }
+
+    /// The frame turned about its normal by `turn` ([`Frame::turn_towards`]);
+    /// itself for [`NO_TURN`].
+    #[inline]
+    pub fn turned(&self, turn: u16) -> Frame {
+        if turn == NO_TURN {
+            return *self;
+        }
+        let (sin, cos) = (turn as f32 * (std::f32::consts::TAU / 65535.0)).sin_cos();
+        let s = self.s * cos + self.t * sin;
+        Frame {
+            s,
+            t: self.n.cross(s),
+            n: self.n,
+        }
     }
 
     #[inline]

@@ -78,8 +78,8 @@ impl SplatBuffer {
         ok
     }
 
-    /// Adds `value` to the pixel containing `film`.
-    fn add_to_pixel(&self, film: Vec2, value: Rgb) -> bool {
+    /// Adds `value` to the pixel containing `film`; false as [`SplatBuffer::add`].
+    pub(crate) fn add_to_pixel(&self, film: Vec2, value: Rgb) -> bool {
         let (x, y) = (film.x as u32, film.y as u32);
         if x >= self.width || y >= self.height {
             return true;
@@ -112,7 +112,8 @@ impl SplatBuffer {
 /// line is fetched when it is made, and added once the rest of the sample's
 /// work has hidden the fetch.
 pub(crate) struct PendingSplats {
-    splats: [(Vec2, Rgb); PENDING],
+    /// Film position, value, and whether it goes through the filter.
+    splats: [(Vec2, Rgb, bool); PENDING],
     len: usize,
     /// Splats that were not finite, negative or too large (not added).
     pub(crate) rejected: u64,
@@ -123,25 +124,31 @@ const PENDING: usize = 64;
 impl PendingSplats {
     pub(crate) fn new() -> Self {
         PendingSplats {
-            splats: [(Vec2::ZERO, Rgb::ZERO); PENDING],
+            splats: [(Vec2::ZERO, Rgb::ZERO, true); PENDING],
             len: 0,
             rejected: 0,
         }
     }
 
+    /// Holds a splat spread by the pixel filter ([`SplatBuffer::add`]), or
+    /// with `filtered` false added to the pixel containing `film` alone.
     #[inline]
-    pub(crate) fn push(&mut self, buffer: &SplatBuffer, film: Vec2, value: Rgb) {
+    pub(crate) fn push(&mut self, buffer: &SplatBuffer, film: Vec2, value: Rgb, filtered: bool) {
         if self.len == PENDING {
             self.flush(buffer);
         }
         buffer.prefetch(film);
-        self.splats[self.len] = (film, value);
+        self.splats[self.len] = (film, value, filtered);
         self.len += 1;
     }
 
     pub(crate) fn flush(&mut self, buffer: &SplatBuffer) {
-        for &(film, value) in &self.splats[..self.len] {
-            if !buffer.add(film, value) {
+        for &(film, value, filtered) in &self.splats[..self.len] {
+            let added = match filtered {
+                true => buffer.add(film, value),
+                false => buffer.add_to_pixel(film, value),
+            };
+            if !added {
                 self.rejected += 1;
             }
         }
@@ -170,7 +177,7 @@ mod tests {
             if !direct.add(film, value) {
                 rejected += 1;
             }
-            pending.push(&held, film, value);
+            pending.push(&held, film, value, true);
         }
         pending.flush(&held);
         assert_eq!(pending.rejected, rejected);

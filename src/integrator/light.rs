@@ -18,7 +18,7 @@
 
 use super::{PathLength, RayCounts, Settings, SplattingEstimator, Technique, survives_roulette};
 use crate::camera::CameraConnection;
-use crate::math::{Frame, Rgb, ray_between};
+use crate::math::{Rgb, ray_between};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::scene::light::EmissionSample;
@@ -64,6 +64,12 @@ impl Default for LightTracer {
 pub struct Splat {
     pub film: Vec2,
     pub value: Rgb,
+    /// Spread over the pixels the pixel filter covers (a point seen by the
+    /// camera); false for an estimate of the traced sample's own pixel,
+    /// whose camera ray was already drawn through the filter (BDPT's
+    /// camera strategies): filtering it again blurred it and, where the
+    /// filter's weights at whole pixels do not sum to 1 (a Gaussian), scaled it.
+    pub filtered: bool,
 }
 
 impl Technique for LightTracer {
@@ -135,6 +141,7 @@ impl SplattingEstimator for LightTracer {
                 splat(Splat {
                     film: c.film,
                     value,
+                    filtered: true,
                 });
             }
         }
@@ -154,7 +161,7 @@ impl SplattingEstimator for LightTracer {
             if bsdf.is_black() {
                 break;
             }
-            let frame = Frame::from_normal(scene.shading_normal(&hit));
+            let frame = scene.shading_frame(&hit);
             let ng = frame.to_local(hit.normal);
             // Direction back towards where the particle came from.
             let w_prev = frame.to_local(-ray.direction);
@@ -174,6 +181,7 @@ impl SplattingEstimator for LightTracer {
                     splat(Splat {
                         film: c.film,
                         value: beta * f * (w_cam.z.abs() * c.weight),
+                        filtered: true,
                     });
                 }
             }

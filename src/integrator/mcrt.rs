@@ -16,7 +16,7 @@
 
 use super::{CameraEstimator, MisHeuristic, RayCounts, Settings, Technique};
 use crate::accel::{NO_LIGHT, SurfaceHit};
-use crate::math::{Frame, Ray, Rgb};
+use crate::math::{Ray, Rgb};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::shortcuts::{PrimaryPixel, ShortcutsUsed};
@@ -205,7 +205,7 @@ impl McRayTracer {
         if level >= self.max_depth || bsdf.is_black() {
             return Rgb::ZERO;
         }
-        let frame = Frame::from_normal(scene.shading_normal(&hit));
+        let frame = scene.shading_frame(&hit);
         let wo = frame.to_local(wo_world);
         let n_light = if bsdf.is_specular() {
             0

@@ -14,7 +14,7 @@ use super::{
 };
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::bsdf::lambert;
-use crate::math::{Frame, Ray, Rgb};
+use crate::math::{Ray, Rgb};
 use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
@@ -371,7 +371,7 @@ impl PathTracer {
                 break;
             }
 
-            let frame = Frame::from_normal(scene.shading_normal(&hit));
+            let frame = scene.shading_frame(&hit);
             let wo = frame.to_local(wo_world);
             // The lobe and roulette numbers are computed only when used.
             let u_lobe = if matches!(bsdf, Bsdf::Diffuse { .. }) {

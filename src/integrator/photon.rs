@@ -208,7 +208,7 @@ impl PhotonMap2Pass {
             if !bsdf.is_specular() {
                 return Some((hit, ray.direction, beta));
             }
-            let frame = Frame::from_normal(scene.shading_normal(&hit));
+            let frame = scene.shading_frame(&hit);
             let wo = frame.to_local(-ray.direction);
             let u_lobe = sampler.next_1d_for(Domain::Bsdf);
             let u = sampler.next_2d_for(Domain::Bsdf);
@@ -285,7 +285,7 @@ impl MultiPassEstimator for PhotonMap2Pass {
             if let Some((y, arrived, chain)) = self.through_specular(scene, gather, sampler, counts)
             {
                 let bsdf_y = scene.bsdf_at(&y);
-                let frame_y = Frame::from_normal(scene.shading_normal(&y));
+                let frame_y = scene.shading_frame(&y);
                 let wo_y = frame_y.to_local(-arrived);
                 let facing_y = if y.normal.dot(arrived) < 0.0 {
                     y.normal

@@ -401,7 +401,7 @@ fn trace_photon(
         if bsdf.is_black() {
             break;
         }
-        let frame = Frame::from_normal(scene.shading_normal(&hit));
+        let frame = scene.shading_frame(&hit);
         let ng = frame.to_local(hit.normal);
         let wo = frame.to_local(-ray.direction);
         let u_lobe = sampler.next_1d_for(Domain::Bsdf);
@@ -491,7 +491,7 @@ pub fn camera_to_diffuse(
         if bsdf.is_black() {
             break;
         }
-        let frame = Frame::from_normal(scene.shading_normal(&hit));
+        let frame = scene.shading_frame(&hit);
         let wo = frame.to_local(wo_world);
         let u_lobe = sampler.next_1d_for(Domain::Bsdf);
         let u_bsdf = sampler.next_2d_for(Domain::Bsdf);

@@ -162,7 +162,7 @@ impl WhittedTracer {
         } else {
             Rgb::ZERO
         };
-        let frame = Frame::from_normal(scene.shading_normal(&hit));
+        let frame = scene.shading_frame(&hit);
         let wo = frame.to_local(wo_world);
         // Diffuse lobes: direct light from each light as a point, plus the
         // ambient term; ideal lobes (a rough one read as its smooth limit)

@@ -495,7 +495,7 @@ impl Session {
                     for s in first..first + spp {
                         sampler.start(y * width + x, s);
                         estimator.trace(scene, (x, y), &mut sampler, &mut counts, |splat| {
-                            pending.push(&splats, splat.film, splat.value)
+                            pending.push(&splats, splat.film, splat.value, splat.filtered)
                         });
                         pending.flush(&splats);
                     }

@@ -26,6 +26,9 @@ pub struct Features {
     pub shading_normals: bool,
     /// Some material has a normal map.
     pub normal_maps: bool,
+    /// Some material's roughness differs along u and v: its frame follows
+    /// the surface's dp/du.
+    pub anisotropic: bool,
 }
 
 impl Features {
@@ -70,6 +73,7 @@ impl Features {
             shading_normals: geometry.has_shading_normals()
                 || materials.iter().any(|m| m.normal_map.is_some()),
             normal_maps: materials.iter().any(|m| m.normal_map.is_some()),
+            anisotropic: materials.iter().any(Material::is_anisotropic),
         }
     }
 

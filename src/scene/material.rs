@@ -143,6 +143,17 @@ impl Material {
         bsdf
     }
 
+    /// True when the roughness differs along u and v (a lobe that turns
+    /// with the surface's tangent).
+    pub fn is_anisotropic(&self) -> bool {
+        let microfacet = match &self.bsdf {
+            Bsdf::RoughConductor { lobe, .. } => lobe.microfacet,
+            Bsdf::RoughDielectric(lobe) => lobe.microfacet,
+            _ => return false,
+        };
+        microfacet.alpha_u != microfacet.alpha_v || self.textures.alpha != self.textures.alpha_v
+    }
+
     /// True when the surface is a light source.
     pub fn is_emissive(&self) -> bool {
         self.emission.max_element() > 0.0

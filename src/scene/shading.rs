@@ -4,6 +4,7 @@
 use super::Scene;
 use super::material::NormalMap;
 use crate::accel::SurfaceHit;
+use crate::math::Frame;
 use glam::Vec3A;
 
 impl Scene {
@@ -23,6 +24,48 @@ impl Scene {
         match self.materials[hit.material as usize].normal_map {
             Some(map) => self.normal_mapped(hit, n, map),
             None => n,
+        }
+    }
+
+    /// The frame BSDFs act in at `hit`: around the shading normal, its
+    /// first axis along dp/du where the material is anisotropic (as
+    /// Mitsuba's), any other way elsewhere.
+    #[inline(always)]
+    pub fn shading_frame(&self, hit: &SurfaceHit) -> Frame {
+        let n = self.shading_normal(hit);
+        match self.shading_tangent(hit) {
+            Some(tangent) => Frame::with_tangent(n, tangent),
+            None => Frame::from_normal(n),
+        }
+    }
+
+    /// The direction the first axis of [`Scene::shading_frame`] follows
+    /// at `hit`, where the material needs one.
+    #[inline(always)]
+    pub fn shading_tangent(&self, hit: &SurfaceHit) -> Option<Vec3A> {
+        if !self.features.anisotropic || !self.materials[hit.material as usize].is_anisotropic() {
+            return None;
+        }
+        Some(self.surface_tangent(hit))
+    }
+
+    /// The turn of the frame about shading normal `n` at `hit` from
+    /// [`Frame::from_normal`]'s, as stored vertices keep it.
+    #[inline(always)]
+    pub fn shading_turn(&self, hit: &SurfaceHit, n: Vec3A) -> u16 {
+        match self.shading_tangent(hit) {
+            Some(tangent) => Frame::from_normal(n).turn_towards(tangent),
+            None => crate::math::NO_TURN,
+        }
+    }
+
+    /// dp/du, or without texture coordinates the first axis of the
+    /// geometric normal's frame (as Mitsuba's meshes without uv).
+    #[inline(never)]
+    fn surface_tangent(&self, hit: &SurfaceHit) -> Vec3A {
+        match self.geometry.uv_derivatives(hit) {
+            Some((dpdu, _)) => dpdu,
+            None => Frame::from_normal(hit.normal).s,
         }
     }
 

@@ -194,6 +194,7 @@ impl SplattingEstimator for Bdpt {
                 splat(Splat {
                     film: c.film,
                     value: c.weighted,
+                    filtered: true,
                 })
             }
         });
@@ -201,6 +202,7 @@ impl SplattingEstimator for Bdpt {
             splat(Splat {
                 film: Vec2::new(pixel.0 as f32 + 0.5, pixel.1 as f32 + 0.5),
                 value: own_pixel,
+                filtered: false,
             });
         }
     }
@@ -399,6 +401,9 @@ impl Bdpt {
                 if n != hit.normal {
                     vertex.packed_shading = crate::math::octahedral_encode(n);
                 }
+            }
+            if scene.features.anisotropic {
+                vertex.turn = scene.shading_turn(&hit, scene.shading_normal(&hit));
             }
             if hit.light != NO_LIGHT {
                 vertex.light = hit.light;

@@ -38,6 +38,9 @@ pub(super) struct Vertex {
     /// that subpath copies stay small; [`NO_SHADING_NORMAL`] where it is
     /// the geometric one.
     pub(super) packed_shading: u32,
+    /// The BSDF frame's turn about the normal (`Scene::shading_turn`), for
+    /// an anisotropic surface.
+    pub(super) turn: u16,
     /// Unit direction towards the previous vertex of its subpath.
     pub(super) wo: Vec3A,
     pub(super) bsdf: Bsdf,
@@ -81,6 +84,7 @@ impl Vertex {
         error: Vec3A::ZERO,
         normal: Vec3A::ZERO,
         packed_shading: NO_SHADING_NORMAL,
+        turn: crate::math::NO_TURN,
         wo: Vec3A::ZERO,
         bsdf: Bsdf::Diffuse { albedo: Rgb::ZERO },
         beta: Rgb::ZERO,
@@ -132,10 +136,11 @@ impl Vertex {
     /// The frame of the BSDF: the shading normal's where there is one.
     #[inline]
     pub(super) fn frame(&self) -> Frame {
-        Frame::from_normal(match self.packed_shading {
+        let n = match self.packed_shading {
             NO_SHADING_NORMAL => self.normal,
             p => crate::math::octahedral_decode(p),
-        })
+        };
+        Frame::from_normal(n).turned(self.turn)
     }
 
     /// The geometric normal in `frame` (exactly +z without a shading normal,

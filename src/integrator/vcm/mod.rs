@@ -126,7 +126,9 @@ impl Technique for Vcm {
 
     fn new(settings: &VcmSettings) -> Self {
         Vcm {
-            max_depth: settings.length.max_depth,
+            // Light vertices count their segments in 16 bits; roulette
+            // ends paths thousands of segments before.
+            max_depth: settings.length.max_depth.min(u32::from(u16::MAX) - 1),
             rr_depth: settings.length.rr_depth,
             russian_roulette: settings.length.russian_roulette,
             mis: super::options::combining(settings.mis),
@@ -176,7 +178,10 @@ pub struct LightVertex {
     /// Texture coordinates, to read the material's textures.
     uv: glam::Vec2,
     /// Segments from the light to here.
-    segments: u32,
+    segments: u16,
+    /// The BSDF frame's turn about the shading normal
+    /// (`Scene::shading_turn`), in the 16 bits beside `segments`.
+    turn: u16,
     /// Georgiev et al.'s recursive MIS quantities at this vertex.
     d_vcm: f32,
     d_vc: f32,
@@ -193,10 +198,20 @@ impl LightVertex {
             p => crate::math::octahedral_decode(p),
         }
     }
+
+    /// The frame of its BSDF.
+    #[inline]
+    fn frame(&self) -> Frame {
+        Frame::from_normal(self.shading()).turned(self.turn)
+    }
 }
 
 /// A shading normal that is the geometric one.
 const SAME_AS_GEOMETRIC: u32 = u32::MAX;
+
+// Merges read light vertices from memory: the frame's turn fits beside
+// the segment count, not in a 128-byte vertex.
+const _: () = assert!(std::mem::size_of::<LightVertex>() == 112);
 
 #[inline]
 fn pack_shading(ns: Vec3A, ng: Vec3A) -> u32 {
@@ -450,7 +465,8 @@ impl Vcm {
                     beta: walk.beta,
                     material: hit.material,
                     uv: scene.geometry.uv(&hit),
-                    segments,
+                    segments: segments as u16,
+                    turn: scene.shading_turn(&hit, shading),
                     d_vcm: walk.d_vcm,
                     d_vc: walk.d_vc,
                     d_vm: walk.d_vm,
@@ -461,7 +477,7 @@ impl Vcm {
             if segments == self.max_depth {
                 break;
             }
-            let frame = Frame::from_normal(shading);
+            let frame = scene.shading_frame(&hit);
             let Some(scatter) = self.scatter(
                 bsdf,
                 frame.to_local(wo_world),
@@ -602,8 +618,8 @@ impl MultiPassEstimator for Vcm {
             if bsdf.is_black() || segments > self.max_depth {
                 break;
             }
-            let shading = scene.shading_normal(&hit);
-            let frame = Frame::from_normal(shading);
+            let frame = scene.shading_frame(&hit);
+            let shading = frame.n;
             let wo = frame.to_local(wo_world);
             let at = CameraVertex {
                 point: hit.point,
@@ -620,7 +636,7 @@ impl MultiPassEstimator for Vcm {
                     walk.beta * self.light_sample(scene, iteration, &at, &walk, sampler, counts);
                 iteration.map.prefetch_entries(at.point);
                 for light in &iteration.map.items()[light_path.clone()] {
-                    if light.segments + segments <= self.max_depth {
+                    if u32::from(light.segments) + segments <= self.max_depth {
                         radiance +=
                             walk.beta * self.connect(scene, iteration, &at, &walk, light, counts);
                     }

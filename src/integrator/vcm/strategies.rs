@@ -66,8 +66,8 @@ impl Vcm {
         let at = (v.point, v.error, v.normal);
         self.splat_through_lens(scene, iteration, at, sampler, counts, splats, |c| {
             let bsdf = scene.materials[v.material as usize].bsdf_at(&scene.textures, v.uv);
-            let shading = v.shading();
-            let frame = Frame::from_normal(shading);
+            let frame = v.frame();
+            let shading = frame.n;
             let (wo, wi) = (frame.to_local(v.wo), frame.to_local(c.wi));
             let (f, _, pdf_reverse) = bsdf.eval_adjoint_with_pdfs(wo, wi);
             let f = f * shading_correction(wo, wi, super::normal_in(&frame, v.normal, shading));
@@ -108,7 +108,7 @@ impl Vcm {
         {
             return;
         }
-        splats.push(&iteration.light_image, c.film, value);
+        splats.push(&iteration.light_image, c.film, value, true);
     }
 
     /// The density (area, at `point`) of the camera's rays reaching it, per
@@ -201,8 +201,8 @@ impl Vcm {
             at.bsdf.eval_with_pdfs(at.wo, w_camera_local);
         let light_bsdf =
             scene.materials[light.material as usize].bsdf_at(&scene.textures, light.uv);
-        let light_shading = light.shading();
-        let light_frame = Frame::from_normal(light_shading);
+        let light_frame = light.frame();
+        let light_shading = light_frame.n;
         let (light_wo, light_wi) = (light_frame.to_local(light.wo), light_frame.to_local(-w));
         let (f_light, pdf_light, pdf_light_reverse) =
             light_bsdf.eval_adjoint_with_pdfs(light_wo, light_wi);
@@ -255,7 +255,7 @@ impl Vcm {
         };
         let mut sum = Rgb::ZERO;
         iteration.map.for_each_near(at.point, facing, |light| {
-            if light.segments + at.segments > self.max_depth + 1 {
+            if u32::from(light.segments) + at.segments > self.max_depth + 1 {
                 return;
             }
             let wi = at.frame.to_local(light.wo);
