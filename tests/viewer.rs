@@ -215,7 +215,7 @@ fn a_bad_scene_shows_an_error_and_keeps_the_last_good_one() {
     let xml = dir.join("warned.xml");
     std::fs::write(
         &xml,
-        "<scene version=\"3.0.0\">\n  <shape type=\"cube\"><float name=\"mystery\" value=\"1\"/>\n    <emitter type=\"area\"/></shape>\n</scene>\n",
+        "<scene version=\"3.0.0\">\n  <shape type=\"cube\"><float name=\"mystery\" value=\"1\"/>\n    <emitter type=\"area\"/></shape>\n  <integrator type=\"path\"/>\n</scene>\n",
     )
     .unwrap();
     harness.state_mut().app.scene_field = xml.to_string_lossy().into_owned();
@@ -243,6 +243,20 @@ fn a_bad_scene_shows_an_error_and_keeps_the_last_good_one() {
             .any(|w| w.contains("warned.xml:2:22: shape `cube`")),
         "{warnings:?}"
     );
+    // The file's depth (Mitsuba's default, unbounded) survives the panel's
+    // depth slider, whose bar ends at 32.
+    let depth = |h: &mut Harness<'_, Window>| {
+        *h.state_mut()
+            .app
+            .settings
+            .a
+            .integrator
+            .max_depth_mut()
+            .unwrap()
+    };
+    assert_eq!(depth(&mut harness), tracelab::scene::UNBOUNDED_DEPTH);
+    harness.step();
+    assert_eq!(depth(&mut harness), tracelab::scene::UNBOUNDED_DEPTH);
     harness.state_mut().app.shutdown();
 }
 

@@ -34,8 +34,8 @@ pub fn technique(ui: &mut egui::Ui, options: &mut IntegratorOptions) {
 }
 
 fn whitted(ui: &mut egui::Ui, s: &mut WhittedSettings) {
-    ui.add(egui::Slider::new(&mut s.max_depth, 0..=32).text("Max specular depth"));
-    ui.add(egui::Slider::new(&mut s.ambient, 0.0..=0.5).text("Ambient"));
+    ui.add(slider(&mut s.max_depth, 0..=32).text("Max specular depth"));
+    ui.add(slider(&mut s.ambient, 0.0..=0.5).text("Ambient"));
     ui.horizontal(|ui| {
         ui.label("Glass shadows");
         ui.radio_value(&mut s.glass_shadows, GlassShadows::Opaque, "Opaque");
@@ -45,8 +45,8 @@ fn whitted(ui: &mut egui::Ui, s: &mut WhittedSettings) {
 
 fn mcrt(ui: &mut egui::Ui, s: &mut McrtSettings) {
     max_depth(ui, &mut s.max_depth);
-    ui.add(egui::Slider::new(&mut s.shadow_rays, 0..=16).text("Shadow rays N"));
-    ui.add(egui::Slider::new(&mut s.glossy_rays, 0..=16).text("Glossy rays M"));
+    ui.add(slider(&mut s.shadow_rays, 0..=16).text("Shadow rays N"));
+    ui.add(slider(&mut s.glossy_rays, 0..=16).text("Glossy rays M"));
     if s.shadow_rays + s.glossy_rays == 0 {
         s.shadow_rays = 1;
     }
@@ -87,7 +87,7 @@ fn ambient_occlusion(ui: &mut egui::Ui, s: &mut AoSettings) {
             s.distance = 0.1;
         }
         ui.add(
-            egui::Slider::new(&mut s.distance, 0.001..=1.0)
+            slider(&mut s.distance, 0.001..=1.0)
                 .logarithmic(true)
                 .text("Distance (of the scene's diagonal)"),
         );
@@ -108,13 +108,13 @@ fn bdpt(ui: &mut egui::Ui, s: &mut BdptSettings) {
 fn photon(ui: &mut egui::Ui, s: &mut PhotonSettings) {
     max_depth(ui, &mut s.max_depth);
     ui.add(
-        egui::Slider::new(&mut s.photons, 0..=4_000_000)
+        slider(&mut s.photons, 0..=4_000_000)
             .logarithmic(true)
             .text("Photons per map (0: one per pixel)"),
     );
-    ui.add(egui::Slider::new(&mut s.k, 1..=256).text("k (photons per estimate)"));
+    ui.add(slider(&mut s.k, 1..=256).text("k (photons per estimate)"));
     ui.add(
-        egui::Slider::new(&mut s.gather_radius, 1e-3..=0.2)
+        slider(&mut s.gather_radius, 1e-3..=0.2)
             .logarithmic(true)
             .text("Largest radius (of the scene's diagonal)"),
     );
@@ -123,7 +123,7 @@ fn photon(ui: &mut egui::Ui, s: &mut PhotonSettings) {
 fn sppm(ui: &mut egui::Ui, s: &mut SppmSettings) {
     max_depth(ui, &mut s.max_depth);
     ui.add(
-        egui::Slider::new(&mut s.photons, 0..=4_000_000)
+        slider(&mut s.photons, 0..=4_000_000)
             .logarithmic(true)
             .text("Photons per iteration (0: one per pixel)"),
     );
@@ -149,7 +149,7 @@ fn radiosity(ui: &mut egui::Ui, s: &mut Radiosity) {
     }
     if s.solver == RadiositySolver::Hierarchical {
         ui.add(
-            egui::Slider::new(&mut s.epsilon, 1e-7..=1e-2)
+            slider(&mut s.epsilon, 1e-7..=1e-2)
                 .logarithmic(true)
                 .text("Epsilon (share of the emitted power)"),
         );
@@ -157,17 +157,15 @@ fn radiosity(ui: &mut egui::Ui, s: &mut Radiosity) {
     ui.add(
         // Hierarchical: the smallest element, which goes well below the
         // matrix solvers' sizes (the Cornell box runs use 0.002).
-        egui::Slider::new(&mut s.patch_size, 0.001..=0.5)
+        slider(&mut s.patch_size, 0.001..=0.5)
             .logarithmic(true)
             .text("Patch size (of the scene's diagonal)"),
     );
     if s.solver != RadiositySolver::Hierarchical {
-        ui.add(
-            egui::Slider::new(&mut s.adaptive_rounds, 0..=4).text("Adaptive subdivision rounds"),
-        );
+        ui.add(slider(&mut s.adaptive_rounds, 0..=4).text("Adaptive subdivision rounds"));
         if s.adaptive_rounds > 0 {
             ui.add(
-                egui::Slider::new(&mut s.adaptive_tolerance, 0.05..=2.0)
+                slider(&mut s.adaptive_tolerance, 0.05..=2.0)
                     .logarithmic(true)
                     .text("Tolerance (of the mean)"),
             );
@@ -207,14 +205,25 @@ fn radiosity(ui: &mut egui::Ui, s: &mut Radiosity) {
         }
     });
     ui.add(
-        egui::Slider::new(&mut s.form_factor_samples, 1..=1024)
+        slider(&mut s.form_factor_samples, 1..=1024)
             .logarithmic(true)
             .text("Samples per pair"),
     );
 }
 
+/// A slider that leaves a value from a scene file or the command line as
+/// it is, even beyond the range its bar spans (edits stay within it): egui
+/// clamps every value to that range by default, which turned a file's
+/// unbounded depth (100) into 32 without a word.
+fn slider<Num: egui::emath::Numeric>(
+    value: &mut Num,
+    range: std::ops::RangeInclusive<Num>,
+) -> egui::Slider<'_> {
+    egui::Slider::new(value, range).clamping(egui::SliderClamping::Edits)
+}
+
 fn max_depth(ui: &mut egui::Ui, depth: &mut u32) {
-    ui.add(egui::Slider::new(depth, 0..=32).text("Max depth (bounces)"));
+    ui.add(slider(depth, 0..=32).text("Max depth (bounces)"));
 }
 
 fn mis_heuristic(ui: &mut egui::Ui, mis: &mut MisHeuristic) {
@@ -251,9 +260,9 @@ fn seen_emitters(ui: &mut egui::Ui, exact: &mut bool) {
 
 fn merge_radius(ui: &mut egui::Ui, radius: &mut f32, alpha: &mut f32) {
     ui.add(
-        egui::Slider::new(radius, 1e-4..=0.05)
+        slider(radius, 1e-4..=0.05)
             .logarithmic(true)
             .text("First radius (of the scene's diagonal)"),
     );
-    ui.add(egui::Slider::new(alpha, 0.05..=1.0).text("Alpha (1: fixed radius, biased)"));
+    ui.add(slider(alpha, 0.05..=1.0).text("Alpha (1: fixed radius, biased)"));
 }
