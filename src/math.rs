@@ -494,6 +494,26 @@ mod packing_tests {
     use super::*;
     use glam::Vec3A;
 
+    /// A frame rebuilt from its stored turn is the frame built from the
+    /// tangent, within the 16 bits' 1e-4 radians, and NO_TURN is never a turn.
+    #[test]
+    fn a_frames_turn_rebuilds_it() {
+        let normals = [Vec3A::Z, -Vec3A::Z, Vec3A::new(0.3, -0.8, 0.2).normalize()];
+        for n in normals {
+            for k in 0..64 {
+                let angle = k as f32 * 0.1 - 3.2;
+                let base = Frame::from_normal(n);
+                let tangent = base.s * angle.cos() + base.t * angle.sin() + n * 0.4;
+                let exact = Frame::with_tangent(n, tangent);
+                let turn = base.turn_towards(tangent);
+                assert_ne!(turn, NO_TURN);
+                let rebuilt = base.turned(turn);
+                assert!((rebuilt.s - exact.s).length() < 2e-4, "{n:?} {angle}");
+                assert!((rebuilt.t - exact.t).length() < 2e-4, "{n:?} {angle}");
+            }
+        }
+    }
+
     #[test]
     fn octahedral_packing_keeps_normals_within_1e3_radians() {
         let mut worst = 0.0f32;

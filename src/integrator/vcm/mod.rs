@@ -454,7 +454,8 @@ impl Vcm {
             if bsdf.is_black() {
                 break;
             }
-            let shading = scene.shading_normal(&hit);
+            let frame = scene.shading_frame(&hit);
+            let shading = frame.n;
             if !bsdf.is_specular() {
                 let vertex = LightVertex {
                     point: hit.point,
@@ -477,7 +478,6 @@ impl Vcm {
             if segments == self.max_depth {
                 break;
             }
-            let frame = scene.shading_frame(&hit);
             let Some(scatter) = self.scatter(
                 bsdf,
                 frame.to_local(wo_world),
