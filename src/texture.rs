@@ -111,6 +111,30 @@ impl Texture {
         }
     }
 
+    /// One value at `uv`, as Mitsuba's `eval_1` reads it for a roughness or
+    /// an opacity: the luminance; a checkerboard's squares swapped, as
+    /// Mitsuba 3 (3.9.1) gives color1 from `eval_1` where `eval` gives
+    /// color0 (its own textured-roughness preview is rendered so).
+    #[inline]
+    pub fn eval_1(&self, uv: Vec2) -> f32 {
+        let value = match self {
+            Texture::Checkerboard {
+                color0,
+                color1,
+                to_uv,
+            } => {
+                let swapped = Texture::Checkerboard {
+                    color0: *color1,
+                    color1: *color0,
+                    to_uv: *to_uv,
+                };
+                swapped.eval(uv)
+            }
+            _ => self.eval(uv),
+        };
+        crate::math::luminance(value)
+    }
+
     /// The texture's luminance at `uv` and its gradient in uv (Mitsuba's
     /// `eval_1_grad`: the bilinear interpolant's derivatives; zero for
     /// nearest filtering and the checkerboard, which are flat between

@@ -8,7 +8,7 @@
 //! Scenes without masks never reach this code: [`super::Geometry`] tests
 //! for a mask table once per query.
 
-use crate::math::{Ray, Rgb, luminance, offset_ray_origin};
+use crate::math::{Ray, offset_ray_origin};
 use crate::sampling::hash::hash_combine;
 use crate::texture::Texture;
 use glam::Vec3A;
@@ -68,7 +68,7 @@ impl Masks {
         let opacity = match self.by_material.get(material as usize) {
             None | Some(Opacity::Opaque) => return true,
             Some(Opacity::Constant(a)) => *a,
-            Some(Opacity::Texture(t)) => opacity_of(self.textures[*t as usize].eval(uv())),
+            Some(Opacity::Texture(t)) => opacity_of(self.textures[*t as usize].eval_1(uv())),
         };
         if opacity >= 1.0 {
             return true;
@@ -82,8 +82,7 @@ impl Masks {
 
 /// A texel's opacity: its luminance in [0, 1]; NaN is transparent.
 #[inline]
-fn opacity_of(c: Rgb) -> f32 {
-    let a = luminance(c);
+fn opacity_of(a: f32) -> f32 {
     if a.is_nan() { 0.0 } else { a.clamp(0.0, 1.0) }
 }
 

@@ -101,10 +101,11 @@ impl Material {
         }
         let read = |slot: Option<u32>| slot.map(|i| textures[i as usize].eval(uv));
         let (diffuse, specular) = (read(t.diffuse), read(t.specular));
-        let alpha_u = read(t.alpha).map(|a| a.x);
+        let read_1 = |slot: Option<u32>| slot.map(|i| textures[i as usize].eval_1(uv));
+        let alpha_u = read_1(t.alpha);
         let alpha_v = match t.alpha_v == t.alpha {
             true => alpha_u,
-            false => read(t.alpha_v).map(|a| a.x),
+            false => read_1(t.alpha_v),
         };
         let rough = |m: &mut Microfacet| {
             if alpha_u.is_some() || alpha_v.is_some() {
