@@ -87,6 +87,14 @@ pub enum Texture {
     },
 }
 
+/// True where a checkerboard shows its first colour (`eval`): the
+/// fractional parts of u and v on the same side of 1/2.
+#[inline]
+fn first_square(uv: Vec2, to_uv: &UvTransform) -> bool {
+    let uv = uv * to_uv.scale + to_uv.offset;
+    (uv.x - uv.x.floor() > 0.5) == (uv.y - uv.y.floor() > 0.5)
+}
+
 impl Texture {
     /// The texture's value at surface coordinates `uv`.
     #[inline]
@@ -103,10 +111,11 @@ impl Texture {
                 color1,
                 to_uv,
             } => {
-                let uv = uv * to_uv.scale + to_uv.offset;
-                let fu = uv.x - uv.x.floor() > 0.5;
-                let fv = uv.y - uv.y.floor() > 0.5;
-                if fu == fv { *color0 } else { *color1 }
+                if first_square(uv, to_uv) {
+                    *color0
+                } else {
+                    *color1
+                }
             }
         }
     }
@@ -123,12 +132,11 @@ impl Texture {
                 color1,
                 to_uv,
             } => {
-                let swapped = Texture::Checkerboard {
-                    color0: *color1,
-                    color1: *color0,
-                    to_uv: *to_uv,
-                };
-                swapped.eval(uv)
+                if first_square(uv, to_uv) {
+                    *color1
+                } else {
+                    *color0
+                }
             }
             _ => self.eval(uv),
         };

@@ -50,7 +50,7 @@ pub struct MaterialTextures {
     /// `specular_reflectance`: conductors' and coatings' tint.
     pub specular: Option<u32>,
     /// `alpha` (or `alpha_u`): a rough conductor's, dielectric's or
-    /// plastic's roughness (its first channel); along u where it is
+    /// plastic's roughness (read by `Texture::eval_1`); along u where it is
     /// anisotropic.
     pub alpha: Option<u32>,
     /// `alpha_v`: the roughness along v. An isotropic textured roughness

@@ -396,14 +396,12 @@ impl Bdpt {
             let previous = path.vertices[index - 1];
             let bsdf = scene.bsdf_at(&hit);
             let mut vertex = surface_vertex(&hit, bsdf, wo_world, beta);
-            if scene.features.shading_normals {
+            if scene.features.shading_normals || scene.features.anisotropic {
                 let n = scene.shading_normal(&hit);
                 if n != hit.normal {
                     vertex.packed_shading = crate::math::octahedral_encode(n);
                 }
-            }
-            if scene.features.anisotropic {
-                vertex.turn = scene.shading_turn(&hit, scene.shading_normal(&hit));
+                vertex.turn = scene.shading_turn(&hit, n);
             }
             if hit.light != NO_LIGHT {
                 vertex.light = hit.light;
