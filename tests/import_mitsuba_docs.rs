@@ -1,10 +1,13 @@
 //! What Mitsuba 3's documentation scenes use (mitsuba-data, `docs/scenes`):
-//! roughness read from textures, and objects declared at the top level and
-//! used where a `<ref>` names them.
+//! roughness read from textures, objects declared at the top level and
+//! used where a `<ref>` names them, and integrators' default depth.
 
+use crate::common::{mean_and_standard_error, render};
 use crate::import::load;
 use glam::Vec2;
 use tracelab::bsdf::{Bsdf, Microfacet};
+use tracelab::integrator::IntegratorOptions;
+use tracelab::sampling::SamplerKind;
 use tracelab::scene::Scene;
 
 const SENSOR: &str = r#"<sensor type="perspective">
@@ -144,4 +147,58 @@ fn an_integrator_without_max_depth_is_unbounded_as_in_mitsuba() {
     assert_eq!(scene(given).hints.max_depth, Some(3));
     // No integrator at all: Mitsuba 3 refuses to render; tracelab's defaults.
     assert_eq!(scene("").hints.max_depth, None);
+}
+
+/// Mitsuba's -1 has no limit where roulette ends the paths: inside a
+/// closed cube of albedo a = 0.98 that emits 1 everywhere (a white
+/// furnace), L = 1 / (1 - a) = 50, while paths cut at 100 bounces, the
+/// limit that stood for -1 before, find 50 (1 - a^101) = 43.5. Mitsuba's
+/// diamond preview, whose light circles by total internal reflection, was
+/// 1.4% dark at that limit. Roulette starts at 1 000 bounces, as in that
+/// file: earlier, Mitsuba's survival probability (at most 0.95) against an
+/// albedo above its square root would make the variance infinite.
+///
+/// Tolerance: 3 standard errors of the image mean (per-pixel standard
+/// errors combined as `mean_and_standard_error`); the test also checks that
+/// 43.5 lies beyond 6 of them, so that it can fail.
+#[test]
+fn an_unbounded_depth_has_no_limit_where_roulette_ends_paths() {
+    let xml = r#"<scene version="3.0.0">
+  <integrator type="path"><integer name="rr_depth" value="1000"/></integrator>
+  <sensor type="perspective">
+    <float name="fov" value="90"/>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+  </sensor>
+  <shape type="cube">
+    <boolean name="flip_normals" value="true"/>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.98"/></bsdf>
+    <emitter type="area"><rgb name="radiance" value="1"/></emitter>
+  </shape>
+</scene>"#;
+    let scene = load("unbounded_furnace", xml, &[], true).unwrap_or_else(|e| panic!("{e}"));
+    let mut options = IntegratorOptions::default();
+    let said = options.take_hints(&scene.hints, false).unwrap();
+    assert!(said.iter().any(|s| s == "max depth no limit"), "{said:?}");
+    assert_eq!(options.max_depth(), Some(tracelab::scene::UNBOUNDED_DEPTH));
+    options.validate().unwrap();
+    let (snapshot, stats) = render(scene, options.build(), SamplerKind::Independent, 16, 1);
+    assert_eq!(stats.non_finite, 0);
+    let (mean, se) = mean_and_standard_error(&snapshot);
+    let (expected, truncated) = (50.0, 50.0 * (1.0 - 0.98f64.powi(101)));
+    for c in 0..3 {
+        let z = (mean[c] - expected) / se[c];
+        assert!(
+            z.abs() < 3.0,
+            "channel {c}: {} against {expected} (z {z:.2})",
+            mean[c]
+        );
+        assert!(
+            (expected - truncated) / se[c] > 6.0,
+            "too few samples to tell: {}",
+            se[c]
+        );
+    }
+    // Without roulette, no limit would never end a trapped path: refused.
+    options.length_mut().unwrap().russian_roulette = false;
+    assert!(options.validate().unwrap_err().contains("Russian roulette"));
 }

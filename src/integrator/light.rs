@@ -34,6 +34,10 @@ pub struct LightSettings {
 }
 
 impl Settings for LightSettings {
+    fn validate(&self) -> Result<(), String> {
+        self.length.check()
+    }
+
     fn length_mut(&mut self) -> Option<&mut PathLength> {
         Some(&mut self.length)
     }
@@ -89,7 +93,7 @@ impl Technique for LightTracer {
     fn describe(&self) -> String {
         format!(
             "light tracing (max depth {}, rr {})",
-            self.max_depth,
+            super::options::depth_label(self.max_depth),
             if self.russian_roulette {
                 format!("from {}", self.rr_depth)
             } else {

@@ -38,7 +38,7 @@ pub use camera_ray::{camera_ray, sample_time};
 pub use light::{LightTracer, Splat};
 pub use mcrt::McRayTracer;
 pub use mis::MisHeuristic;
-pub use options::{PathLength, Settings, Strategy};
+pub use options::{DEEPEST_WITHOUT_ROULETTE, PathLength, Settings, Strategy};
 pub use path::PathTracer;
 pub use whitted::{GlassShadows, WhittedTracer};
 

@@ -34,6 +34,32 @@ pub struct PathLength {
     pub rr_depth: u32,
 }
 
+impl PathLength {
+    /// Why this length cannot run: without roulette, a path that total
+    /// internal reflection traps would never end.
+    pub fn check(&self) -> Result<(), String> {
+        if self.max_depth == crate::scene::UNBOUNDED_DEPTH && !self.russian_roulette {
+            return Err("a max depth without limit needs Russian roulette to end paths".into());
+        }
+        Ok(())
+    }
+}
+
+/// The deepest that techniques without Russian roulette go (Whitted,
+/// distribution ray tracing, the photon techniques' specular chains) when
+/// a file asks for no limit: light trapped by total internal reflection
+/// would otherwise never leave.
+pub const DEEPEST_WITHOUT_ROULETTE: u32 = 100;
+
+/// A depth for summaries: Mitsuba's unbounded depth reads as such.
+pub(crate) fn depth_label(depth: u32) -> String {
+    if depth == crate::scene::UNBOUNDED_DEPTH {
+        "no limit".into()
+    } else {
+        depth.to_string()
+    }
+}
+
 impl Default for PathLength {
     fn default() -> Self {
         PathLength {
@@ -136,14 +162,10 @@ impl IntegratorOptions {
         if let (Some(d), Some(depth)) = (hints.max_depth, self.max_depth_mut()) {
             *depth = d.min(deepest);
             taken.push(if d > deepest {
-                let asked = if d == crate::scene::UNBOUNDED_DEPTH {
-                    "no limit".to_string()
-                } else {
-                    d.to_string()
-                };
+                let asked = depth_label(d);
                 format!("max depth {deepest}, the most of {label} (the file asks for {asked})")
             } else {
-                format!("max depth {d}")
+                format!("max depth {}", depth_label(d))
             });
         }
         if let (Some(d), Some(length)) = (hints.rr_depth, self.length_mut()) {

@@ -127,6 +127,10 @@ impl Default for PathSettings {
 }
 
 impl Settings for PathSettings {
+    fn validate(&self) -> Result<(), String> {
+        self.length.check()
+    }
+
     fn length_mut(&mut self) -> Option<&mut PathLength> {
         Some(&mut self.length)
     }
@@ -196,7 +200,7 @@ impl Technique for PathTracer {
     fn describe(&self) -> String {
         format!(
             "path (max depth {}, nee {}, mis {:?}, rr {})",
-            self.max_depth,
+            super::options::depth_label(self.max_depth),
             if self.nee { "on" } else { "off" },
             self.mis,
             if self.russian_roulette {

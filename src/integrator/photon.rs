@@ -64,6 +64,10 @@ impl Settings for PhotonSettings {
         check_fraction("gather radius", self.gather_radius)
     }
 
+    fn deepest(&self) -> u32 {
+        super::DEEPEST_WITHOUT_ROULETTE
+    }
+
     fn max_depth_mut(&mut self) -> Option<&mut u32> {
         Some(&mut self.max_depth)
     }

@@ -68,6 +68,10 @@ impl Settings for SppmSettings {
         check_radius(self.radius, self.alpha)
     }
 
+    fn deepest(&self) -> u32 {
+        super::DEEPEST_WITHOUT_ROULETTE
+    }
+
     fn max_depth_mut(&mut self) -> Option<&mut u32> {
         Some(&mut self.max_depth)
     }

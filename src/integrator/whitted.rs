@@ -66,6 +66,10 @@ impl Settings for WhittedSettings {
         }
     }
 
+    fn deepest(&self) -> u32 {
+        super::DEEPEST_WITHOUT_ROULETTE
+    }
+
     fn max_depth_mut(&mut self) -> Option<&mut u32> {
         Some(&mut self.max_depth)
     }

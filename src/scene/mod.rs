@@ -98,9 +98,10 @@ impl LoadOptions {
     }
 }
 
-/// Bounces that stand for Mitsuba's unbounded `max_depth = -1` (Russian
-/// roulette ends paths long before).
-pub const UNBOUNDED_DEPTH: u32 = 100;
+/// Mitsuba's unbounded `max_depth = -1`: no limit where Russian roulette
+/// ends every path (Mitsuba's survival probability is at most 0.95), and
+/// [`crate::integrator::DEEPEST_WITHOUT_ROULETTE`] elsewhere.
+pub const UNBOUNDED_DEPTH: u32 = u32::MAX;
 
 /// What an imported file asks of the renderer (Mitsuba's integrator and
 /// sampler), used where the command line does not say otherwise.

@@ -15,6 +15,7 @@ use crate::integrator::{
     GlassShadows, IntegratorKind, IntegratorOptions, MisHeuristic, PathLength, Strategy,
 };
 use crate::radiosity::{FormFactorMethod, RadiositySolver};
+use crate::scene::UNBOUNDED_DEPTH;
 use eframe::egui::{self, RichText};
 
 /// The chosen technique's controls.
@@ -62,7 +63,7 @@ fn mcrt(ui: &mut egui::Ui, s: &mut McrtSettings) {
 }
 
 fn path(ui: &mut egui::Ui, s: &mut PathSettings) {
-    max_depth(ui, &mut s.length.max_depth);
+    unbounded_max_depth(ui, &mut s.length);
     ui.horizontal(|ui| {
         ui.label("Strategy");
         ui.radio_value(&mut s.strategy, Strategy::Bsdf, "BSDF");
@@ -95,7 +96,7 @@ fn ambient_occlusion(ui: &mut egui::Ui, s: &mut AoSettings) {
 }
 
 fn light(ui: &mut egui::Ui, s: &mut LightSettings) {
-    max_depth(ui, &mut s.length.max_depth);
+    unbounded_max_depth(ui, &mut s.length);
     roulette(ui, &mut s.length);
 }
 
@@ -131,7 +132,7 @@ fn sppm(ui: &mut egui::Ui, s: &mut SppmSettings) {
 }
 
 fn vcm(ui: &mut egui::Ui, s: &mut VcmSettings) {
-    max_depth(ui, &mut s.length.max_depth);
+    unbounded_max_depth(ui, &mut s.length);
     mis_heuristic(ui, &mut s.mis);
     roulette(ui, &mut s.length);
     merge_radius(ui, &mut s.radius, &mut s.alpha);
@@ -214,7 +215,7 @@ fn radiosity(ui: &mut egui::Ui, s: &mut Radiosity) {
 /// A slider that leaves a value from a scene file or the command line as
 /// it is, even beyond the range its bar spans (edits stay within it): egui
 /// clamps every value to that range by default, which turned a file's
-/// unbounded depth (100) into 32 without a word.
+/// depth of 100 into 32 without a word.
 fn slider<Num: egui::emath::Numeric>(
     value: &mut Num,
     range: std::ops::RangeInclusive<Num>,
@@ -224,6 +225,33 @@ fn slider<Num: egui::emath::Numeric>(
 
 fn max_depth(ui: &mut egui::Ui, depth: &mut u32) {
     ui.add(slider(depth, 0..=32).text("Max depth (bounces)"));
+}
+
+/// The depth of a technique that Russian roulette can end, which may have
+/// no limit (Mitsuba's -1); roulette stays on while it has none.
+fn unbounded_max_depth(ui: &mut egui::Ui, length: &mut PathLength) {
+    let mut unbounded = length.max_depth == UNBOUNDED_DEPTH;
+    ui.horizontal(|ui| {
+        if unbounded {
+            ui.label("Max depth: no limit");
+        } else {
+            max_depth(ui, &mut length.max_depth);
+        }
+        let toggled = ui
+            .checkbox(&mut unbounded, "No limit")
+            .on_hover_text("Paths end by Russian roulette only, as Mitsuba's max_depth -1")
+            .changed();
+        if toggled {
+            length.max_depth = if unbounded {
+                UNBOUNDED_DEPTH
+            } else {
+                PathLength::default().max_depth
+            };
+        }
+    });
+    if unbounded {
+        length.russian_roulette = true;
+    }
 }
 
 fn mis_heuristic(ui: &mut egui::Ui, mis: &mut MisHeuristic) {
@@ -239,7 +267,12 @@ fn mis_heuristic(ui: &mut egui::Ui, mis: &mut MisHeuristic) {
 
 fn roulette(ui: &mut egui::Ui, length: &mut PathLength) {
     ui.horizontal(|ui| {
-        ui.checkbox(&mut length.russian_roulette, "Russian roulette");
+        let bounded = length.max_depth != UNBOUNDED_DEPTH;
+        ui.add_enabled(
+            bounded,
+            egui::Checkbox::new(&mut length.russian_roulette, "Russian roulette"),
+        )
+        .on_disabled_hover_text("Without a depth limit, roulette ends the paths");
         if length.russian_roulette {
             ui.add(
                 egui::DragValue::new(&mut length.rr_depth)

@@ -63,6 +63,7 @@ pub struct BdptSettings {
 
 impl Settings for BdptSettings {
     fn validate(&self) -> Result<(), String> {
+        self.length.check()?;
         if self.length.max_depth > MAX_BOUNCES {
             return Err(format!(
                 "max depth {} is more than bidirectional path tracing's {MAX_BOUNCES}",

@@ -75,6 +75,7 @@ impl Default for VcmSettings {
 
 impl Settings for VcmSettings {
     fn validate(&self) -> Result<(), String> {
+        self.length.check()?;
         super::sppm::check_radius(self.radius, self.alpha)
     }
 
@@ -140,7 +141,7 @@ impl Technique for Vcm {
     fn describe(&self) -> String {
         format!(
             "vcm (max depth {}, mis {:?}, radius {:.3e}, alpha {:.2}, rr {})",
-            self.max_depth,
+            super::options::depth_label(self.max_depth),
             self.mis,
             self.radius,
             self.alpha,
