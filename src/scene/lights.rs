@@ -1,6 +1,5 @@
-//! All lights of a scene, chosen in proportion to their power: the
-//! emitters of `light.rs` and the environment, for next-event estimation
-//! and for light paths.
+//! All lights of a scene and how one is chosen: the emitters of `light.rs`
+//! and the environment, for next-event estimation and for light paths.
 
 use super::environment::Environment;
 use super::light::{EmissionSample, Light, LightSample, LightSampling};
@@ -10,13 +9,18 @@ use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
 use std::sync::Arc;
 
-/// All lights of a scene with the power-proportional selection table.
+/// All lights of a scene with their two selection tables.
 #[derive(Clone, Debug, Default)]
 pub struct Lights {
     lights: Vec<Light>,
     /// Light from infinitely far away; its light id is `lights.len()`.
     environment: Option<Arc<Environment>>,
+    /// In proportion to power: particles, and the bidirectional techniques'
+    /// light ends, whose MIS weights need one density for both.
     selection: Option<AliasTable>,
+    /// Next-event estimation's choice: by power, or by the shares that the
+    /// scene's pilot measured for its groups ([`Lights::set_direct_shares`]).
+    direct: Option<AliasTable>,
     /// How shadow rays stop short of sampled light points.
     offset: OffsetMode,
 }
@@ -34,10 +38,14 @@ impl Lights {
             powers.push(env.power());
         }
         let selection = AliasTable::new(&powers);
+        // Power until the scene is built and its pilot aims the choice
+        // ([`Lights::set_direct_shares`]).
+        let direct = selection.clone();
         Lights {
             lights,
             environment: environment.map(Arc::new),
             selection,
+            direct,
             offset: OffsetMode::Robust,
         }
     }
@@ -72,6 +80,99 @@ impl Lights {
         1.0 / (PI * radius * radius)
     }
 
+    /// The groups whose shares of next-event estimation's choice a pilot
+    /// may set: all bounded lights together (group 0), then each light at
+    /// infinity; 0 where there is nothing to weigh (no light of one kind,
+    /// or one kind emits nothing), and power alone decides.
+    pub fn direct_groups(&self) -> usize {
+        let Some(table) = &self.selection else {
+            return 0;
+        };
+        let ids = 0..self.lights.len() + usize::from(self.environment.is_some());
+        let (mut near, mut far, mut far_power) = (0.0, 0, 0.0);
+        for i in ids {
+            if self.is_infinite(i as u32) {
+                (far, far_power) = (far + 1, far_power + table.pmf(i));
+            } else {
+                near += table.pmf(i);
+            }
+        }
+        if near > 0.0 && far_power > 0.0 {
+            1 + far
+        } else {
+            0
+        }
+    }
+
+    /// Each light's group in [`Lights::direct_groups`]'s numbering, by
+    /// light id.
+    pub fn direct_group_of_each(&self) -> Vec<usize> {
+        let count = self.lights.len() + usize::from(self.environment.is_some());
+        let mut far = 0;
+        (0..count as u32)
+            .map(|i| match self.is_infinite(i) {
+                true => {
+                    far += 1;
+                    far
+                }
+                false => 0,
+            })
+            .collect()
+    }
+
+    /// Next-event estimation chooses group g with probability `shares[g]`
+    /// and, within it, by power.
+    pub fn set_direct_shares(&mut self, shares: &[f64]) {
+        let Some(table) = &self.selection else {
+            return;
+        };
+        let count = self.lights.len() + usize::from(self.environment.is_some());
+        let powers: Vec<f32> = (0..count).map(|i| table.pmf(i)).collect();
+        let groups = self.direct_group_of_each();
+        if let Some(weights) = direct_weights(&powers, &groups, shares) {
+            self.direct = AliasTable::new(&weights);
+        }
+    }
+
+    /// Each group's share of next-event estimation's choice beside its
+    /// share by power, for the render summary; None without groups.
+    pub fn direct_summary(&self) -> Option<String> {
+        let (Some(direct), Some(power)) = (&self.direct, &self.selection) else {
+            return None;
+        };
+        let groups = self.direct_groups();
+        if groups < 2 {
+            return None;
+        }
+        let mut shares = vec![(0.0f32, 0.0f32); groups];
+        for (id, g) in self.direct_group_of_each().into_iter().enumerate() {
+            shares[g].0 += direct.pmf(id);
+            shares[g].1 += power.pmf(id);
+        }
+        let parts: Vec<String> = shares
+            .iter()
+            .enumerate()
+            .map(|(g, (d, p))| {
+                let name = match g {
+                    0 => "bounded lights".to_string(),
+                    _ if g == groups - 1 && self.environment.is_some() => "the environment".into(),
+                    _ => format!("directional light {g}"),
+                };
+                format!("{name} {:.0}% (by power {:.0}%)", 100.0 * d, 100.0 * p)
+            })
+            .collect();
+        Some(format!(
+            "shadow rays' light choice, measured by a pilot: {}",
+            parts.join(", ")
+        ))
+    }
+
+    /// The share of next-event estimation's choices that goes to light
+    /// `light`: for tests and summaries.
+    pub fn direct_pmf(&self, light: u32) -> f32 {
+        self.direct.as_ref().map_or(0.0, |t| t.pmf(light as usize))
+    }
+
     /// The environment, if the scene has one.
     #[inline]
     pub fn environment(&self) -> Option<&Environment> {
@@ -88,6 +189,15 @@ impl Lights {
     /// [`Lights::sample`] picks direction `d` on the environment.
     #[inline]
     pub fn environment_pdf(&self, d: Vec3A) -> f32 {
+        match (&self.environment, &self.direct) {
+            (Some(env), Some(table)) => table.pmf(self.lights.len()) * env.pdf(d),
+            _ => 0.0,
+        }
+    }
+
+    /// [`Lights::environment_pdf`] for [`Lights::sample_as_emitted`].
+    #[inline]
+    pub fn environment_pdf_as_emitted(&self, d: Vec3A) -> f32 {
         match (&self.environment, &self.selection) {
             (Some(env), Some(table)) => table.pmf(self.lights.len()) * env.pdf(d),
             _ => 0.0,
@@ -108,6 +218,7 @@ impl Lights {
             lights,
             environment: self.environment.clone(),
             selection: self.selection.clone(),
+            direct: self.direct.clone(),
             offset: self.offset,
         }
     }
@@ -137,7 +248,30 @@ impl Lights {
     /// estimation from `reference`. The pdf includes the selection probability.
     #[inline(always)]
     pub fn sample(&self, reference: Vec3A, u_select: f32, u: Vec2) -> Option<LightSample> {
-        let table = self.selection.as_ref()?;
+        self.sample_from_table(self.direct.as_ref()?, reference, u_select, u)
+    }
+
+    /// [`Lights::sample`] with the light chosen as [`Lights::sample_emission`]
+    /// chooses it: the connection to a light of BDPT and VCM, whose weights
+    /// give a path's light end one density whichever strategy made it.
+    #[inline(always)]
+    pub fn sample_as_emitted(
+        &self,
+        reference: Vec3A,
+        u_select: f32,
+        u: Vec2,
+    ) -> Option<LightSample> {
+        self.sample_from_table(self.selection.as_ref()?, reference, u_select, u)
+    }
+
+    #[inline(always)]
+    fn sample_from_table(
+        &self,
+        table: &AliasTable,
+        reference: Vec3A,
+        u_select: f32,
+        u: Vec2,
+    ) -> Option<LightSample> {
         // One light needs no choice (the Cornell box); its pmf is 1.
         let (index, pmf) = if self.has_choice() {
             table.sample(u_select)
@@ -160,7 +294,7 @@ impl Lights {
     /// a cache miss that held 14% of path tracing's time).
     #[inline(always)]
     pub fn prefetch_sample(&self, u_select: f32, u: Vec2) {
-        let (Some(environment), Some(table)) = (&self.environment, &self.selection) else {
+        let (Some(environment), Some(table)) = (&self.environment, &self.direct) else {
             return;
         };
         let index = if self.has_choice() {
@@ -205,7 +339,7 @@ impl Lights {
         if light as usize >= self.lights.len() {
             return self.environment_pdf((point - reference).normalize());
         }
-        match &self.selection {
+        match &self.direct {
             Some(table) => {
                 table.pmf(light as usize)
                     * self.lights[light as usize].pdf(reference, point, normal)
@@ -258,6 +392,25 @@ impl Lights {
     }
 }
 
+/// Weights that give group `groups[i]` the share `shares[group]` of the
+/// choice, split by `powers` within it; a group without power passes its
+/// share on to the others. None where a light's group has no share.
+fn direct_weights(powers: &[f32], groups: &[usize], shares: &[f64]) -> Option<Vec<f32>> {
+    let mut totals = vec![0.0f64; shares.len()];
+    for (&p, &g) in powers.iter().zip(groups) {
+        *totals.get_mut(g)? += f64::from(p);
+    }
+    let weights = powers
+        .iter()
+        .zip(groups)
+        .map(|(&p, &g)| match totals[g] {
+            t if t > 0.0 => (f64::from(p) * shares[g] / t) as f32,
+            _ => 0.0,
+        })
+        .collect();
+    Some(weights)
+}
+
 impl Environment {
     /// A light sample towards the environment from `reference`: a point
     /// beyond the scene's bounding sphere in the sampled direction.
@@ -297,5 +450,28 @@ impl Environment {
             light: 0,
             cone: None,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_group_gets_its_share_split_by_power() {
+        // Two spots of 60 and 40, a sun of 100 and a sky of 900, shares
+        // 0.5, 0.2, 0.3 for the spots, the sun and the sky.
+        let powers = [60.0, 40.0, 100.0, 900.0];
+        let w = direct_weights(&powers, &[0, 0, 1, 2], &[0.5, 0.2, 0.3]).unwrap();
+        let total: f32 = w.iter().sum();
+        let share: Vec<f32> = w.iter().map(|x| x / total).collect();
+        for (got, want) in share.iter().zip([0.3, 0.2, 0.2, 0.3]) {
+            assert!((got - want).abs() < 1e-6, "{share:?}");
+        }
+        // A group without power passes its share on.
+        let w = direct_weights(&[0.0, 5.0, 5.0], &[0, 1, 2], &[0.5, 0.2, 0.3]).unwrap();
+        assert_eq!(w[0], 0.0);
+        assert!((w[1] / w[2] - 2.0 / 3.0).abs() < 1e-6);
+        assert!(direct_weights(&[1.0, 1.0], &[0, 2], &[0.5, 0.5]).is_none());
     }
 }

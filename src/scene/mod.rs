@@ -10,6 +10,7 @@ pub mod framing;
 pub mod gltf;
 mod instances;
 pub mod light;
+mod light_pilot;
 pub mod lights;
 pub mod load;
 pub mod material;
@@ -447,7 +448,7 @@ impl Scene {
         }
         let features = Features::detect(&input.materials, &geometry, &lights, &input.camera);
         let shortcuts = Shortcuts::new(&geometry, &flat_light_corners(&lights));
-        Ok(Scene {
+        let mut scene = Scene {
             camera: input.camera,
             features,
             geometry: Arc::new(geometry),
@@ -457,7 +458,11 @@ impl Scene {
             warnings,
             hints,
             shortcuts,
-        })
+        };
+        if let Some(shares) = light_pilot::direct_shares(&scene) {
+            scene.lights.set_direct_shares(&shares);
+        }
+        Ok(scene)
     }
 
     /// The scene with triangle `i` split into `pieces[i]` where that is not
@@ -574,6 +579,7 @@ impl Scene {
     /// has spheres)"). Builds the camera lists if they are not built yet.
     pub fn shortcut_report(&self, used: ShortcutsUsed) -> Vec<String> {
         let mut lines = Vec::new();
+        lines.extend(self.lights.direct_summary());
         let primary = self.try_primary_candidates();
         if used.primary_candidates {
             lines.push(match &primary {

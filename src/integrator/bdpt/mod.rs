@@ -549,7 +549,9 @@ impl Bdpt {
         let pl = &cam_local[t - 1];
         if s == 1 {
             // Next-event estimation from z_{t-1}.
-            let ls = scene.lights.sample(pt.point, pt.u_select, pt.u_connect)?;
+            let ls = scene
+                .lights
+                .sample_as_emitted(pt.point, pt.u_select, pt.u_connect)?;
             let (f, pdf_forward, pdf_reverse) =
                 pt.bsdf.eval_with_pdfs(pl.wo, pl.frame.to_local(ls.wi));
             let value = pt.beta * f * ls.radiance * (pl.shading_cos(ls.wi) / ls.pdf);

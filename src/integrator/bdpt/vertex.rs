@@ -299,5 +299,5 @@ pub(super) fn origin_density(scene: &Scene, light: u32, to_light: Vec3A) -> f32 
     if scene.lights.is_directional(light) {
         return 0.0;
     }
-    scene.lights.environment_pdf(to_light)
+    scene.lights.environment_pdf_as_emitted(to_light)
 }

@@ -670,7 +670,7 @@ impl Vcm {
         if segments == 1 {
             return le;
         }
-        let direct = scene.lights.environment_pdf(ray.direction);
+        let direct = scene.lights.environment_pdf_as_emitted(ray.direction);
         let (pdf_position, pdf_direction) =
             scene
                 .lights

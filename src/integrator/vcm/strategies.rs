@@ -140,7 +140,7 @@ impl Vcm {
     ) -> Rgb {
         let u_select = sampler.next_1d_for(Domain::Light);
         let u_light = sampler.next_2d_for(Domain::Light);
-        let Some(ls) = scene.lights.sample(at.point, u_select, u_light) else {
+        let Some(ls) = scene.lights.sample_as_emitted(at.point, u_select, u_light) else {
             return Rgb::ZERO;
         };
         let wi = at.frame.to_local(ls.wi);
