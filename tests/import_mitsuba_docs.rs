@@ -6,7 +6,7 @@ use crate::common::{mean_and_standard_error, render};
 use crate::import::load;
 use glam::Vec2;
 use tracelab::bsdf::{Bsdf, Microfacet};
-use tracelab::integrator::IntegratorOptions;
+use tracelab::integrator::{IntegratorKind, IntegratorOptions, Strategy};
 use tracelab::sampling::SamplerKind;
 use tracelab::scene::Scene;
 
@@ -269,4 +269,64 @@ fn shadow_rays_go_where_the_light_arrives_and_the_image_stays_the_same() {
             m[c]
         );
     }
+}
+
+/// Mitsuba's `direct` integrator with one of its sample counts 0, as
+/// `integrator_direct_lum.xml` and `_bsdf.xml` give Veach's MIS figure:
+/// path tracing's one bounce with that strategy alone, not MIS.
+#[test]
+fn the_direct_integrators_sample_counts_choose_the_strategy() {
+    let scene = |integrator: &str, strict: bool| {
+        let xml = format!(
+            r#"<scene version="3.0.0"><integrator type="direct">{integrator}</integrator>{SENSOR}<shape type="cube"/><emitter type="constant"/></scene>"#
+        );
+        load("direct", &xml, &[], strict)
+    };
+    let counts = |e: i32, b: i32| {
+        format!(
+            r#"<integer name="emitter_samples" value="{e}"/><integer name="bsdf_samples" value="{b}"/>"#
+        )
+    };
+    for ((e, b), strategy, said) in [
+        ((1, 0), Strategy::Light, "strategy light"),
+        ((0, 1), Strategy::Bsdf, "strategy bsdf"),
+        ((1, 1), Strategy::Mis, "strategy mis"),
+    ] {
+        let loaded = scene(&counts(e, b), true).unwrap_or_else(|err| panic!("{err}"));
+        assert_eq!(loaded.hints.max_depth, Some(1));
+        let mut options = IntegratorOptions::default();
+        let taken = options.take_hints(&loaded.hints, false).unwrap();
+        assert!(taken.iter().any(|t| t == said), "{taken:?}");
+        assert_eq!(options.path.strategy, strategy);
+        // Another technique chosen on the command line keeps its own.
+        let mut bdpt = IntegratorOptions::of(IntegratorKind::Bdpt);
+        assert!(
+            !bdpt
+                .take_hints(&loaded.hints, true)
+                .unwrap()
+                .iter()
+                .any(|t| t == said)
+        );
+    }
+    // The default (shading_samples 1) is both; none leaves the emitters seen.
+    assert_eq!(
+        scene("", true).unwrap().hints.strategy.as_deref(),
+        Some("mis")
+    );
+    assert_eq!(scene(&counts(0, 0), true).unwrap().hints.max_depth, Some(0));
+    // More than one sample of a kind is said, and an error under --strict.
+    let many = scene(&counts(4, 2), false).unwrap();
+    assert!(
+        many.warnings
+            .iter()
+            .any(|w| w.contains("4 emitter and 2 BSDF samples")),
+        "{:?}",
+        many.warnings
+    );
+    assert!(scene(&counts(4, 2), true).is_err());
+    let negative = scene(&counts(-1, 1), false).unwrap_err().to_string();
+    assert!(
+        negative.contains("emitter_samples must be >= 0"),
+        "{negative}"
+    );
 }

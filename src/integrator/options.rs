@@ -172,6 +172,23 @@ impl IntegratorOptions {
             length.rr_depth = d;
             taken.push(format!("roulette from {d}"));
         }
+        if let Some(name) = hints
+            .strategy
+            .as_deref()
+            .filter(|_| self.kind == IntegratorKind::Path)
+        {
+            self.path.strategy = match name {
+                "bsdf" => Strategy::Bsdf,
+                "light" => Strategy::Light,
+                "mis" => Strategy::Mis,
+                other => {
+                    return Err(format!(
+                        "the scene asks for an unknown strategy \"{other}\""
+                    ));
+                }
+            };
+            taken.push(format!("strategy {name}"));
+        }
         Ok(taken)
     }
 }

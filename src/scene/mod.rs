@@ -113,6 +113,10 @@ pub struct RenderHints {
     /// Bounces, tracelab's count (Mitsuba's `max_depth` − 1).
     pub max_depth: Option<u32>,
     pub rr_depth: Option<u32>,
+    /// Path tracing's sampling of direct light as the CLI names it (`bsdf`,
+    /// `light`, `mis`): Mitsuba's `direct` with one of its two sample
+    /// counts 0.
+    pub strategy: Option<String>,
     pub spp: Option<u32>,
     /// A sampler's name as the CLI takes it.
     pub sampler: Option<String>,

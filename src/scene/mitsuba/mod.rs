@@ -217,7 +217,7 @@ impl<'a> Importer<'a> {
         // Mitsuba counts segments (1: emitters seen directly, -1: unbounded,
         // every integrator's default); tracelab counts bounces, one fewer.
         let max_depth = match e.plugin() {
-            "direct" => 2,
+            "direct" => self.direct_samples(e, &p)?,
             _ => p.int("max_depth")?.unwrap_or(-1),
         };
         self.hints.max_depth = match max_depth {
@@ -245,6 +245,43 @@ impl<'a> Importer<'a> {
         }
         p.unused(&mut self.warnings);
         Ok(())
+    }
+
+    /// Mitsuba's `direct`: emitter and BSDF samples at the first hit,
+    /// combined by MIS, become path tracing's one bounce with the strategy
+    /// whose counts are not 0 (Veach's figure in `integrator_direct_lum`
+    /// and `_bsdf`). Returns the depth in Mitsuba's count.
+    fn direct_samples(&mut self, e: &'a Element, p: &Props<'a>) -> Result<i64> {
+        let count = |name: &str, default: i64| -> Result<i64> {
+            match p.int(name)?.unwrap_or(default) {
+                n if n >= 0 => Ok(n),
+                n => Err(e.loc.error(format!("{name} must be >= 0, got {n}"))),
+            }
+        };
+        let shading = count("shading_samples", 1)?;
+        let (emitter, bsdf) = (
+            count("emitter_samples", shading)?,
+            count("bsdf_samples", shading)?,
+        );
+        let strategy = match (emitter > 0, bsdf > 0) {
+            (true, true) => "mis",
+            (true, false) => "light",
+            (false, true) => "bsdf",
+            // Only the emitters the camera sees.
+            (false, false) => return Ok(1),
+        };
+        self.hints.strategy = Some(strategy.into());
+        if emitter > 1 || bsdf > 1 {
+            self.warn(
+                &e.loc,
+                &format!(
+                    "direct integrator: {emitter} emitter and {bsdf} BSDF samples read as one of \
+                     each per camera ray (the same expectation; Mitsuba weighs its samples by \
+                     their counts)"
+                ),
+            );
+        }
+        Ok(2)
     }
 
     fn emitter(&mut self, e: &'a Element) -> Result<()> {
