@@ -56,10 +56,13 @@ impl Config {
                 "mcrt d{} n{} m{}",
                 i.mcrt.max_depth, i.mcrt.shadow_rays, i.mcrt.glossy_rays
             ),
-            IntegratorKind::Path => {
-                format!("path d{} {:?}", i.path.length.max_depth, i.path.strategy).to_lowercase()
-            }
-            IntegratorKind::Light => format!("light d{}", i.light.length.max_depth),
+            IntegratorKind::Path => format!(
+                "path d{} {:?}",
+                depth(i.path.length.max_depth),
+                i.path.strategy
+            )
+            .to_lowercase(),
+            IntegratorKind::Light => format!("light d{}", depth(i.light.length.max_depth)),
             IntegratorKind::Radiosity => format!(
                 "radiosity {} {}",
                 i.radiosity.solver.name(),
@@ -304,6 +307,15 @@ pub fn save_settings(path: &std::path::Path, settings: &Settings) -> crate::Resu
     crate::image::write_atomically(path, |tmp| {
         std::fs::write(tmp, &text).map_err(|e| e.to_string())
     })
+}
+
+/// A depth in a label: Mitsuba's unbounded one as `inf`, fit for file names.
+fn depth(max_depth: u32) -> String {
+    if max_depth == crate::scene::UNBOUNDED_DEPTH {
+        "inf".into()
+    } else {
+        max_depth.to_string()
+    }
 }
 
 #[cfg(test)]
