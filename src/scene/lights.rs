@@ -21,6 +21,8 @@ pub struct Lights {
     /// Next-event estimation's choice: by power, or by the shares that the
     /// scene's pilot measured for its groups ([`Lights::set_direct_shares`]).
     direct: Option<AliasTable>,
+    /// Whether a pilot set `direct`.
+    aimed: bool,
     /// How shadow rays stop short of sampled light points.
     offset: OffsetMode,
 }
@@ -46,6 +48,7 @@ impl Lights {
             environment: environment.map(Arc::new),
             selection,
             direct,
+            aimed: false,
             offset: OffsetMode::Robust,
         }
     }
@@ -88,7 +91,7 @@ impl Lights {
         let Some(table) = &self.selection else {
             return 0;
         };
-        let ids = 0..self.lights.len() + usize::from(self.environment.is_some());
+        let ids = 0..self.count();
         let (mut near, mut far, mut far_power) = (0.0, 0, 0.0);
         for i in ids {
             if self.is_infinite(i as u32) {
@@ -107,9 +110,8 @@ impl Lights {
     /// Each light's group in [`Lights::direct_groups`]'s numbering, by
     /// light id.
     pub fn direct_group_of_each(&self) -> Vec<usize> {
-        let count = self.lights.len() + usize::from(self.environment.is_some());
         let mut far = 0;
-        (0..count as u32)
+        (0..self.count() as u32)
             .map(|i| match self.is_infinite(i) {
                 true => {
                     far += 1;
@@ -126,18 +128,18 @@ impl Lights {
         let Some(table) = &self.selection else {
             return;
         };
-        let count = self.lights.len() + usize::from(self.environment.is_some());
-        let powers: Vec<f32> = (0..count).map(|i| table.pmf(i)).collect();
+        let powers: Vec<f32> = (0..self.count()).map(|i| table.pmf(i)).collect();
         let groups = self.direct_group_of_each();
         if let Some(weights) = direct_weights(&powers, &groups, shares) {
             self.direct = AliasTable::new(&weights);
+            self.aimed = self.direct.is_some();
         }
     }
 
     /// Each group's share of next-event estimation's choice beside its
-    /// share by power, for the render summary; None without groups.
+    /// share by power, for the render summary; None where no pilot set them.
     pub fn direct_summary(&self) -> Option<String> {
-        let (Some(direct), Some(power)) = (&self.direct, &self.selection) else {
+        let (Some(direct), Some(power), true) = (&self.direct, &self.selection, self.aimed) else {
             return None;
         };
         let groups = self.direct_groups();
@@ -171,6 +173,12 @@ impl Lights {
     /// `light`: for tests and summaries.
     pub fn direct_pmf(&self, light: u32) -> f32 {
         self.direct.as_ref().map_or(0.0, |t| t.pmf(light as usize))
+    }
+
+    /// Lights and the environment: the light ids.
+    #[inline]
+    fn count(&self) -> usize {
+        self.lights.len() + usize::from(self.environment.is_some())
     }
 
     /// The environment, if the scene has one.
@@ -219,6 +227,7 @@ impl Lights {
             environment: self.environment.clone(),
             selection: self.selection.clone(),
             direct: self.direct.clone(),
+            aimed: self.aimed,
             offset: self.offset,
         }
     }
@@ -241,7 +250,7 @@ impl Lights {
     /// True when sampling chooses between lights: with one light the
     /// choice's random number is not read, so callers may skip drawing it.
     pub fn has_choice(&self) -> bool {
-        self.lights.len() + usize::from(self.environment.is_some()) > 1
+        self.count() > 1
     }
 
     /// Chooses a light with `u_select` and a point on it with `u`, for next-event
