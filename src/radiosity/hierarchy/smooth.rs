@@ -235,3 +235,74 @@ fn linear_source(x: Vec3A, n: Vec3A, v: &[Vec3A; 3], corners: [Rgb; 3]) -> Rgb {
     }
     sum
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// ∫ F(x → y) B(y) over `v` by 4^levels sub-triangles of its own: the
+    /// reference, at a depth where the centroid rule's error is far below
+    /// the tolerances.
+    fn fine(x: Vec3A, n: Vec3A, v: [Vec3A; 3], b: [Rgb; 3], levels: u32) -> Rgb {
+        if levels == 0 {
+            return point_to_polygon(x, n, &v) * ((b[0] + b[1] + b[2]) / 3.0);
+        }
+        let m = [
+            (v[0] + v[1]) / 2.0,
+            (v[1] + v[2]) / 2.0,
+            (v[2] + v[0]) / 2.0,
+        ];
+        let bm = [
+            (b[0] + b[1]) / 2.0,
+            (b[1] + b[2]) / 2.0,
+            (b[2] + b[0]) / 2.0,
+        ];
+        fine(x, n, [v[0], m[0], m[2]], [b[0], bm[0], bm[2]], levels - 1)
+            + fine(x, n, [m[0], v[1], m[1]], [bm[0], b[1], bm[1]], levels - 1)
+            + fine(x, n, [m[2], m[1], v[2]], [bm[2], bm[1], b[2]], levels - 1)
+            + fine(x, n, [m[0], m[1], m[2]], [bm[0], bm[1], bm[2]], levels - 1)
+    }
+
+    /// A wall beside a floor point at its corner, as on the Cornell box.
+    fn corner() -> (Vec3A, Vec3A, [Vec3A; 3]) {
+        let x = Vec3A::new(0.05, 0.0, 0.3);
+        let up = Vec3A::Y;
+        // The wall x = 0, facing +x, from the floor up.
+        let wall = [
+            Vec3A::new(0.0, 0.0, 0.0),
+            Vec3A::new(0.0, 1.0, 0.0),
+            Vec3A::new(0.0, 0.0, 1.0),
+        ];
+        (x, up, wall)
+    }
+
+    #[test]
+    fn a_constant_source_gives_its_form_factor_times_its_radiance() {
+        let (x, n, wall) = corner();
+        let b = Rgb::new(0.2, 0.5, 0.9);
+        let got = linear_source(x, n, &wall, [b; 3]);
+        let want = point_to_polygon(x, n, &wall) * b;
+        // The sub-triangles partition the source, so only rounding differs.
+        assert!(
+            (got - want).abs().max_element() < 1e-5 * want.max_element(),
+            "{got} {want}"
+        );
+    }
+
+    #[test]
+    fn a_linear_source_is_integrated_with_its_variation() {
+        let (x, n, wall) = corner();
+        // Dark along the floor, bright at the top: the point near the floor
+        // sees mostly the dark part.
+        let b = [Rgb::splat(0.0), Rgb::splat(1.0), Rgb::splat(0.0)];
+        let got = linear_source(x, n, &wall, b).x;
+        let want = fine(x, n, wall, b, 7).x;
+        let constant = point_to_polygon(x, n, &wall) / 3.0;
+        // The point lies a twentieth of the wall's size from it, so even 16
+        // sub-triangles see the variation coarsely: measured +20% (0.0595
+        // against 0.0495; 16 384 and 262 144 sub-triangles agree to 1e-5),
+        // while the source's mean radiance gives +197% (0.147).
+        assert!((got - want).abs() < 0.25 * want, "{got} {want}");
+        assert!((constant - want).abs() > 1.5 * want, "{constant} {want}");
+    }
+}
