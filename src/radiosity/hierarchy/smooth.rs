@@ -58,20 +58,20 @@ impl Hierarchy {
         // at that source's vertices.
         let first: Vec<(Rgb, bool)> = vertices
             .par_iter()
-            .map(|&(k, v)| self.vertex_radiance(geometry, &parent, k, v, None))
+            .map(|&(k, v)| self.vertex_radiance(geometry, &parent, k, v))
             .collect();
         let near = NearField {
             index: &index,
-            radiance: first.iter().map(|&(r, _)| r).collect(),
+            radiance: first.iter().map(|&(r, _)| r.max(Rgb::ZERO)).collect(),
         };
         let values: Vec<(Rgb, bool)> = vertices
             .par_iter()
             .zip(&first)
             .map(|(&(k, v), &(radiance, was_near))| {
                 let radiance = if was_near {
-                    self.vertex_radiance(geometry, &parent, k, v, Some(&near)).0
+                    (radiance + self.near_correction(geometry, &parent, k, v, &near)).max(Rgb::ZERO)
                 } else {
-                    radiance
+                    radiance.max(Rgb::ZERO)
                 };
                 let e = &self.nodes[k as usize].element;
                 let x = gather_point(e, v);
@@ -117,16 +117,13 @@ impl Hierarchy {
 
     /// The radiance at vertex `v` of leaf `k` (`parent`: each node's parent):
     /// E + ρ Σ B_q F(x → q) V over the links of the leaf and its ancestors,
-    /// and whether a leaf source was near. With `near`, a near leaf source's
-    /// radiance is the linear field through its vertices' radiance instead
-    /// of its mean.
+    /// and whether a leaf source was near.
     fn vertex_radiance(
         &self,
         geometry: &Geometry,
         parent: &[u32],
         k: u32,
         v: Vec3A,
-        near: Option<&NearField>,
     ) -> (Rgb, bool) {
         let e = &self.nodes[k as usize].element;
         let x = gather_point(e, v);
@@ -146,30 +143,76 @@ impl Hierarchy {
                     continue;
                 }
                 let f = point_to_polygon(x, e.normal, &q.element.vertices);
-                // Through a shadow boundary the link's mean is not the
-                // vertex's: a leaf half behind the light gave the ceiling a
-                // dark ring around it.
-                let visibility = if self.uncertain(a, link) {
-                    point_visibility(geometry, x, e.normal, &q.element, VERTEX_RAYS)
-                } else {
-                    link.visibility
-                };
-                let is_near = q.children == NONE && f > NEAR_FORM_FACTOR;
-                was_near |= is_near;
-                let sent = match near.filter(|_| is_near).and_then(|n| n.at(&q.element)) {
-                    Some(corners) => linear_source(x, e.normal, &q.element.vertices, corners),
-                    None => f * self.sent_by(link.source),
-                };
-                irradiance += visibility * sent;
+                was_near |= q.children == NONE && f > NEAR_FORM_FACTOR;
+                irradiance += self.vertex_visibility(geometry, a, link, x, e.normal)
+                    * f
+                    * self.sent_by(link.source);
             }
             root = a;
             a = parent[a as usize];
         }
         irradiance += self.cluster_irradiance(root, x, e.normal);
-        (
-            (e.emission + e.reflectance * irradiance).max(Rgb::ZERO),
-            was_near,
-        )
+        (e.emission + e.reflectance * irradiance, was_near)
+    }
+
+    /// What [`Self::vertex_radiance`] changes by when each near leaf source
+    /// sends the linear field through its vertices' radiance (`near`)
+    /// instead of its mean. Only the near links are evaluated again, so the
+    /// second pass costs a fraction of the first.
+    fn near_correction(
+        &self,
+        geometry: &Geometry,
+        parent: &[u32],
+        k: u32,
+        v: Vec3A,
+        near: &NearField,
+    ) -> Rgb {
+        let e = &self.nodes[k as usize].element;
+        let x = gather_point(e, v);
+        let mut change = Rgb::ZERO;
+        let mut a = k;
+        while a != NONE {
+            for link in &self.nodes[a as usize].links {
+                if is_cluster(link.source) {
+                    continue;
+                }
+                let q = &self.nodes[link.source as usize];
+                if q.children != NONE || q.element.normal.dot(x - q.element.vertices[0]) <= 0.0 {
+                    continue;
+                }
+                if !may_be_near(x, &q.element) {
+                    continue;
+                }
+                let f = point_to_polygon(x, e.normal, &q.element.vertices);
+                let Some(corners) = near.at(&q.element).filter(|_| f > NEAR_FORM_FACTOR) else {
+                    continue;
+                };
+                let linear = linear_source(x, e.normal, &q.element.vertices, corners);
+                change += self.vertex_visibility(geometry, a, link, x, e.normal)
+                    * (linear - f * self.sent_by(link.source));
+            }
+            a = parent[a as usize];
+        }
+        e.reflectance * change
+    }
+
+    /// A link's visibility at a vertex: through a shadow boundary the link's
+    /// mean is not the vertex's (a leaf half behind the light gave the
+    /// ceiling a dark ring around it), so uncertain links cast rays there.
+    fn vertex_visibility(
+        &self,
+        geometry: &Geometry,
+        a: u32,
+        link: &super::Link,
+        x: Vec3A,
+        normal: Vec3A,
+    ) -> f32 {
+        if self.uncertain(a, link) {
+            let q = &self.nodes[link.source as usize];
+            point_visibility(geometry, x, normal, &q.element, VERTEX_RAYS)
+        } else {
+            link.visibility
+        }
     }
 }
 
@@ -183,6 +226,20 @@ const NEAR_FORM_FACTOR: f32 = 0.05;
 /// A near source is integrated over 4^NEAR_LEVELS sub-triangles (1:
 /// 0.001563 / 0.001212 as above, 3: 0.001558 / 0.001211).
 const NEAR_LEVELS: u32 = 2;
+
+/// Whether the form factor from `x` to `q` can exceed [`NEAR_FORM_FACTOR`]:
+/// it is at most A / (π d²), d the distance to q's bounding sphere, which
+/// skips the exact form factor for all but the adjacent sources.
+fn may_be_near(x: Vec3A, q: &crate::radiosity::Element) -> bool {
+    let centre = (q.vertices[0] + q.vertices[1] + q.vertices[2]) / 3.0;
+    let radius = q
+        .vertices
+        .iter()
+        .map(|&v| v.distance(centre))
+        .fold(0.0, f32::max);
+    let d = x.distance(centre) - radius;
+    d <= 0.0 || q.area > NEAR_FORM_FACTOR * std::f32::consts::PI * d * d
+}
 
 /// Where a vertex's radiance is gathered: just inside its leaf, since on a
 /// neighbour's edge the integral is singular.
