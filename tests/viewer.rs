@@ -342,6 +342,10 @@ fn radiosity_controls_drive_the_solver() {
     click(&mut harness, "Radiosity");
     click(&mut harness, "hierarchical");
     click(&mut harness, "flat");
+    // A lookup display antialiases with its own sampler, and says so in place
+    // of the sampler's controls.
+    harness.get_by_label_contains("Sampler: sobol");
+    assert!(harness.query_by_label("Stratify samples").is_none());
     // Each form-factor method starts from the count at which it is accurate.
     let samples = |h: &Harness<'_, Window>| {
         h.state()

@@ -158,6 +158,26 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
             .on_hover_text(kind.summary());
     }
     super::controls::technique(ui, options);
+    match config.fixed_sampler() {
+        Some(fixed) => {
+            ui.label(format!(
+                "Sampler: {} (this display looks the solution up: its only noise is \
+                 the pixels' coverage)",
+                fixed.name()
+            ));
+        }
+        None => sampler_rows(ui, config),
+    }
+    ui.horizontal(|ui| {
+        let label = ui.label("Seed");
+        ui.add(egui::DragValue::new(&mut config.seed))
+            .labelled_by(label.id);
+    });
+}
+
+/// The sampler, its domains and sample spreading, for techniques that
+/// follow the session's sampler.
+fn sampler_rows(ui: &mut egui::Ui, config: &mut Config) {
     ui.horizontal_wrapped(|ui| {
         ui.label("Sampler");
         ui.radio_value(&mut config.sampler, SamplerKind::Independent, "Independent");
@@ -198,11 +218,6 @@ fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
                  per-pixel noise is (Neyman allocation): least RMSE for the time",
         );
     }
-    ui.horizontal(|ui| {
-        let label = ui.label("Seed");
-        ui.add(egui::DragValue::new(&mut config.seed))
-            .labelled_by(label.id);
-    });
 }
 
 fn samples_section(ui: &mut egui::Ui, app: &mut ViewerApp) {

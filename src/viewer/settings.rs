@@ -94,15 +94,17 @@ impl Config {
         } else {
             ""
         };
-        // Lookup displays of radiosity antialias with Sobol points.
+        let sampler = self.fixed_sampler().unwrap_or(self.sampler);
+        format!("{estimator} {}{partial}{adaptive}", sampler.name())
+    }
+
+    /// The sampler the technique uses whatever the session's is: radiosity's
+    /// lookup displays antialias with Sobol points (`display_sampler`).
+    pub fn fixed_sampler(&self) -> Option<SamplerKind> {
+        let i = &self.integrator;
         let lookup = i.kind == IntegratorKind::Radiosity
             && i.radiosity.display != crate::integrator::radiosity::RadiosityDisplay::Gather;
-        let sampler = if lookup {
-            SamplerKind::Sobol
-        } else {
-            self.sampler
-        };
-        format!("{estimator} {}{partial}{adaptive}", sampler.name())
+        lookup.then_some(SamplerKind::Sobol)
     }
 }
 
