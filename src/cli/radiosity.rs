@@ -96,6 +96,11 @@ pub struct RadiosityFlags {
     /// with --wireframe).
     #[arg(long)]
     discontinuity_meshing: bool,
+    /// Radiosity, matrix solvers, with --discontinuity-meshing: keep the
+    /// regular elements of the mesh without lines and split only those a
+    /// line crosses (better at fine meshes, worse at coarse ones).
+    #[arg(long)]
+    lines_on_regular_mesh: bool,
 }
 
 impl RadiosityFlags {
@@ -114,6 +119,7 @@ impl RadiosityFlags {
             || self.adaptive_tolerance.is_some()
             || self.wireframe
             || self.discontinuity_meshing
+            || self.lines_on_regular_mesh
     }
 
     /// `settings` with the flags given applied, checked.
@@ -143,7 +149,8 @@ impl RadiosityFlags {
             .unwrap_or(settings.adaptive_tolerance);
         settings.ambient |= self.ambient_term;
         settings.wireframe |= self.wireframe;
-        settings.discontinuity |= self.discontinuity_meshing;
+        settings.discontinuity |= self.discontinuity_meshing || self.lines_on_regular_mesh;
+        settings.lines_on_regular_mesh |= self.lines_on_regular_mesh;
         if let Some(display) = self.display {
             settings.display = match display {
                 DisplayArg::Flat => RadiosityDisplay::Flat,

@@ -79,6 +79,11 @@ pub struct Radiosity {
     /// Split receivers along the shadows' discontinuities first
     /// ([`crate::radiosity::discontinuity`]).
     pub discontinuity: bool,
+    /// Matrix solvers with `discontinuity`: keep the regular elements of the
+    /// mesh without lines and split only those a line crosses, instead of
+    /// meshing every receiver by Delaunay refinement (better from about
+    /// 2 000 elements on the Cornell box, worse below: docs/validation.md).
+    pub lines_on_regular_mesh: bool,
 }
 
 /// How the solution is shown.
@@ -140,10 +145,10 @@ impl Technique for Radiosity {
             } else {
                 String::new()
             },
-            if self.discontinuity {
-                ", discontinuity meshing"
-            } else {
-                ""
+            match (self.discontinuity, self.lines_on_regular_mesh) {
+                (false, _) => "",
+                (true, false) => ", discontinuity meshing",
+                (true, true) => ", discontinuity meshing on the regular mesh",
             },
             self.form_factors,
             self.form_factor_samples,
@@ -448,11 +453,17 @@ impl Radiosity {
             let scene = flat.as_ref().unwrap_or(scene);
             // The matrix solvers' elements are the pieces; the hierarchy
             // subdivides its own.
-            let size = self.solver.matrix().map(|_| {
+            let base = self.solver.matrix().map(|_| {
+                use crate::radiosity::discontinuity::Base;
                 let b = scene.geometry.bounds();
-                self.patch_size * (b.max - b.min).length()
+                let max_edge = self.patch_size * (b.max - b.min).length();
+                if self.lines_on_regular_mesh {
+                    Base::Regular { max_edge }
+                } else {
+                    Base::Delaunay { max_edge }
+                }
             });
-            let (meshed, notes) = discontinuity_mesh(scene, size);
+            let (meshed, notes) = discontinuity_mesh(scene, base);
             (Some(meshed), notes)
         } else if let Some(flat) = flat {
             let note = format!(

@@ -28,7 +28,7 @@ use glam::Vec3A;
 use std::collections::{BTreeMap, HashMap};
 
 mod triangulate;
-pub use triangulate::{MIN_ANGLE, split};
+pub use triangulate::{Base, MIN_ANGLE, split};
 
 /// Rays per fan before bisection.
 const FAN_RAYS: u32 = 32;

@@ -84,10 +84,7 @@ impl Mesh {
                 .length()
                 .max((v[2] - v[1]).length())
                 .max((v[0] - v[2]).length());
-            let mut depth = 0u8;
-            while depth < MAX_DEPTH && longest / (1u32 << depth) as f32 > target {
-                depth += 1;
-            }
+            let depth = depth_for(longest, target);
             total += (1usize << (2 * depth)) * (1 + usize::from(two_sided[i]));
             depths.push(Some(depth));
         }
@@ -371,6 +368,16 @@ impl Mesh {
             }
         }
     }
+}
+
+/// How many times a triangle whose longest edge is `longest` is split in
+/// four for elements of at most `target` along their longest edge.
+pub fn depth_for(longest: f32, target: f32) -> u8 {
+    let mut depth = 0u8;
+    while depth < MAX_DEPTH && longest / (1u32 << depth) as f32 > target {
+        depth += 1;
+    }
+    depth
 }
 
 /// The four children of triangle `v` by midpoint subdivision: corner

@@ -181,6 +181,14 @@ fn radiosity(ui: &mut egui::Ui, s: &mut Radiosity) {
         "Split receivers along the umbra and penumbra boundaries of polygonal lights \
              before meshing, so that no element straddles a shadow's edge",
     );
+    if s.discontinuity && s.solver != RadiositySolver::Hierarchical {
+        ui.checkbox(&mut s.lines_on_regular_mesh, "Lines on the regular mesh")
+            .on_hover_text(
+                "Keep the elements of the mesh without lines and split only those a line \
+                 crosses (better at fine meshes); off: every receiver meshed by Delaunay \
+                 refinement (fewer pieces at coarse ones)",
+            );
+    }
     ui.horizontal(|ui| {
         ui.label("Form factors");
         let before = s.form_factors;

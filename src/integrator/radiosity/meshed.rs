@@ -44,10 +44,13 @@ impl Meshed {
 
 /// `scene` split along the discontinuities its polygonal lights cast, and
 /// notes saying what was found.
-pub(super) fn discontinuity_mesh(scene: &Scene, size: Option<f32>) -> (Meshed, Vec<String>) {
+pub(super) fn discontinuity_mesh(
+    scene: &Scene,
+    base: Option<crate::radiosity::discontinuity::Base>,
+) -> (Meshed, Vec<String>) {
     use crate::radiosity::discontinuity;
     let lines = discontinuity::find(scene);
-    let pieces = discontinuity::split(scene, &lines, size);
+    let pieces = discontinuity::split(scene, &lines, base);
     let corners: Vec<Vec<[glam::Vec3A; 3]>> = pieces
         .iter()
         .map(|p| p.iter().map(|p| p.vertices).collect())

@@ -20,6 +20,7 @@ impl Default for Radiosity {
             adaptive_tolerance: 0.5,
             wireframe: false,
             discontinuity: false,
+            lines_on_regular_mesh: false,
         }
     }
 }

@@ -7,20 +7,31 @@ use crate::scene::Scene;
 use glam::Vec3A;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
+/// How a matrix solver's receivers are meshed around their lines.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Base {
+    /// Every receiver, lines or not, by constrained Delaunay refinement with
+    /// points at most `max_edge` apart along its edges and lines.
+    Delaunay { max_edge: f32 },
+    /// The regular elements of the mesh without lines (edges at most
+    /// `max_edge`, [`crate::radiosity::Mesh::build`]'s depth), only those a
+    /// line crosses triangulated along it; receivers without lines stay
+    /// whole for the mesh to subdivide the same way.
+    Regular { max_edge: f32 },
+}
+
 /// Splits receiver triangles along their discontinuities: a constrained
 /// Delaunay triangulation of the triangle's corners and its segments, the
 /// segments constraints (crossing ones split each other), refined by
 /// spade's Delaunay refinement to angles of at least [`MIN_ANGLE`].
 ///
-/// With `max_edge` (scene units; the matrix solvers' element size), every
-/// receiver is meshed, lines or not, with points at most that far apart
-/// along its edges and lines, the interior refined for angles only:
-/// the triangle's edges are cut at points that depend only on the edge,
-/// so the triangle across it, meshed on its own, has the same ones and
-/// the mesh has no T-vertices. Without (the hierarchy, which subdivides
-/// on its own), only triangles with lines are split, and only along them.
-/// Per scene triangle, its pieces, or none where it stays whole.
-pub fn split(scene: &Scene, lines: &Discontinuities, max_edge: Option<f32>) -> Vec<Vec<Piece>> {
+/// With a `base` (the matrix solvers' elements), receivers are meshed as it
+/// says. The two are complementary on the Cornell box (docs/validation.md):
+/// Delaunay pieces are fewer for a coarse size, the regular base keeps the
+/// walls' regular elements at fine ones. Without (the hierarchy, which
+/// subdivides on its own), only triangles with lines are split, and only
+/// along them. Per scene triangle, its pieces, or none where it stays whole.
+pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<Vec<Piece>> {
     let geometry = &scene.geometry;
     let tracer = Tracer {
         scene,
@@ -33,13 +44,88 @@ pub fn split(scene: &Scene, lines: &Discontinuities, max_edge: Option<f32>) -> V
         .iter()
         .enumerate()
         .map(|(t, segments)| {
-            if segments.is_empty() && !(max_edge.is_some() && tracer.receiver(t)) {
-                Vec::new()
-            } else {
-                split_triangle(geometry.triangles()[t], segments, max_edge)
+            let v = geometry.triangles()[t];
+            let receiver = || tracer.receiver(t);
+            match base {
+                _ if segments.is_empty() && !base.is_some_and(|_| receiver()) => Vec::new(),
+                Some(Base::Delaunay { max_edge }) => split_triangle(v, segments, Some(max_edge)),
+                // Receivers without lines stay whole: the mesh subdivides them.
+                Some(Base::Regular { .. }) if segments.is_empty() => Vec::new(),
+                Some(Base::Regular { max_edge }) => split_regular(v, segments, max_edge),
+                None => split_triangle(v, segments, None),
             }
         })
         .collect()
+}
+
+/// Triangle `v` cut into the regular elements of the mesh without lines
+/// (edges at most `max_edge`), each element that `segments` cross split
+/// along the part of them inside it.
+fn split_regular(v: [Vec3A; 3], segments: &[Segment], max_edge: f32) -> Vec<Piece> {
+    let longest = (v[1] - v[0])
+        .length()
+        .max((v[2] - v[1]).length())
+        .max((v[0] - v[2]).length());
+    let depth = crate::radiosity::mesh::depth_for(longest, max_edge);
+    let mut elements = vec![v];
+    for _ in 0..depth {
+        elements = elements
+            .into_iter()
+            .flat_map(crate::radiosity::mesh::children)
+            .collect();
+    }
+    let mut pieces = Vec::with_capacity(elements.len());
+    let mut inside = Vec::new();
+    for element in elements {
+        inside.clear();
+        inside.extend(segments.iter().filter_map(|s| clip(s, &element)));
+        if inside.is_empty() {
+            pieces.push(Piece {
+                vertices: element,
+                on_line: [false; 3],
+            });
+        } else {
+            pieces.extend(split_triangle(element, &inside, None));
+        }
+    }
+    pieces
+}
+
+/// The part of segment `s` inside triangle `v` (both in one plane), unless
+/// it is shorter than a thousandth of the triangle's longest edge.
+fn clip(s: &Segment, v: &[Vec3A; 3]) -> Option<Segment> {
+    let normal = (v[1] - v[0]).cross(v[2] - v[0]);
+    let inverse = 1.0 / normal.length_squared();
+    // Barycentric i of point p: the sub-triangle opposite vertex i.
+    let weight = |p: Vec3A, i: usize| {
+        let (a, b) = (v[(i + 1) % 3], v[(i + 2) % 3]);
+        (b - a).cross(p - a).dot(normal) * inverse
+    };
+    let [a, b] = s.ends;
+    let (mut t0, mut t1) = (0.0f32, 1.0f32);
+    for i in 0..3 {
+        let (wa, wb) = (weight(a, i), weight(b, i));
+        // w(t) = wa + t (wb - wa) >= 0.
+        if wa < 0.0 && wb < 0.0 {
+            return None;
+        }
+        if wa < 0.0 {
+            t0 = t0.max(wa / (wa - wb));
+        } else if wb < 0.0 {
+            t1 = t1.min(wa / (wa - wb));
+        }
+    }
+    let longest = (v[1] - v[0])
+        .length()
+        .max((v[2] - v[1]).length())
+        .max((v[0] - v[2]).length());
+    if (t1 - t0) * (b - a).length() <= 1e-3 * longest {
+        return None;
+    }
+    Some(Segment {
+        ends: [a + t0 * (b - a), a + t1 * (b - a)],
+        event: s.event,
+    })
 }
 
 /// Smallest angle of a piece that refinement aims for (spade terminates
@@ -275,6 +361,53 @@ fn split_triangle(v: [Vec3A; 3], segments: &[Segment], max_edge: Option<f32>) ->
 mod tests {
     use super::*;
     use crate::radiosity::discontinuity::Event;
+
+    #[test]
+    fn the_regular_base_keeps_the_elements_no_line_crosses() {
+        let v = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
+        // From edge to edge, so that the line's sides are the segment's.
+        let line = Segment {
+            ends: [Vec3A::new(0.0, 0.55, 0.0), Vec3A::new(0.65, 0.0, 0.0)],
+            event: Event::VertexEdge,
+        };
+        // Longest edge √2 at most 0.3: three levels, 64 elements.
+        let pieces = split_regular(v, &[line], 0.3);
+        let mut regular = vec![v];
+        for _ in 0..3 {
+            regular = regular
+                .into_iter()
+                .flat_map(crate::radiosity::mesh::children)
+                .collect();
+        }
+        let side = |p: Vec3A| {
+            let [a, b] = line.ends;
+            (b - a).cross(p - a).z
+        };
+        let crossed = |e: &[Vec3A; 3]| clip(&line, e).is_some();
+        let kept = regular.iter().filter(|e| !crossed(e)).count();
+        assert!(kept < 64 && kept > 40, "{kept}");
+        // Every element the line misses is a piece as it is.
+        for e in regular.iter().filter(|e| !crossed(e)) {
+            assert!(pieces.iter().any(|p| p.vertices == *e), "{e:?}");
+        }
+        // The pieces tile the triangle, and none straddles the line.
+        let area: f32 = pieces
+            .iter()
+            .map(|p| {
+                0.5 * (p.vertices[1] - p.vertices[0])
+                    .cross(p.vertices[2] - p.vertices[0])
+                    .z
+            })
+            .sum();
+        assert!((area - 0.5).abs() < 1e-5, "{area}");
+        for p in &pieces {
+            let sides = p.vertices.map(side);
+            let (lo, hi) = sides
+                .iter()
+                .fold((0.0f32, 0.0f32), |(l, h), &x| (l.min(x), h.max(x)));
+            assert!(lo > -1e-5 || hi < 1e-5, "{p:?} straddles the line");
+        }
+    }
 
     #[test]
     fn pieces_do_not_depend_on_the_scenes_units() {
