@@ -66,45 +66,52 @@ fn penumbra_lines_fall_where_similar_triangles_put_them_and_pieces_never_straddl
         }
         assert!((reach - OUTER).abs() < 0.01, "{line:?} ends at {reach}");
     }
-    // Pieces of about 0.3 m: they tile the floor, and within the outer
-    // square (where the lines run) none has corners on both sides of one.
-    let pieces = discontinuity::split(&scene, &lines, Some(0.3));
-    let mut area = 0.0;
-    for (t, pieces) in pieces.iter().enumerate() {
-        if !on_floor(t) {
-            continue;
-        }
-        for p in pieces {
-            let [a, b, c] = p.vertices;
-            area += 0.5 * (b - a).cross(c - a).length();
-            let [p0, p1, p2] = geometry.triangles()[t];
-            assert!(
-                (b - a).cross(c - a).y * (p1 - p0).cross(p2 - p0).y > 0.0,
-                "a piece wound unlike its triangle: {p:?} in {:?}",
-                geometry.triangles()[t]
-            );
-            let centroid = (a + b + c) / 3.0;
-            for axis in [0, 2] {
-                let across = 2 - axis;
-                // (Fans stop a thousandth short of the occluder's corners.)
-                if centroid[across].abs() > OUTER - 0.05 {
-                    continue;
-                }
-                for value in [-OUTER, -INNER, INNER, OUTER] {
-                    let sides = p.vertices.map(|v| v[axis] - value);
-                    // Within 5 mm: where two lines meet, the fan's end and the
-                    // merging of points a thousandth of the triangle apart leave that.
-                    let straddles =
-                        sides.iter().any(|&d| d > 5e-3) && sides.iter().any(|&d| d < -5e-3);
-                    assert!(!straddles, "{p:?} straddles {axis} = {value}");
+    // Pieces of about 0.3 m, on either base: they tile the floor, and within
+    // the outer square (where the lines run) none has corners on both sides
+    // of one.
+    use discontinuity::Base;
+    for base in [
+        Base::Delaunay { max_edge: 0.3 },
+        Base::Regular { max_edge: 0.3 },
+    ] {
+        let pieces = discontinuity::split(&scene, &lines, Some(base));
+        let mut area = 0.0;
+        for (t, pieces) in pieces.iter().enumerate() {
+            if !on_floor(t) {
+                continue;
+            }
+            for p in pieces {
+                let [a, b, c] = p.vertices;
+                area += 0.5 * (b - a).cross(c - a).length();
+                let [p0, p1, p2] = geometry.triangles()[t];
+                assert!(
+                    (b - a).cross(c - a).y * (p1 - p0).cross(p2 - p0).y > 0.0,
+                    "a piece wound unlike its triangle: {p:?} in {:?}",
+                    geometry.triangles()[t]
+                );
+                let centroid = (a + b + c) / 3.0;
+                for axis in [0, 2] {
+                    let across = 2 - axis;
+                    // (Fans stop a thousandth short of the occluder's corners.)
+                    if centroid[across].abs() > OUTER - 0.05 {
+                        continue;
+                    }
+                    for value in [-OUTER, -INNER, INNER, OUTER] {
+                        let sides = p.vertices.map(|v| v[axis] - value);
+                        // Within 5 mm: where two lines meet, the fan's end and the
+                        // merging of points a thousandth of the triangle apart leave that.
+                        let straddles =
+                            sides.iter().any(|&d| d > 5e-3) && sides.iter().any(|&d| d < -5e-3);
+                        assert!(!straddles, "{p:?} straddles {axis} = {value}");
+                    }
                 }
             }
         }
+        assert!(
+            (area - 16.0).abs() < 1e-3,
+            "{base:?}: floor pieces cover {area} m² of 16"
+        );
     }
-    assert!(
-        (area - 16.0).abs() < 1e-3,
-        "floor pieces cover {area} m² of 16"
-    );
 }
 
 /// Gauss–Seidel on the Cornell box at patch size 0.15, smooth display,
