@@ -362,6 +362,18 @@ mod tests {
     use super::*;
     use crate::radiosity::discontinuity::Event;
 
+    /// The pieces' signed area, for pieces in the z = 0 plane.
+    fn area_in_xy(pieces: &[Piece]) -> f32 {
+        pieces
+            .iter()
+            .map(|p| {
+                0.5 * (p.vertices[1] - p.vertices[0])
+                    .cross(p.vertices[2] - p.vertices[0])
+                    .z
+            })
+            .sum()
+    }
+
     #[test]
     fn the_regular_base_keeps_the_elements_no_line_crosses() {
         let v = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
@@ -391,14 +403,7 @@ mod tests {
             assert!(pieces.iter().any(|p| p.vertices == *e), "{e:?}");
         }
         // The pieces tile the triangle, and none straddles the line.
-        let area: f32 = pieces
-            .iter()
-            .map(|p| {
-                0.5 * (p.vertices[1] - p.vertices[0])
-                    .cross(p.vertices[2] - p.vertices[0])
-                    .z
-            })
-            .sum();
+        let area = area_in_xy(&pieces);
         assert!((area - 0.5).abs() < 1e-5, "{area}");
         for p in &pieces {
             let sides = p.vertices.map(side);
@@ -456,14 +461,7 @@ mod tests {
             ],
             None,
         );
-        let area: f32 = pieces
-            .iter()
-            .map(|p| {
-                0.5 * (p.vertices[1] - p.vertices[0])
-                    .cross(p.vertices[2] - p.vertices[0])
-                    .z
-            })
-            .sum();
+        let area = area_in_xy(&pieces);
         // Every piece wound like the triangle (positive z), covering it.
         assert!(pieces.iter().all(|p| {
             (p.vertices[1] - p.vertices[0])
