@@ -80,11 +80,7 @@ impl Mesh {
                 depths.push(None);
                 continue;
             }
-            let longest = (v[1] - v[0])
-                .length()
-                .max((v[2] - v[1]).length())
-                .max((v[0] - v[2]).length());
-            let depth = depth_for(longest, target);
+            let depth = depth_for(longest_edge(v), target);
             total += (1usize << (2 * depth)) * (1 + usize::from(two_sided[i]));
             depths.push(Some(depth));
         }
@@ -368,6 +364,14 @@ impl Mesh {
             }
         }
     }
+}
+
+/// The longest edge of triangle `v`.
+pub fn longest_edge(v: &[Vec3A; 3]) -> f32 {
+    (v[1] - v[0])
+        .length()
+        .max((v[2] - v[1]).length())
+        .max((v[0] - v[2]).length())
 }
 
 /// How many times a triangle whose longest edge is `longest` is split in

@@ -47,12 +47,17 @@ pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<
             let v = geometry.triangles()[t];
             let receiver = || tracer.receiver(t);
             match base {
-                _ if segments.is_empty() && !base.is_some_and(|_| receiver()) => Vec::new(),
-                Some(Base::Delaunay { max_edge }) => split_triangle(v, segments, Some(max_edge)),
-                // Receivers without lines stay whole: the mesh subdivides them.
-                Some(Base::Regular { .. }) if segments.is_empty() => Vec::new(),
-                Some(Base::Regular { max_edge }) => split_regular(v, segments, max_edge),
+                None if segments.is_empty() => Vec::new(),
                 None => split_triangle(v, segments, None),
+                Some(Base::Delaunay { max_edge }) if !segments.is_empty() || receiver() => {
+                    split_triangle(v, segments, Some(max_edge))
+                }
+                Some(Base::Regular { max_edge }) if !segments.is_empty() => {
+                    split_regular(v, segments, max_edge)
+                }
+                // Left whole: the mesh subdivides it (a receiver without
+                // lines on the regular base).
+                Some(_) => Vec::new(),
             }
         })
         .collect()
@@ -62,10 +67,7 @@ pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<
 /// (edges at most `max_edge`), each element that `segments` cross split
 /// along the part of them inside it.
 fn split_regular(v: [Vec3A; 3], segments: &[Segment], max_edge: f32) -> Vec<Piece> {
-    let longest = (v[1] - v[0])
-        .length()
-        .max((v[2] - v[1]).length())
-        .max((v[0] - v[2]).length());
+    let longest = crate::radiosity::mesh::longest_edge(&v);
     let depth = crate::radiosity::mesh::depth_for(longest, max_edge);
     let mut elements = vec![v];
     for _ in 0..depth {
@@ -115,10 +117,7 @@ fn clip(s: &Segment, v: &[Vec3A; 3]) -> Option<Segment> {
             t1 = t1.min(wa / (wa - wb));
         }
     }
-    let longest = (v[1] - v[0])
-        .length()
-        .max((v[2] - v[1]).length())
-        .max((v[0] - v[2]).length());
+    let longest = crate::radiosity::mesh::longest_edge(v);
     if (t1 - t0) * (b - a).length() <= 1e-3 * longest {
         return None;
     }
