@@ -3,7 +3,7 @@
 //! vertex connection and merging (`vcm/`, for its light vertices).
 //!
 //! Photons are found through a hash grid of cells of side 2R built once per
-//! map (a counting sort of photon positions and indices by cell), R the
+//! map (a counting sort of the photons by cell), R the
 //! largest radius a lookup may use: a query sphere then touches at most
 //! 2 x 2 x 2 cells.
 //! Every lookup of an iteration has the same largest radius and the map is
@@ -99,56 +99,114 @@ pub fn describe_photons(photons: u32) -> String {
 
 /// Photons (or other [`Stored`] points) in a hash grid.
 pub struct PhotonMap<P = Photon> {
+    /// The photons sorted by cell hash: `starts[h]..starts[h + 1]` are those
+    /// of hash h, so that a lookup reads the photons it finds in a few runs
+    /// of memory, not one cache miss each (dense maps find tens per lookup).
     photons: Vec<P>,
-    /// Each photon's position and index, sorted by cell hash;
-    /// `starts[h]..starts[h + 1]` are those of hash h. A lookup tests
-    /// distances on these 16 bytes in a row and reads a photon only where it
-    /// is near (most candidates of the 2 x 2 x 2 cells are not).
-    entries: Vec<Entry>,
+    /// Their positions, in the same order: a lookup tests distances on these
+    /// 12 bytes in a row and reads a photon only where it is near (most
+    /// candidates of the 2 x 2 x 2 cells are not).
+    positions: Vec<Vec3>,
     starts: Vec<u32>,
     cell: f32,
     /// The largest lookup radius.
     radius: f32,
 }
 
-/// A photon's position and its index in [`PhotonMap::items`].
-#[derive(Clone, Copy, Default)]
-struct Entry {
-    position: Vec3,
-    index: u32,
-}
+impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
+    /// A map of `photons` for lookups of radius at most `radius`, sorted
+    /// in place (a copy would cost each pass new pages).
+    pub fn build(mut photons: Vec<P>, radius: f32) -> PhotonMap<P> {
+        let (mut map, mut source) = Self::sorted_places(&[photons.as_slice()], radius);
+        // Each cycle of the permutation moved along, one photon in hand.
+        for start in 0..source.len() {
+            if source[start] as usize == start {
+                continue;
+            }
+            let held = photons[start];
+            let mut place = start;
+            loop {
+                let from = source[place] as usize;
+                source[place] = place as u32;
+                if from == start {
+                    photons[place] = held;
+                    break;
+                }
+                photons[place] = photons[from];
+                place = from;
+            }
+        }
+        map.photons = photons;
+        map.positions = map
+            .photons
+            .par_iter()
+            .map(|p| p.position().into())
+            .collect();
+        map
+    }
 
-impl<P: Stored + Sync> PhotonMap<P> {
-    /// A map of `photons` for lookups of radius at most `radius`.
-    pub fn build(photons: Vec<P>, radius: f32) -> PhotonMap<P> {
-        let buckets = photons.len().next_power_of_two().max(1);
+    /// A map of what `convert` makes of the points of `parts` (one part
+    /// after another), without first copying them into one list.
+    pub fn from_parts<T: Stored + Sync>(
+        parts: &[&[T]],
+        radius: f32,
+        convert: impl Fn(&T) -> P + Sync,
+    ) -> PhotonMap<P> {
+        let (mut map, source) = Self::sorted_places(parts, radius);
+        let mut offsets = Vec::with_capacity(parts.len() + 1);
+        offsets.push(0);
+        for part in parts {
+            offsets.push(offsets.last().unwrap() + part.len());
+        }
+        map.photons = source
+            .par_iter()
+            .map(|&i| {
+                let i = i as usize;
+                let part = offsets.partition_point(|&o| o <= i) - 1;
+                convert(&parts[part][i - offsets[part]])
+            })
+            .collect();
+        map.positions = map
+            .photons
+            .par_iter()
+            .map(|p| p.position().into())
+            .collect();
+        map
+    }
+
+    /// An empty map with its buckets' bounds, and the point (an index into
+    /// `parts` one after another) that goes to each place: a counting sort
+    /// by cell hash.
+    fn sorted_places<T: Stored + Sync>(parts: &[&[T]], radius: f32) -> (PhotonMap<P>, Vec<u32>) {
+        let count: usize = parts.iter().map(|p| p.len()).sum();
+        let buckets = count.next_power_of_two().max(1);
         let mut map = PhotonMap {
-            entries: vec![Entry::default(); photons.len()],
-            starts: vec![0; buckets + 1],
             photons: Vec::new(),
+            positions: Vec::new(),
+            starts: vec![0; buckets + 1],
             cell: 2.0 * radius,
             radius,
         };
-        let hashes: Vec<usize> = photons
-            .par_iter()
-            .map(|p| map.hash(map.cell_of(p.position())))
-            .collect();
+        let mut hashes: Vec<u32> = Vec::with_capacity(count);
+        for part in parts {
+            hashes.par_extend(
+                part.par_iter()
+                    .map(|p| map.hash(map.cell_of(p.position())) as u32),
+            );
+        }
         for &h in &hashes {
-            map.starts[h + 1] += 1;
+            map.starts[h as usize + 1] += 1;
         }
         for i in 1..map.starts.len() {
             map.starts[i] += map.starts[i - 1];
         }
         let mut next = map.starts.clone();
-        for (i, (&h, p)) in hashes.iter().zip(&photons).enumerate() {
-            map.entries[next[h] as usize] = Entry {
-                position: p.position().into(),
-                index: i as u32,
-            };
-            next[h] += 1;
+        let mut source = vec![0u32; count];
+        for (i, &h) in hashes.iter().enumerate() {
+            source[next[h as usize] as usize] = i as u32;
+            next[h as usize] += 1;
         }
-        map.photons = photons;
-        map
+        (map, source)
     }
 
     /// The bucket of cell `c`: rows of cells along x fill consecutive
@@ -179,7 +237,7 @@ impl<P: Stored + Sync> PhotonMap<P> {
         self.photons.is_empty()
     }
 
-    /// What the map holds, in the order it was given.
+    /// What the map holds, sorted by cell.
     pub fn items(&self) -> &[P] {
         &self.photons
     }
@@ -213,11 +271,11 @@ impl<P: Stored + Sync> PhotonMap<P> {
                     continue;
                 }
                 seen[k] = h;
-                for e in &self.entries[self.starts[h] as usize..self.starts[h + 1] as usize] {
-                    if (Vec3A::from(e.position) - point).length_squared() <= r2 {
-                        let p = &self.photons[e.index as usize];
+                for i in self.starts[h] as usize..self.starts[h + 1] as usize {
+                    if (Vec3A::from(self.positions[i]) - point).length_squared() <= r2 {
+                        let p = &self.photons[i];
                         if p.facing().dot(normal) > 0.0 {
-                            visit(e.index, p);
+                            visit(i as u32, p);
                         }
                     }
                 }
@@ -252,8 +310,8 @@ impl<P: Stored + Sync> PhotonMap<P> {
     pub fn prefetch_entries(&self, point: Vec3A) {
         if !self.photons.is_empty() {
             for h in self.rows(point) {
-                if let Some(e) = self.entries.get(self.starts[h] as usize) {
-                    prefetch(e);
+                if let Some(p) = self.positions.get(self.starts[h] as usize) {
+                    prefetch(p);
                 }
             }
         }
@@ -603,6 +661,22 @@ mod tests {
                 .count();
             assert_eq!(found, expected, "at {q:?}");
         }
+    }
+
+    #[test]
+    fn both_builds_keep_every_photon_once_in_the_same_order() {
+        let photons = cloud();
+        let in_place = PhotonMap::build(photons.clone(), 0.13);
+        let (a, b) = photons.split_at(photons.len() / 3);
+        let gathered = PhotonMap::from_parts(&[a, b], 0.13, |p: &Photon| *p);
+        let key = |p: &Photon| p.point.to_array().map(f32::to_bits);
+        let order: Vec<_> = in_place.items().iter().map(key).collect();
+        assert_eq!(order, gathered.items().iter().map(key).collect::<Vec<_>>());
+        let mut given: Vec<_> = photons.iter().map(key).collect();
+        let mut kept = order;
+        given.sort();
+        kept.sort();
+        assert_eq!(given, kept);
     }
 
     #[test]

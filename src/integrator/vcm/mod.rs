@@ -36,7 +36,7 @@ use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Sampler, SamplerKind};
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
-use glam::Vec3A;
+use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 use std::f32::consts::PI;
 use strategies::CameraVertex;
@@ -238,12 +238,54 @@ impl Stored for LightVertex {
     }
 }
 
+/// What a merge reads of a light vertex, in one cache line: the map holds
+/// these in cell order, so that a lookup's tens of merges (in a room lit by
+/// a million light paths) read a few runs of lines, not two misses each.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct MergeVertex {
+    point: Vec3,
+    segments: u32,
+    wo: Vec3,
+    d_vcm: f32,
+    facing: Vec3,
+    d_vm: f32,
+    beta: Vec3,
+}
+
+impl From<&LightVertex> for MergeVertex {
+    #[inline]
+    fn from(v: &LightVertex) -> MergeVertex {
+        MergeVertex {
+            point: v.point.into(),
+            segments: u32::from(v.segments),
+            wo: v.wo.into(),
+            d_vcm: v.d_vcm,
+            facing: v.facing().into(),
+            d_vm: v.d_vm,
+            beta: v.beta.into(),
+        }
+    }
+}
+
+impl Stored for MergeVertex {
+    #[inline]
+    fn position(&self) -> Vec3A {
+        self.point.into()
+    }
+    #[inline]
+    fn facing(&self) -> Vec3A {
+        self.facing.into()
+    }
+}
+
 /// One iteration: the light subpaths' vertices (those of subpath i are
 /// `vertices[starts[i]..starts[i + 1]]`), their grid, the splats of the
 /// light vertices the camera sees, and the iteration's MIS constants.
 pub struct Iteration {
     starts: Vec<u32>,
-    map: PhotonMap<LightVertex>,
+    vertices: Vec<LightVertex>,
+    map: PhotonMap<MergeVertex>,
     light_image: SplatBuffer,
     paths: u32,
     radius: f32,
@@ -294,7 +336,10 @@ impl Vcm {
     /// per light subpath (roulette ends most before the depth limit).
     pub fn memory_per_iteration(scene: &Scene) -> u64 {
         let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
-        let per_vertex = std::mem::size_of::<LightVertex>() as u64 + 2 * 4;
+        let per_vertex = (std::mem::size_of::<LightVertex>()
+            + std::mem::size_of::<MergeVertex>()
+            + std::mem::size_of::<Vec3>()
+            + 4) as u64;
         pixels * 24 + u64::from(Self::light_paths(scene)) * (4 * per_vertex + 4)
     }
 
@@ -506,6 +551,7 @@ impl MultiPassEstimator for Vcm {
         let eta = paths as f32 * PI * radius * radius;
         let mut iteration = Iteration {
             starts: Vec::new(),
+            vertices: Vec::new(),
             map: PhotonMap::build(Vec::new(), radius),
             light_image: SplatBuffer::with_filter(
                 scene.camera.width,
@@ -553,9 +599,10 @@ impl MultiPassEstimator for Vcm {
             counts.bounce += rays.bounce;
             counts.shadow += rays.shadow;
         }
-        let vertices = concat(&chunks.iter().map(|c| c.0.as_slice()).collect::<Vec<_>>());
+        let parts: Vec<&[LightVertex]> = chunks.iter().map(|c| c.0.as_slice()).collect();
         iteration.starts = starts;
-        iteration.map = PhotonMap::build(vertices, radius);
+        iteration.map = PhotonMap::from_parts(&parts, radius, |v| MergeVertex::from(v));
+        iteration.vertices = concat(&parts);
         iteration
     }
 
@@ -636,7 +683,7 @@ impl MultiPassEstimator for Vcm {
                 radiance +=
                     walk.beta * self.light_sample(scene, iteration, &at, &walk, sampler, counts);
                 iteration.map.prefetch_entries(at.point);
-                for light in &iteration.map.items()[light_path.clone()] {
+                for light in &iteration.vertices[light_path.clone()] {
                     if u32::from(light.segments) + segments <= self.max_depth {
                         radiance +=
                             walk.beta * self.connect(scene, iteration, &at, &walk, light, counts);

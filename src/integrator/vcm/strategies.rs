@@ -255,10 +255,10 @@ impl Vcm {
         };
         let mut sum = Rgb::ZERO;
         iteration.map.for_each_near(at.point, facing, |light| {
-            if u32::from(light.segments) + at.segments > self.max_depth + 1 {
+            if light.segments + at.segments > self.max_depth + 1 {
                 return;
             }
-            let wi = at.frame.to_local(light.wo);
+            let wi = at.frame.to_local(light.wo.into());
             let (f, pdf, pdf_reverse) = at.bsdf.eval_with_pdfs(at.wo, wi);
             // Flux per geometric area turned into the shading integral.
             let f = f * photon_shading_factor(wi, at.ng);
@@ -267,7 +267,7 @@ impl Vcm {
             }
             let w_light = light.d_vcm * iteration.vc_factor + light.d_vm * self.mis(pdf);
             let w_camera = walk.d_vcm * iteration.vc_factor + walk.d_vm * self.mis(pdf_reverse);
-            sum += f * light.beta / (1.0 + w_light + w_camera);
+            sum += f * Rgb::from(light.beta) / (1.0 + w_light + w_camera);
         });
         sum
     }
