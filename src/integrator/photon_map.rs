@@ -63,6 +63,9 @@ impl Stored for Photon {
     }
 }
 
+/// Photons found within a lookup's radius before they are visited.
+const NEAR_BATCH: usize = 32;
+
 /// The largest k of a k-nearest lookup.
 pub const MAX_K: usize = 256;
 
@@ -263,6 +266,11 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
         // The 2 x 2 x 2 cells nearest the point cover its sphere; a row's
         // second cell is the bucket after its first.
         let r2 = self.radius * self.radius;
+        // The photons within the radius are found first and asked of the
+        // cache, then visited: their misses overlap instead of each waiting
+        // behind the previous one's visit (a dense map finds tens).
+        let mut near = [0u32; NEAR_BATCH];
+        let mut found = 0;
         let mut seen = [usize::MAX; 8];
         for (row, first) in self.rows(point).into_iter().enumerate() {
             for (k, h) in [(2 * row, first), (2 * row + 1, (first + 1) & self.mask())] {
@@ -273,12 +281,28 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
                 seen[k] = h;
                 for i in self.starts[h] as usize..self.starts[h + 1] as usize {
                     if (Vec3A::from(self.positions[i]) - point).length_squared() <= r2 {
-                        let p = &self.photons[i];
-                        if p.facing().dot(normal) > 0.0 {
-                            visit(i as u32, p);
+                        prefetch(&self.photons[i]);
+                        near[found] = i as u32;
+                        found += 1;
+                        if found == NEAR_BATCH {
+                            self.visit_facing(&near, normal, &mut visit);
+                            found = 0;
                         }
                     }
                 }
+            }
+        }
+        self.visit_facing(&near[..found], normal, &mut visit);
+    }
+
+    /// Calls `visit` with each of the photons `near` on the side of the
+    /// surface that `normal` faces.
+    #[inline(always)]
+    fn visit_facing(&self, near: &[u32], normal: Vec3A, visit: &mut impl FnMut(u32, &P)) {
+        for &i in near {
+            let p = &self.photons[i as usize];
+            if p.facing().dot(normal) > 0.0 {
+                visit(i, p);
             }
         }
     }
