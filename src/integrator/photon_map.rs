@@ -120,7 +120,7 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
     /// A map of `photons` for lookups of radius at most `radius`, sorted
     /// in place (a copy would cost each pass new pages).
     pub fn build(mut photons: Vec<P>, radius: f32) -> PhotonMap<P> {
-        let (mut map, mut source) = Self::sorted_places(&[photons.as_slice()], radius);
+        let (map, mut source) = Self::sorted_places(&[photons.as_slice()], radius);
         // Each cycle of the permutation moved along, one photon in hand.
         for start in 0..source.len() {
             if source[start] as usize == start {
@@ -139,13 +139,7 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
                 place = from;
             }
         }
-        map.photons = photons;
-        map.positions = map
-            .photons
-            .par_iter()
-            .map(|p| p.position().into())
-            .collect();
-        map
+        map.holding(photons)
     }
 
     /// A map of what `convert` makes of the points of `parts` (one part
@@ -155,13 +149,13 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
         radius: f32,
         convert: impl Fn(&T) -> P + Sync,
     ) -> PhotonMap<P> {
-        let (mut map, source) = Self::sorted_places(parts, radius);
+        let (map, source) = Self::sorted_places(parts, radius);
         let mut offsets = Vec::with_capacity(parts.len() + 1);
         offsets.push(0);
         for part in parts {
             offsets.push(offsets.last().unwrap() + part.len());
         }
-        map.photons = source
+        let photons = source
             .par_iter()
             .map(|&i| {
                 let i = i as usize;
@@ -169,12 +163,14 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
                 convert(&parts[part][i - offsets[part]])
             })
             .collect();
-        map.positions = map
-            .photons
-            .par_iter()
-            .map(|p| p.position().into())
-            .collect();
-        map
+        map.holding(photons)
+    }
+
+    /// The map with its photons, already in place order, and their positions.
+    fn holding(mut self, photons: Vec<P>) -> PhotonMap<P> {
+        self.positions = photons.par_iter().map(|p| p.position().into()).collect();
+        self.photons = photons;
+        self
     }
 
     /// An empty map with its buckets' bounds, and the point (an index into
