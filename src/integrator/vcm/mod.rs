@@ -27,7 +27,7 @@
 //! the scene at the shutter's opening, as the photon mappers do.
 
 use super::light::{importance_weight, sample_particle};
-use super::photon_map::{self, PARTICLE_CHUNK, PhotonMap, Stored, concat};
+use super::photon_map::{self, PARTICLE_CHUNK, PhotonMap, concat};
 use super::{MisHeuristic, MultiPassEstimator, PathLength, RayCounts, Settings, Technique};
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::film::splats::{PendingSplats, SplatBuffer};
@@ -42,6 +42,9 @@ use std::f32::consts::PI;
 use strategies::CameraVertex;
 
 mod strategies;
+mod vertex;
+
+use vertex::{LightVertex, MergeVertex, pack_shading};
 
 /// Light subpaths per iteration at most: past it, pixels share them (a
 /// camera subpath connects to the light subpath of its pixel index modulo
@@ -158,124 +161,6 @@ impl Technique for Vcm {
             radius: photon_map::of_diagonal(scene, self.radius),
             ..self
         }
-    }
-}
-
-/// A light subpath's non-specular vertex, as merges and connections read
-/// it.
-#[derive(Clone, Copy, Debug)]
-pub struct LightVertex {
-    point: Vec3A,
-    error: Vec3A,
-    normal: Vec3A,
-    /// The shading normal, which frames the BSDF, packed in 32 bits
-    /// ([`LightVertex::shading`]), so that the vertex stays 112 bytes.
-    packed_shading: u32,
-    /// Unit direction towards the previous vertex (where the light came from).
-    wo: Vec3A,
-    /// The subpath's weight up to here (flux of one of N subpaths).
-    beta: Rgb,
-    material: u32,
-    /// Texture coordinates, to read the material's textures.
-    uv: glam::Vec2,
-    /// Segments from the light to here.
-    segments: u16,
-    /// The BSDF frame's turn about the shading normal
-    /// (`Scene::shading_turn`), in the 16 bits beside `segments`.
-    turn: u16,
-    /// Georgiev et al.'s recursive MIS quantities at this vertex.
-    d_vcm: f32,
-    d_vc: f32,
-    d_vm: f32,
-}
-
-impl LightVertex {
-    /// The shading normal (the geometric one where the mesh has no vertex
-    /// normals, exactly).
-    #[inline]
-    fn shading(&self) -> Vec3A {
-        match self.packed_shading {
-            SAME_AS_GEOMETRIC => self.normal,
-            p => crate::math::octahedral_decode(p),
-        }
-    }
-
-    /// The frame of its BSDF.
-    #[inline]
-    fn frame(&self) -> Frame {
-        Frame::from_normal(self.shading()).turned(self.turn)
-    }
-}
-
-/// A shading normal that is the geometric one.
-const SAME_AS_GEOMETRIC: u32 = u32::MAX;
-
-// Merges read light vertices from memory: the frame's turn fits beside
-// the segment count, not in a 128-byte vertex.
-const _: () = assert!(std::mem::size_of::<LightVertex>() == 112);
-
-#[inline]
-fn pack_shading(ns: Vec3A, ng: Vec3A) -> u32 {
-    if ns == ng {
-        SAME_AS_GEOMETRIC
-    } else {
-        crate::math::octahedral_encode(ns)
-    }
-}
-
-impl Stored for LightVertex {
-    #[inline]
-    fn position(&self) -> Vec3A {
-        self.point
-    }
-    #[inline]
-    fn facing(&self) -> Vec3A {
-        if self.normal.dot(self.wo) >= 0.0 {
-            self.normal
-        } else {
-            -self.normal
-        }
-    }
-}
-
-/// What a merge reads of a light vertex, in one cache line: the map holds
-/// these in cell order, so that a lookup's tens of merges (in a room lit by
-/// a million light paths) read a few runs of lines, not two misses each.
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(64))]
-pub struct MergeVertex {
-    point: Vec3,
-    segments: u32,
-    wo: Vec3,
-    d_vcm: f32,
-    facing: Vec3,
-    d_vm: f32,
-    beta: Vec3,
-}
-
-impl From<&LightVertex> for MergeVertex {
-    #[inline]
-    fn from(v: &LightVertex) -> MergeVertex {
-        MergeVertex {
-            point: v.point.into(),
-            segments: u32::from(v.segments),
-            wo: v.wo.into(),
-            d_vcm: v.d_vcm,
-            facing: v.facing().into(),
-            d_vm: v.d_vm,
-            beta: v.beta.into(),
-        }
-    }
-}
-
-impl Stored for MergeVertex {
-    #[inline]
-    fn position(&self) -> Vec3A {
-        self.point.into()
-    }
-    #[inline]
-    fn facing(&self) -> Vec3A {
-        self.facing.into()
     }
 }
 

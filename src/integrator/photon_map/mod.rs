@@ -1,0 +1,349 @@
+//! Photons and the map that finds them (`grid.rs`), shared by the photon
+//! mappers (`photon.rs`, Jensen's two-pass method; `sppm.rs`, progressive)
+//! and by vertex connection and merging (`vcm/`, for its light vertices).
+
+mod grid;
+
+pub use grid::{MAX_K, PhotonMap, Stored};
+
+use super::RayCounts;
+use super::light::importance_weight;
+use crate::accel::{NO_LIGHT, SurfaceHit};
+use crate::math::{Frame, Ray, Rgb, ray_between};
+use crate::sampling::hash::hash_combine;
+use crate::sampling::{Domain, Sampler, SamplerKind};
+use crate::scene::Scene;
+use crate::scene::material::Bsdf;
+use glam::{Vec2, Vec3A};
+use rayon::prelude::*;
+
+/// A photon: where it landed, where it came from, and what it carries.
+#[derive(Clone, Copy, Debug)]
+pub struct Photon {
+    pub point: Vec3A,
+    /// Unit direction back towards where the photon came from.
+    pub wi: Vec3A,
+    /// The surface's normal on the side the photon arrived, so that photons
+    /// on the far side of a thin wall do not count.
+    pub normal: Vec3A,
+    /// Its weight (flux) after N photons were shot: divide by N.
+    pub power: Rgb,
+}
+
+/// How a photon got where it is: bounces since the light, and whether
+/// every one of them was specular (a caustic photon, L S+ D).
+#[derive(Clone, Copy, Debug)]
+pub struct PhotonPath {
+    pub bounces: u32,
+    pub specular_only: bool,
+}
+
+impl Stored for Photon {
+    #[inline]
+    fn position(&self) -> Vec3A {
+        self.point
+    }
+    #[inline]
+    fn facing(&self) -> Vec3A {
+        self.normal
+    }
+}
+
+/// `fraction` of the scene's bounding-box diagonal, in scene units (the
+/// fraction itself where the scene has no finite size), so that radii do
+/// not depend on the scene's units.
+pub fn of_diagonal(scene: &Scene, fraction: f32) -> f32 {
+    let bounds = scene.geometry.bounds();
+    let diagonal = (bounds.max - bounds.min).length();
+    if diagonal.is_finite() && diagonal > 0.0 {
+        fraction * diagonal
+    } else {
+        fraction
+    }
+}
+
+/// The photons to shoot per iteration: `photons`, or one per pixel for 0.
+pub fn photons_per_iteration(scene: &Scene, photons: u32) -> u32 {
+    if photons == 0 {
+        scene.camera.width * scene.camera.height
+    } else {
+        photons
+    }
+}
+
+/// Says how many photons an iteration shoots, for summaries.
+pub fn describe_photons(photons: u32) -> String {
+    if photons == 0 {
+        "one per pixel".to_string()
+    } else {
+        photons.to_string()
+    }
+}
+
+/// Shoots `count` photons (randomness from `key` and each photon's index,
+/// so the maps do not depend on the schedule), following each for up to
+/// `max_bounces` bounces, and sorts the photons that land on non-specular
+/// surfaces into two lists by `keep`: (first list, second list).
+pub fn shoot(
+    scene: &Scene,
+    count: u32,
+    key: u64,
+    max_bounces: u32,
+    keep: impl Fn(PhotonPath) -> (bool, bool) + Sync,
+    counts: &mut RayCounts,
+) -> (Vec<Photon>, Vec<Photon>) {
+    let chunks = count.div_ceil(PARTICLE_CHUNK);
+    let key = hash_combine(key, 0x5048_4f54_4f4e);
+    let results: Vec<(Vec<Photon>, Vec<Photon>, u64)> = (0..chunks)
+        .into_par_iter()
+        .map(|chunk| {
+            let mut sampler = Sampler::new(SamplerKind::Independent, key, 0);
+            let (mut first, mut second) = (Vec::new(), Vec::new());
+            let mut rays = RayCounts::default();
+            let end = ((chunk + 1) * PARTICLE_CHUNK).min(count);
+            for index in chunk * PARTICLE_CHUNK..end {
+                sampler.start(index, 0);
+                trace_photon(
+                    scene,
+                    &mut sampler,
+                    max_bounces,
+                    &mut rays,
+                    |photon, path| {
+                        let (a, b) = keep(path);
+                        if a {
+                            first.push(photon);
+                        }
+                        if b {
+                            second.push(photon);
+                        }
+                    },
+                );
+            }
+            (first, second, rays.bounce)
+        })
+        .collect();
+    counts.bounce += results.iter().map(|r| r.2).sum::<u64>();
+    let first = concat(&results.iter().map(|r| r.0.as_slice()).collect::<Vec<_>>());
+    let second = concat(&results.iter().map(|r| r.1.as_slice()).collect::<Vec<_>>());
+    (first, second)
+}
+
+/// Particles (photons, VCM's light paths) traced per parallel task: small
+/// enough that the last tasks of a pass leave few of 16 threads idle, large
+/// enough that a task's set-up is nothing beside its paths.
+pub(crate) const PARTICLE_CHUNK: u32 = 1024;
+
+/// The parts one after another, copied in parallel: at 16 threads a serial
+/// copy of a pass's photons or light vertices would be a large share of the
+/// pass.
+pub(crate) fn concat<T: Copy + Send + Sync>(parts: &[&[T]]) -> Vec<T> {
+    let total = parts.iter().map(|p| p.len()).sum();
+    let mut out = Vec::with_capacity(total);
+    let mut rest = &mut out.spare_capacity_mut()[..total];
+    let mut places = Vec::with_capacity(parts.len());
+    for part in parts {
+        let (place, tail) = rest.split_at_mut(part.len());
+        places.push(place);
+        rest = tail;
+    }
+    places.into_par_iter().zip(parts).for_each(|(place, part)| {
+        for (slot, &item) in place.iter_mut().zip(part.iter()) {
+            slot.write(item);
+        }
+    });
+    // SAFETY: the places cover the first `total` slots, each written above.
+    unsafe { out.set_len(total) };
+    out
+}
+
+/// Traces one photon from the lights and hands every landing on a
+/// non-specular surface to `store`, with how it got there.
+fn trace_photon(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    max_bounces: u32,
+    counts: &mut RayCounts,
+    mut store: impl FnMut(Photon, PhotonPath),
+) {
+    let Some(emission) = super::light::sample_particle(scene, sampler) else {
+        return;
+    };
+    let roulette_scale = 1.0 / emission.throughput.max_element();
+    let mut beta = emission.throughput;
+    let mut ray = emission.ray().at_time(scene.camera.shutter_open);
+    counts.bounce += 1;
+    let mut specular_only = true;
+    for bounces in 0..=max_bounces {
+        let Some(hit) = scene.geometry.intersect(&ray) else {
+            break;
+        };
+        let bsdf = scene.bsdf_at(&hit);
+        if bsdf.is_black() {
+            break;
+        }
+        let frame = scene.shading_frame(&hit);
+        let ng = frame.to_local(hit.normal);
+        let wo = frame.to_local(-ray.direction);
+        let u_lobe = sampler.next_1d_for(Domain::Bsdf);
+        let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
+        let u_roulette = sampler.next_1d();
+        if !bsdf.is_specular() {
+            let facing = if hit.normal.dot(ray.direction) < 0.0 {
+                hit.normal
+            } else {
+                -hit.normal
+            };
+            store(
+                Photon {
+                    point: hit.point,
+                    wi: -ray.direction,
+                    normal: facing,
+                    power: beta,
+                },
+                PhotonPath {
+                    bounces,
+                    specular_only,
+                },
+            );
+            specular_only = false;
+        }
+        if bounces == max_bounces {
+            break;
+        }
+        let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
+            break;
+        };
+        beta *= importance_weight(bsdf, wo, sample.wi, ng, sample.weight);
+        // Roulette from the first bounce: a photon is cheap and the map
+        // only needs its density right.
+        if !super::survives_roulette(&mut beta, roulette_scale, u_roulette) {
+            break;
+        }
+        ray = hit.spawn_ray(frame.to_world(sample.wi));
+        counts.bounce += 1;
+    }
+}
+
+/// Where a camera ray of a photon mapper is estimated: its first diffuse
+/// or glossy hit, reached through mirrors and glass.
+pub struct DiffuseHit {
+    pub hit: SurfaceHit,
+    /// The weight of the chain of mirrors and glass before it.
+    pub beta: Rgb,
+    pub bsdf: Bsdf,
+    pub frame: Frame,
+    /// Direction to the camera side, local.
+    pub wo: Vec3A,
+    /// The normal on the side the ray arrived from.
+    pub facing: Vec3A,
+    /// Random numbers for a BSDF sample at the hit.
+    pub u_lobe: f32,
+    pub u_bsdf: Vec2,
+}
+
+/// Follows a camera ray through mirrors and glass (a chain of at most
+/// `max_depth` bounces) to its first diffuse or glossy hit; returns the
+/// emission seen on the way and the hit, if the ray got there.
+pub fn camera_to_diffuse(
+    scene: &Scene,
+    mut ray: Ray,
+    max_depth: u32,
+    sampler: &mut Sampler,
+    counts: &mut RayCounts,
+) -> (Rgb, Option<DiffuseHit>) {
+    let mut beta = Rgb::ONE;
+    let mut emitted = Rgb::ZERO;
+    for _ in 0..=max_depth {
+        let Some(hit) = scene.geometry.intersect(&ray) else {
+            // Seen directly or through Dirac surfaces only: no photon
+            // stands for it.
+            if let Some(env) = scene.lights.environment() {
+                emitted += beta * env.le(ray.direction);
+            }
+            break;
+        };
+        let material = &scene.materials[hit.material as usize];
+        let wo_world = -ray.direction;
+        if hit.light != NO_LIGHT {
+            emitted += beta * material.emitted(hit.normal, wo_world);
+        }
+        let bsdf = scene.bsdf_at(&hit);
+        if bsdf.is_black() {
+            break;
+        }
+        let frame = scene.shading_frame(&hit);
+        let wo = frame.to_local(wo_world);
+        let u_lobe = sampler.next_1d_for(Domain::Bsdf);
+        let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
+        if !bsdf.is_specular() {
+            let facing = if hit.normal.dot(wo_world) > 0.0 {
+                hit.normal
+            } else {
+                -hit.normal
+            };
+            let diffuse = DiffuseHit {
+                hit,
+                beta,
+                bsdf,
+                frame,
+                wo,
+                facing,
+                u_lobe,
+                u_bsdf,
+            };
+            return (emitted, Some(diffuse));
+        }
+        let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
+            break;
+        };
+        beta *= sample.weight;
+        ray = hit.spawn_ray(frame.to_world(sample.wi));
+        counts.bounce += 1;
+    }
+    (emitted, None)
+}
+
+impl DiffuseHit {
+    /// Direct light at the hit by one light sample (next-event
+    /// estimation), times the chain's weight.
+    pub fn direct_light(
+        &self,
+        scene: &Scene,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+    ) -> Rgb {
+        let u_select = sampler.next_1d_for(Domain::Light);
+        let u_light = sampler.next_2d_for(Domain::Light);
+        let hit = &self.hit;
+        let Some(ls) = scene.lights.sample(hit.point, u_select, u_light) else {
+            return Rgb::ZERO;
+        };
+        let wi = self.frame.to_local(ls.wi);
+        let f = self.bsdf.eval(self.wo, wi);
+        if !(f.max_element() > 0.0) {
+            return Rgb::ZERO;
+        }
+        counts.shadow += 1;
+        let shadow = ray_between(
+            hit.point, hit.error, hit.normal, ls.point, ls.error, ls.normal,
+        )
+        .at_time(hit.time);
+        if scene.geometry.occluded(&shadow) {
+            return Rgb::ZERO;
+        }
+        self.beta * f * ls.radiance * (wi.z.abs() / ls.pdf)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn concat_keeps_every_part_in_order() {
+        let parts: Vec<Vec<u32>> = vec![vec![], vec![1, 2, 3], vec![], vec![4], vec![5, 6]];
+        let slices: Vec<&[u32]> = parts.iter().map(Vec::as_slice).collect();
+        assert_eq!(concat(&slices), vec![1, 2, 3, 4, 5, 6]);
+        assert!(concat::<u32>(&[]).is_empty());
+    }
+}
