@@ -15,7 +15,7 @@
 //! Caustics (light through glass onto a diffuse floor) are in that sum, and
 //! the density estimate finds them where path tracing rarely does.
 //!
-//! Photons are found through the hash grid of `photon_map.rs`, built per
+//! Photons are found through the hash grid of `photon_map/grid.rs`, built per
 //! iteration for that iteration's radius.
 
 use super::light::photon_shading_factor;
