@@ -46,7 +46,7 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
     /// A map of `photons` for lookups of radius at most `radius`, sorted
     /// in place (a copy would cost each pass new pages).
     pub fn build(mut photons: Vec<P>, radius: f32) -> PhotonMap<P> {
-        let (map, mut source) = Self::sorted_places(&[photons.as_slice()], radius);
+        let (map, mut source) = Self::sorted_places(&photons, radius);
         // Each cycle of the permutation moved along, one photon in hand.
         for start in 0..source.len() {
             if source[start] as usize == start {
@@ -68,26 +68,17 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
         map.holding(photons)
     }
 
-    /// A map of what `convert` makes of the points of `parts` (one part
-    /// after another), without first copying them into one list.
-    pub fn from_parts<T: Stored + Sync>(
-        parts: &[&[T]],
+    /// A map of what `convert` makes of each of `points`, which stay as
+    /// they are (VCM's connections read its light vertices in path order).
+    pub fn converted<T: Stored + Sync>(
+        points: &[T],
         radius: f32,
         convert: impl Fn(&T) -> P + Sync,
     ) -> PhotonMap<P> {
-        let (map, source) = Self::sorted_places(parts, radius);
-        let mut offsets = Vec::with_capacity(parts.len() + 1);
-        offsets.push(0);
-        for part in parts {
-            offsets.push(offsets.last().unwrap() + part.len());
-        }
+        let (map, source) = Self::sorted_places(points, radius);
         let photons = source
             .par_iter()
-            .map(|&i| {
-                let i = i as usize;
-                let part = offsets.partition_point(|&o| o <= i) - 1;
-                convert(&parts[part][i - offsets[part]])
-            })
+            .map(|&i| convert(&points[i as usize]))
             .collect();
         map.holding(photons)
     }
@@ -99,11 +90,10 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
         self
     }
 
-    /// An empty map with its buckets' bounds, and the point (an index into
-    /// `parts` one after another) that goes to each place: a counting sort
-    /// by cell hash.
-    fn sorted_places<T: Stored + Sync>(parts: &[&[T]], radius: f32) -> (PhotonMap<P>, Vec<u32>) {
-        let count: usize = parts.iter().map(|p| p.len()).sum();
+    /// An empty map with its buckets' bounds, and the index in `points` of
+    /// the point that goes to each place: a counting sort by cell hash.
+    fn sorted_places<T: Stored + Sync>(points: &[T], radius: f32) -> (PhotonMap<P>, Vec<u32>) {
+        let count = points.len();
         let buckets = count.next_power_of_two().max(1);
         let mut map = PhotonMap {
             photons: Vec::new(),
@@ -112,13 +102,10 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
             cell: 2.0 * radius,
             radius,
         };
-        let mut hashes: Vec<u32> = Vec::with_capacity(count);
-        for part in parts {
-            hashes.par_extend(
-                part.par_iter()
-                    .map(|p| map.hash(map.cell_of(p.position())) as u32),
-            );
-        }
+        let hashes: Vec<u32> = points
+            .par_iter()
+            .map(|p| map.hash(map.cell_of(p.position())) as u32)
+            .collect();
         for &h in &hashes {
             map.starts[h as usize + 1] += 1;
         }
@@ -351,8 +338,7 @@ mod tests {
     fn both_builds_keep_every_photon_once_in_the_same_order() {
         let photons = cloud();
         let in_place = PhotonMap::build(photons.clone(), 0.13);
-        let (a, b) = photons.split_at(photons.len() / 3);
-        let gathered = PhotonMap::from_parts(&[a, b], 0.13, |p: &Photon| *p);
+        let gathered = PhotonMap::converted(&photons, 0.13, |p: &Photon| *p);
         let key = |p: &Photon| p.point.to_array().map(f32::to_bits);
         let order: Vec<_> = in_place.items().iter().map(key).collect();
         assert_eq!(order, gathered.items().iter().map(key).collect::<Vec<_>>());

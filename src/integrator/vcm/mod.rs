@@ -484,10 +484,13 @@ impl MultiPassEstimator for Vcm {
             counts.bounce += rays.bounce;
             counts.shadow += rays.shadow;
         }
-        let parts: Vec<&[LightVertex]> = chunks.iter().map(|c| c.0.as_slice()).collect();
+        let vertices = concat(&chunks.iter().map(|c| c.0.as_slice()).collect::<Vec<_>>());
+        // Freed before the map is built: two copies of the light vertices at
+        // most, not three.
+        drop(chunks);
         iteration.starts = starts;
-        iteration.map = PhotonMap::from_parts(&parts, radius, |v| MergeVertex::from(v));
-        iteration.vertices = concat(&parts);
+        iteration.map = PhotonMap::converted(&vertices, radius, |v| MergeVertex::from(v));
+        iteration.vertices = vertices;
         iteration
     }
 
