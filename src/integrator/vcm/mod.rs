@@ -48,7 +48,8 @@ use vertex::{LightVertex, MergeVertex, pack_shading};
 
 /// Light subpaths per iteration at most: past it, pixels share them (a
 /// camera subpath connects to the light subpath of its pixel index modulo
-/// this), which bounds the vertices kept per iteration (~110 bytes each).
+/// this), which bounds the vertices kept per iteration (about 190 bytes
+/// each, with their merge copy and grid).
 pub const MAX_LIGHT_PATHS: u32 = 1 << 20;
 
 /// Settings of vertex connection and merging.
