@@ -414,12 +414,15 @@ fn print_flagged(flagged: &[FlaggedPixel], non_finite: u64, width: u32, seed: &s
 }
 
 /// What the scene holds, by part: "scene memory: 240 MiB (vertices 48, ...)",
-/// parts under 0.5 MiB left out.
+/// parts under 0.5 MiB left out; a scene under 1 MiB in KiB, without parts.
 fn memory_line(scene: &Scene) -> String {
     let mb = |bytes: usize| bytes as f64 / (1024.0 * 1024.0);
     let mut parts: Vec<(&str, usize)> = scene.geometry.memory_parts().to_vec();
     parts.push(("textures", scene.texture_bytes()));
     let total: usize = parts.iter().map(|(_, bytes)| bytes).sum();
+    if total < 1024 * 1024 {
+        return format!("scene memory: {} KiB", total.div_ceil(1024));
+    }
     let shown: Vec<String> = parts
         .iter()
         .filter(|(_, bytes)| mb(*bytes) >= 0.5)
