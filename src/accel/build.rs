@@ -104,6 +104,7 @@ impl Geometry {
             keep_normals: triangles.par_iter().any(|t| t.normals.is_some()),
             ..Geometry::default()
         };
+        geometry.update_plain();
         let use_soup = match choice {
             AccelChoice::Auto => triangles.len() <= SOUP_MAX_TRIANGLES,
             AccelChoice::Bvh => false,
@@ -220,6 +221,7 @@ impl Geometry {
             instances: self.instances.clone(),
             ..Geometry::default()
         };
+        geometry.update_plain();
         let use_soup = inputs.len() <= SOUP_MAX_TRIANGLES;
         let order = geometry.store_triangles(inputs, use_soup);
         let from: Vec<u32> = order.iter().map(|&k| origin[k]).collect();
@@ -249,6 +251,7 @@ impl Geometry {
         self.bvh_too_deep |= prototypes.iter().any(|p| p.bvh_too_deep);
         self.instances =
             instance::Instances::new(prototypes.into_iter().map(Arc::new).collect(), placements);
+        self.update_plain();
     }
 
     /// Surface area of the triangles drawn, instances' included.
@@ -300,6 +303,7 @@ impl Geometry {
             masks: self.masks.clone(),
             ..Geometry::default()
         };
+        geometry.update_plain();
         let use_soup = inputs.len() <= SOUP_MAX_TRIANGLES;
         let order = geometry.store_triangles(inputs, use_soup);
         geometry.bvh_too_deep |= self.bvh_too_deep;

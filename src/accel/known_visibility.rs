@@ -60,16 +60,16 @@ impl Geometry {
     }
 
     /// [`Geometry::intersect_among`] where the ray's possible hits are known
-    /// (a camera ray's candidates), else [`Geometry::intersect`].
+    /// (a camera ray's candidates), else [`Geometry::intersect_as`].
     #[inline(always)]
-    pub fn intersect_maybe_among(
+    pub fn intersect_maybe_among<const PLAIN: bool>(
         &self,
         ray: &Ray,
         candidates: Option<&[u32]>,
     ) -> Option<SurfaceHit> {
         match candidates {
             Some(among) => self.intersect_among(ray, among),
-            None => self.intersect(ray),
+            None => self.intersect_as::<PLAIN>(ray),
         }
     }
 

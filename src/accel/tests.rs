@@ -120,6 +120,34 @@ fn moving_sphere_is_where_the_ray_time_puts_it() {
 }
 
 #[test]
+fn queries_take_the_inlined_path_only_where_nothing_else_takes_part() {
+    let mut g = Geometry::build(&quad_mesh(), vec![]);
+    assert!(g.is_plain());
+    assert!(g.flattened().is_plain());
+    g.set_offset(OffsetMode::Fixed(1e-3));
+    assert!(!g.is_plain(), "a fixed offset widens every hit's error");
+    g.set_offset(OffsetMode::Robust);
+    assert!(g.is_plain());
+    let ball = Sphere {
+        center: Vec3A::new(-3.0, 0.5, 0.5),
+        radius: 0.25,
+        material: 9,
+        light: NO_LIGHT,
+    };
+    let mut moving = g.clone();
+    moving.add_moving(Geometry::build(&[], vec![ball]), Vec3A::X);
+    assert!(!moving.is_plain() && !moving.flattened().is_plain());
+    let mut placed = g.clone();
+    placed.add_instances(
+        vec![Geometry::build(&quad_mesh(), vec![])],
+        &[(0, Affine3A::from_translation(glam::Vec3::Z))],
+    );
+    assert!(!placed.is_plain());
+    // A geometry nobody settled takes the general path, which is always right.
+    assert!(!Geometry::default().is_plain());
+}
+
+#[test]
 fn pathologically_deep_bvh_falls_back_to_testing_every_triangle() {
     // Hundreds of copies of one quad (the shape of a fuzzer's find).
     let mut triangles = Vec::new();

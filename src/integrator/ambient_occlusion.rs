@@ -122,7 +122,10 @@ impl CameraEstimator for AmbientOcclusion {
         counts: &mut RayCounts,
     ) -> Rgb {
         let u = sampler.next_2d_for(Domain::Bsdf);
-        let Some(hit) = scene.geometry.intersect_maybe_among(&ray, pixel.candidates) else {
+        let Some(hit) = scene
+            .geometry
+            .intersect_maybe_among::<false>(&ray, pixel.candidates)
+        else {
             return Rgb::ZERO;
         };
         // The hemisphere on the side the camera sees.

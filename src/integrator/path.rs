@@ -77,20 +77,25 @@ impl PendingShadow {
     /// knows which triangles can block rays from the origin's voxel to the
     /// light ([`crate::shortcuts::ShadowVoxels`]) only those are tested, and none
     /// where the light is seen whole; the ray counts either way.
+    /// `PLAIN` as for [`crate::accel::Geometry::occluded_as`].
     #[inline(always)]
-    fn visible(&self, scene: &Scene, counts: &mut RayCounts) -> bool {
+    fn visible<const PLAIN: bool>(&self, scene: &Scene, counts: &mut RayCounts) -> bool {
         counts.shadow += 1;
         match scene.shortcuts.shadow_voxels(self.light) {
-            Some(voxels) => !voxels.occluded(&scene.geometry, &self.ray),
-            None => !scene.geometry.occluded(&self.ray),
+            Some(voxels) => !voxels.occluded::<PLAIN>(&scene.geometry, &self.ray),
+            None => !scene.geometry.occluded_as::<PLAIN>(&self.ray),
         }
     }
 
     /// What a deferred light sample adds, if there is one.
     #[inline(always)]
-    fn trace(pending: Option<Self>, scene: &Scene, counts: &mut RayCounts) -> Rgb {
+    fn trace<const PLAIN: bool>(
+        pending: Option<Self>,
+        scene: &Scene,
+        counts: &mut RayCounts,
+    ) -> Rgb {
         match pending {
-            Some(shadow) if shadow.visible(scene, counts) => shadow.added,
+            Some(shadow) if shadow.visible::<PLAIN>(scene, counts) => shadow.added,
             _ => Rgb::ZERO,
         }
     }
@@ -266,14 +271,19 @@ impl PathTracer {
             candidates: pixel.candidates.filter(|_| !self.general),
             seen_emission: pixel.seen_emission.filter(|_| self.exact_seen_emitters),
         };
-        // Only the Lambertian-only loop is specialised: it measured 3.3-3.9%
-        // faster on the Cornell box; a loop without specular branches for
-        // glossy scenes measured -2.3 to +0.9% and was dropped
-        // (docs/performance.md).
-        let traced = if !self.general && f.diffuse_only() {
-            self.trace::<true, O>(scene, ray, p, sampler, counts, observer)
-        } else {
-            self.trace::<false, O>(scene, ray, p, sampler, counts, observer)
+        // The Lambertian-only loop measured 3.3-3.9% faster on the Cornell
+        // box; a loop without specular branches for glossy scenes -2.3 to
+        // +0.9%, dropped. Geometry without masks, instances or moving
+        // objects: the glossy room 7.6% -> 1.1% more instructions than
+        // before those features (docs/performance.md).
+        let (lambert, plain) = (!self.general && f.diffuse_only(), scene.geometry.is_plain());
+        let traced = match (lambert, plain) {
+            (true, true) => self.trace::<true, true, O>(scene, ray, p, sampler, counts, observer),
+            (true, false) => self.trace::<true, false, O>(scene, ray, p, sampler, counts, observer),
+            (false, true) => self.trace::<false, true, O>(scene, ray, p, sampler, counts, observer),
+            (false, false) => {
+                self.trace::<false, false, O>(scene, ray, p, sampler, counts, observer)
+            }
         };
         match p.seen_emission {
             Some(emission) => emission + traced,
@@ -282,10 +292,11 @@ impl PathTracer {
     }
 
     /// The path loop. `DIFFUSE_ONLY`: every BSDF is Lambertian, so the
-    /// Lambertian code is inline and no branch is specular. `pixel`: the
+    /// Lambertian code is inline and no branch is specular. `PLAIN`: the
+    /// geometry is [`crate::accel::Geometry::is_plain`]. `pixel`: the
     /// camera ray's candidates, and whether its emission is accounted for
     /// outside the loop.
-    fn trace<const DIFFUSE_ONLY: bool, O: PathObserver>(
+    fn trace<const DIFFUSE_ONLY: bool, const PLAIN: bool, O: PathObserver>(
         &self,
         scene: &Scene,
         mut ray: Ray,
@@ -331,7 +342,7 @@ impl PathTracer {
             // The camera ray tests only its pixel's candidates, if known.
             let hit = scene
                 .geometry
-                .intersect_maybe_among(&ray, candidates.take());
+                .intersect_maybe_among::<PLAIN>(&ray, candidates.take());
             let Some(hit) = hit else {
                 observer.escaped();
                 // Light from infinity, weighed against its light samples.
@@ -407,7 +418,7 @@ impl PathTracer {
                         // An observer hears of the light sample before the
                         // bounce; the image is the same either way.
                         if O::IN_ORDER {
-                            let visible = shadow.visible(scene, counts);
+                            let visible = shadow.visible::<PLAIN>(scene, counts);
                             let added = if visible { shadow.added } else { Rgb::ZERO };
                             observer.light_sample(&ls, f, weight, visible, added);
                             radiance += added;
@@ -450,7 +461,7 @@ impl PathTracer {
                 Some(hit.spawn_ray(frame.to_world(sample.wi)))
             };
             // Whether or not the path goes on, its light sample counts.
-            radiance += PendingShadow::trace(pending, scene, counts);
+            radiance += PendingShadow::trace::<PLAIN>(pending, scene, counts);
             let Some(next) = next else {
                 break;
             };

@@ -75,14 +75,15 @@ impl ShadowVoxels {
     /// it), only the origin voxel's occluders are tested, by the same
     /// watertight test, so the answer is the whole test's. Rays that leave
     /// the box, or whose voxel lists too many, take the whole test.
+    /// `PLAIN` as for [`Geometry::occluded_as`].
     #[inline(always)]
-    pub fn occluded(&self, geometry: &Geometry, ray: &Ray) -> bool {
+    pub fn occluded<const PLAIN: bool>(&self, geometry: &Geometry, ray: &Ray) -> bool {
         if let Some(occluders) = self.occluders_from(ray.origin)
             && geometry.segment_inside_soup(ray)
         {
             return geometry.occluded_among(ray, occluders);
         }
-        geometry.occluded(ray)
+        geometry.occluded_as::<PLAIN>(ray)
     }
 
     /// Voxels of the box [lo, hi] and, for each, which of `occluders`
