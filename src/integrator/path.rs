@@ -14,7 +14,7 @@ use super::{
 };
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::bsdf::lambert;
-use crate::math::{Ray, Rgb};
+use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::warp::square_to_cosine_hemisphere;
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
@@ -274,7 +274,7 @@ impl PathTracer {
         // The Lambertian-only loop measured 3.3-3.9% faster on the Cornell
         // box; a loop without specular branches for glossy scenes -2.3 to
         // +0.9%, dropped. Geometry without masks, instances or moving
-        // objects: the glossy room 7.6% -> 1.1% more instructions than
+        // objects: the glossy room 7.6% -> 0.5% more instructions than
         // before those features (docs/performance.md).
         let (lambert, plain) = (!self.general && f.diffuse_only(), scene.geometry.is_plain());
         let traced = match (lambert, plain) {
@@ -305,39 +305,21 @@ impl PathTracer {
         counts: &mut RayCounts,
         observer: &mut O,
     ) -> Rgb {
-        let mut radiance = Rgb::ZERO;
-        let mut beta = Rgb::ONE;
+        let (mut radiance, mut beta) = (Rgb::ZERO, Rgb::ONE);
         // 1 / the (eta_i / eta_t)^2 factors in beta: roulette reads beta
         // without them, as if the path were outside the glass.
         let mut eta_scale = 1.0f32;
         // The camera ray behaves like a specular bounce: emission it finds is
         // counted in full because no light sample could have found it.
         let mut specular_bounce = true;
-        let mut prev_bsdf_pdf = 0.0;
-        let mut prev_point = ray.origin;
+        let (mut prev_bsdf_pdf, mut prev_point) = (0.0, ray.origin);
         let mut bounces = 0;
         let mut candidates = pixel.candidates;
         let seen_known = pixel.seen_emission.is_some();
         loop {
-            // Every vertex consumes the same five dimensions (light choice,
-            // light point, lobe, BSDF direction, roulette), so stratified
-            // samplers keep dimensions aligned across samples. The numbers
-            // that do not depend on the hit are drawn before the ray is
-            // traced: their hash chains then overlap with the traversal
-            // instead of stalling the light sample after it.
-            sampler.enter_path_vertex(bounces);
-            let vertex_dim = sampler.reserve(5);
-            // One light needs no choice (the Cornell box): skipping that
-            // number leaves the image bit-identical.
-            let u_light_select = if scene.lights.has_choice() {
-                sampler.get_1d_for(vertex_dim, Domain::Light)
-            } else {
-                0.0
-            };
-            let u_light = sampler.get_2d_for(vertex_dim + 1, Domain::Light);
-            let u_bsdf = sampler.get_2d_for(vertex_dim + 3, Domain::Bsdf);
+            let u = VertexNumbers::draw(sampler, bounces, scene.lights.has_choice());
             if !DIFFUSE_ONLY && self.nee {
-                scene.lights.prefetch_sample(u_light_select, u_light);
+                scene.lights.prefetch_sample(u.light_select, u.light);
             }
             // The camera ray tests only its pixel's candidates, if known.
             let hit = scene
@@ -347,36 +329,24 @@ impl PathTracer {
                 observer.escaped();
                 // Light from infinity, weighed against its light samples.
                 if let Some(env) = scene.lights.environment() {
-                    let weight = if specular_bounce || !self.nee {
-                        1.0
-                    } else if self.mis == MisHeuristic::None {
-                        0.0
-                    } else {
-                        let light_pdf = scene.lights.environment_pdf(ray.direction);
-                        self.mis.weight(prev_bsdf_pdf, light_pdf)
-                    };
+                    let weight = self.found_light_weight(specular_bounce, prev_bsdf_pdf, || {
+                        scene.lights.environment_pdf(ray.direction)
+                    });
                     radiance += beta * env.le(ray.direction) * weight;
                 }
                 break;
             };
             observer.vertex(bounces, &hit, beta);
             let wo_world = -ray.direction;
-            let material = &scene.materials[hit.material as usize];
-
             if hit.light != NO_LIGHT && !(seen_known && bounces == 0) {
+                let material = &scene.materials[hit.material as usize];
                 let emitted = material.emitted(hit.normal, wo_world);
                 if emitted.max_element() > 0.0 {
-                    let weight = if specular_bounce || !self.nee {
-                        1.0
-                    } else if self.mis == MisHeuristic::None {
-                        // Light sampling alone accounts for this path.
-                        0.0
-                    } else {
-                        let light_pdf = scene
+                    let weight = self.found_light_weight(specular_bounce, prev_bsdf_pdf, || {
+                        scene
                             .lights
-                            .pdf(hit.light, prev_point, hit.point, hit.normal);
-                        self.mis.weight(prev_bsdf_pdf, light_pdf)
-                    };
+                            .pdf(hit.light, prev_point, hit.point, hit.normal)
+                    });
                     radiance += beta * emitted * weight;
                     observer.emission(emitted, weight, beta * emitted * weight);
                 }
@@ -385,53 +355,34 @@ impl PathTracer {
             if bounces >= self.max_depth || bsdf.is_black() {
                 break;
             }
-
             let frame = scene.shading_frame(&hit);
             let wo = frame.to_local(wo_world);
-            // The lobe and roulette numbers are computed only when used.
-            let u_lobe = if matches!(bsdf, Bsdf::Diffuse { .. }) {
-                0.0
-            } else {
-                sampler.get_1d_for(vertex_dim + 2, Domain::Bsdf)
-            };
+            let u_lobe = u.lobe(sampler, &bsdf);
 
-            // The shadow ray is traced once the next ray is known, next to
-            // that ray's traversal: the two are independent, and with no
-            // shading between them the core overlaps them (Cornell box,
-            // 2 threads: Sobol 3.46 -> 3.61 M paths/s, independent 3.81 -> 4.10).
+            // Next-event estimation. The shadow ray is traced once the next
+            // ray is known, beside its traversal: the two are independent,
+            // and the core overlaps them (Cornell box, 2 threads: Sobol 3.46
+            // -> 3.61 M paths/s, independent 3.81 -> 4.10). An observer
+            // hears of it in path order; the image is the same either way.
             let mut pending = None;
             if self.nee && !(!DIFFUSE_ONLY && bsdf.is_specular()) {
-                if let Some(ls) = scene.lights.sample(hit.point, u_light_select, u_light) {
-                    let wi = frame.to_local(ls.wi);
-                    let f = eval::<DIFFUSE_ONLY>(&bsdf, wo, wi);
-                    if f.max_element() > 0.0 {
-                        let weight = if ls.delta || self.mis == MisHeuristic::None {
-                            1.0
-                        } else {
-                            self.mis.weight(ls.pdf, pdf::<DIFFUSE_ONLY>(&bsdf, wo, wi))
-                        };
-                        let shadow = PendingShadow {
-                            ray: ls.shadow_ray_from(&hit),
-                            added: beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf),
-                            light: ls.light,
-                        };
-                        // An observer hears of the light sample before the
-                        // bounce; the image is the same either way.
-                        if O::IN_ORDER {
-                            let visible = shadow.visible::<PLAIN>(scene, counts);
-                            let added = if visible { shadow.added } else { Rgb::ZERO };
-                            observer.light_sample(&ls, f, weight, visible, added);
-                            radiance += added;
-                        } else {
-                            pending = Some(shadow);
-                        }
+                let light =
+                    self.sample_light::<DIFFUSE_ONLY>(scene, &hit, &frame, &bsdf, wo, beta, &u);
+                if let Some((shadow, ls, f, weight)) = light {
+                    if O::IN_ORDER {
+                        let visible = shadow.visible::<PLAIN>(scene, counts);
+                        let added = if visible { shadow.added } else { Rgb::ZERO };
+                        observer.light_sample(&ls, f, weight, visible, added);
+                        radiance += added;
+                    } else {
+                        pending = Some(shadow);
                     }
                 }
             }
 
             // The next ray, or None where the path ends here.
             let next = 'next: {
-                let Some(sample) = sample::<DIFFUSE_ONLY>(&bsdf, wo, u_lobe, u_bsdf) else {
+                let Some(sample) = sample::<DIFFUSE_ONLY>(&bsdf, wo, u_lobe, u.bsdf) else {
                     break 'next None;
                 };
                 observer.bsdf_sample(&sample);
@@ -441,20 +392,9 @@ impl PathTracer {
                 if !DIFFUSE_ONLY && sample.wi.z * wo.z < 0.0 {
                     eta_scale /= bsdf.refraction_scale(wo, sample.wi);
                 }
-                prev_bsdf_pdf = sample.pdf;
-                prev_point = hit.point;
+                (prev_bsdf_pdf, prev_point) = (sample.pdf, hit.point);
                 bounces += 1;
-
-                if self.russian_roulette && bounces > self.rr_depth {
-                    let q = (beta.max_element() * eta_scale).min(0.95);
-                    let u_roulette = sampler.get_1d_for(vertex_dim + 4, Domain::Other);
-                    let survived = survives_roulette(&mut beta, eta_scale, u_roulette);
-                    observer.roulette(q, survived);
-                    if !survived {
-                        break 'next None;
-                    }
-                }
-                if beta.max_element() <= 0.0 {
+                if !self.survives(bounces, &mut beta, eta_scale, &u, sampler, observer) {
                     break 'next None;
                 }
                 counts.bounce += 1;
@@ -468,6 +408,129 @@ impl PathTracer {
             ray = next;
         }
         radiance
+    }
+
+    /// The MIS weight of light found by a BSDF-sampled ray (or the camera
+    /// ray) against the light sample that could have found it, whose
+    /// solid-angle density `light_pdf` gives.
+    #[inline(always)]
+    fn found_light_weight(
+        &self,
+        specular_bounce: bool,
+        bsdf_pdf: f32,
+        light_pdf: impl FnOnce() -> f32,
+    ) -> f32 {
+        if specular_bounce || !self.nee {
+            1.0
+        } else if self.mis == MisHeuristic::None {
+            // Light sampling alone accounts for this path.
+            0.0
+        } else {
+            self.mis.weight(bsdf_pdf, light_pdf())
+        }
+    }
+
+    /// A light sample from `hit`: its shadow ray and what it adds where
+    /// the light is visible (throughput `beta`), then for observers the
+    /// sample, the BSDF's value towards it and its MIS weight against BSDF
+    /// sampling; `None` where it adds nothing.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn sample_light<const DIFFUSE_ONLY: bool>(
+        &self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        frame: &Frame,
+        bsdf: &Bsdf,
+        wo: Vec3A,
+        beta: Rgb,
+        u: &VertexNumbers,
+    ) -> Option<(PendingShadow, LightSample, Rgb, f32)> {
+        let ls = scene.lights.sample(hit.point, u.light_select, u.light)?;
+        let wi = frame.to_local(ls.wi);
+        let f = eval::<DIFFUSE_ONLY>(bsdf, wo, wi);
+        if f.max_element() <= 0.0 {
+            return None;
+        }
+        let weight = if ls.delta || self.mis == MisHeuristic::None {
+            1.0
+        } else {
+            self.mis.weight(ls.pdf, pdf::<DIFFUSE_ONLY>(bsdf, wo, wi))
+        };
+        let shadow = PendingShadow {
+            ray: ls.shadow_ray_from(hit),
+            added: beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf),
+            light: ls.light,
+        };
+        Some((shadow, ls, f, weight))
+    }
+
+    /// Russian roulette after `bounces` (where it applies), then whether
+    /// the path still carries anything.
+    #[inline(always)]
+    fn survives<O: PathObserver>(
+        &self,
+        bounces: u32,
+        beta: &mut Rgb,
+        eta_scale: f32,
+        u: &VertexNumbers,
+        sampler: &mut Sampler,
+        observer: &mut O,
+    ) -> bool {
+        if self.russian_roulette && bounces > self.rr_depth {
+            let q = (beta.max_element() * eta_scale).min(0.95);
+            let u_roulette = sampler.get_1d_for(u.dim + 4, Domain::Other);
+            let survived = survives_roulette(beta, eta_scale, u_roulette);
+            observer.roulette(q, survived);
+            if !survived {
+                return false;
+            }
+        }
+        beta.max_element() > 0.0
+    }
+}
+
+/// The numbers of one path vertex. Every vertex consumes the same five
+/// dimensions (light choice, light point, lobe, BSDF direction, roulette),
+/// so stratified samplers keep dimensions aligned across samples. Those
+/// that do not depend on the hit are drawn before the ray is traced: their
+/// hash chains then overlap with the traversal instead of stalling the
+/// light sample after it.
+struct VertexNumbers {
+    dim: u32,
+    light_select: f32,
+    light: Vec2,
+    bsdf: Vec2,
+}
+
+impl VertexNumbers {
+    /// Draws the numbers of vertex `bounces`. One light needs no choice
+    /// (the Cornell box): skipping that number leaves the image
+    /// bit-identical.
+    #[inline(always)]
+    fn draw(sampler: &mut Sampler, bounces: u32, light_choice: bool) -> Self {
+        sampler.enter_path_vertex(bounces);
+        let dim = sampler.reserve(5);
+        VertexNumbers {
+            dim,
+            light_select: if light_choice {
+                sampler.get_1d_for(dim, Domain::Light)
+            } else {
+                0.0
+            },
+            light: sampler.get_2d_for(dim + 1, Domain::Light),
+            bsdf: sampler.get_2d_for(dim + 3, Domain::Bsdf),
+        }
+    }
+
+    /// The lobe's number, drawn only where there is a lobe to choose.
+    #[inline(always)]
+    fn lobe(&self, sampler: &Sampler, bsdf: &Bsdf) -> f32 {
+        if matches!(bsdf, Bsdf::Diffuse { .. }) {
+            0.0
+        } else {
+            sampler.get_1d_for(self.dim + 2, Domain::Bsdf)
+        }
     }
 }
 
