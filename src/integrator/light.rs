@@ -111,6 +111,26 @@ impl SplattingEstimator for LightTracer {
         _pixel: (u32, u32),
         sampler: &mut Sampler,
         counts: &mut RayCounts,
+        splat: impl FnMut(Splat),
+    ) {
+        // As the path tracer: plain geometry keeps the other cases'
+        // queries out of the walk (docs/performance.md).
+        if scene.geometry.is_plain() {
+            self.trace_particle::<true>(scene, sampler, counts, splat)
+        } else {
+            self.trace_particle::<false>(scene, sampler, counts, splat)
+        }
+    }
+}
+
+impl LightTracer {
+    /// [`SplattingEstimator::trace`]; `PLAIN` as for
+    /// [`crate::accel::Geometry::intersect_as`].
+    fn trace_particle<const PLAIN: bool>(
+        &self,
+        scene: &Scene,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
         mut splat: impl FnMut(Splat),
     ) {
         let emission = sample_particle(scene, sampler);
@@ -131,7 +151,7 @@ impl SplattingEstimator for LightTracer {
         {
             let le = emission.emitted_towards(c.wi);
             if le.max_element() > 0.0
-                && sees_lens(
+                && sees_lens::<PLAIN>(
                     scene,
                     emission.point,
                     emission.error,
@@ -158,7 +178,7 @@ impl SplattingEstimator for LightTracer {
         counts.camera += 1;
         let mut bounces = 0;
         while bounces < self.max_depth {
-            let Some(hit) = scene.geometry.intersect(&ray) else {
+            let Some(hit) = scene.geometry.intersect_as::<PLAIN>(&ray) else {
                 break;
             };
             let bsdf = scene.bsdf_at(&hit);
@@ -180,7 +200,7 @@ impl SplattingEstimator for LightTracer {
                 let w_cam = frame.to_local(c.wi);
                 let f = bsdf.eval(w_cam, w_prev) * shading_correction(w_prev, w_cam, ng);
                 if f.max_element() > 0.0
-                    && sees_lens(scene, hit.point, hit.error, hit.normal, &c, time, counts)
+                    && sees_lens::<PLAIN>(scene, hit.point, hit.error, hit.normal, &c, time, counts)
                 {
                     splat(Splat {
                         film: c.film,
@@ -212,9 +232,10 @@ impl SplattingEstimator for LightTracer {
 }
 
 /// Casts the connection from a surface point to the lens point (a shadow
-/// ray, counted) and says whether nothing is in between.
+/// ray, counted) and says whether nothing is in between. `PLAIN` as for
+/// [`crate::accel::Geometry::occluded_as`].
 #[inline]
-pub(super) fn sees_lens(
+pub(super) fn sees_lens<const PLAIN: bool>(
     scene: &Scene,
     point: Vec3A,
     error: Vec3A,
@@ -233,7 +254,7 @@ pub(super) fn sees_lens(
         Vec3A::ZERO,
     )
     .at_time(time);
-    !scene.geometry.occluded(&ray)
+    !scene.geometry.occluded_as::<PLAIN>(&ray)
 }
 
 /// A particle's start: a light, a point on it and a direction, from three

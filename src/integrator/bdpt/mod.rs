@@ -522,7 +522,7 @@ impl Bdpt {
             let (f, pdf_back) = qs.scatter(scene, c.wi, &light_local[s - 1]);
             let value = qs.beta * f * (qs.shading_cos(c.wi) * c.weight);
             if !(value.max_element() > 0.0)
-                || !sees_lens(scene, qs.point, qs.error, qs.normal, &c, time, counts)
+                || !sees_lens::<false>(scene, qs.point, qs.error, qs.normal, &c, time, counts)
             {
                 return None;
             }

@@ -104,7 +104,7 @@ impl Vcm {
         };
         let value = weighted(&c);
         if !(value.max_element() > 0.0)
-            || !sees_lens(scene, point, error, normal, &c, iteration.time, counts)
+            || !sees_lens::<false>(scene, point, error, normal, &c, iteration.time, counts)
         {
             return;
         }
