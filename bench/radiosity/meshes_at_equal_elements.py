@@ -9,6 +9,9 @@ a configuration chosen for it.
     python3 bench/radiosity/meshes_at_equal_elements.py [--tracelab PATH]
 
 Gauss-Seidel, smooth display, against tests/data/cornell_box_path_ref.exr.
+With --max-penumbrae the meshes with lines are also solved with each
+--max-penumbra value; the element counts where the lines' envelope (all
+their kinds together) is not below the plain one are printed last.
 """
 import argparse, itertools, subprocess
 
@@ -17,6 +20,9 @@ parser.add_argument("--tracelab", default="target/release/tracelab")
 parser.add_argument("--sizes", default="0.1,0.12,0.15,0.2")
 parser.add_argument("--rounds", default="1,2")
 parser.add_argument("--tolerances", default="0.8,1,1.3")
+parser.add_argument("--max-penumbrae", default="all",
+                    help="for the kinds with lines: --max-penumbra values to sweep too "
+                         "(comma-separated; all: every line)")
 parser.add_argument("--kinds", default="plain,lines,regular",
                     help="plain (adaptive subdivision), lines (discontinuity meshing first), "
                          "regular (its lines on the regular mesh: --lines-on-regular-mesh)")
@@ -25,13 +31,15 @@ args = parser.parse_args()
 FLAGS = {"plain": [], "lines": ["--discontinuity-meshing"],
          "regular": ["--discontinuity-meshing", "--lines-on-regular-mesh"]}
 
-def solve(size, rounds, tolerance, kind):
+def solve(size, rounds, tolerance, kind, max_penumbra):
     command = [args.tracelab, "radiosity", "scenes/cornell_box.toml",
                "--reference", "tests/data/cornell_box_path_ref.exr",
                "--solver", "gauss-seidel", "--display", "smooth",
                "--patch-size", size, "--adaptive-rounds", rounds,
                "--adaptive-tolerance", tolerance]
     command += FLAGS[kind]
+    if kind != "plain" and max_penumbra != "all":
+        command += ["--max-penumbra", max_penumbra]
     out = subprocess.run(command, capture_output=True, text=True, check=True).stdout
     row = [l for l in out.splitlines() if l.strip() and l.split()[0].isdigit()][-1].split()
     # Columns: steps, elements, links, rays, bytes, solve s, residual, RMSE, masked RMSE.
@@ -45,16 +53,51 @@ def envelope(points):
             front.append((elements, rmse, config))
     return front
 
-grid = list(itertools.product(args.sizes.split(","), args.rounds.split(","),
-                              args.tolerances.split(",")))
+def configurations(kind):
+    # Without rounds the tolerance does nothing: one run.
+    sizes, rounds = args.sizes.split(","), args.rounds.split(",")
+    tolerances = args.tolerances.split(",")
+    penumbrae = ["all"] if kind == "plain" else args.max_penumbrae.split(",")
+    for size, r, tolerance, m in itertools.product(sizes, rounds, tolerances, penumbrae):
+        if r != "0" or tolerance == tolerances[0]:
+            yield size, r, tolerance, m
+
+envelopes = {}
 for kind in args.kinds.split(","):
     points = []
-    for size, rounds, tolerance in grid:
-        elements, rmse, seconds = solve(size, rounds, tolerance, kind)
+    for size, rounds, tolerance, max_penumbra in configurations(kind):
+        elements, rmse, seconds = solve(size, rounds, tolerance, kind, max_penumbra)
         config = f"patch {size}, {rounds} rounds, tolerance {tolerance}"
+        if max_penumbra != "all":
+            config += f", max penumbra {max_penumbra}"
         print(f"{kind}\t{elements}\t{rmse:.5f}\t{seconds:.1f} s\t{config}", flush=True)
         points.append((elements, rmse, config))
     print(f"\nlower envelope, {kind}:")
-    for elements, rmse, config in envelope(points):
+    envelopes[kind] = envelope(points)
+    for elements, rmse, config in envelopes[kind]:
         print(f"  {elements:6d}  {rmse:.5f}  {config}")
     print(flush=True)
+
+def best_within(front, count):
+    """The envelope's RMSE with at most `count` elements (None below its start)."""
+    within = [rmse for elements, rmse, _ in front if elements <= count]
+    return min(within) if within else None
+
+# Where the meshes with lines lose: the element counts (from the smallest
+# mesh either side has to the largest both grids reach) at which the best
+# mesh with lines of at most that many elements is not below the best
+# plain one.
+if "plain" in envelopes and len(envelopes) > 1:
+    lines = sorted(p for kind, front in envelopes.items() if kind != "plain" for p in front)
+    plain = envelopes["plain"]
+    counts = sorted({e for e, _, _ in plain} | {e for e, _, _ in lines})
+    losing, start = [], None
+    for i, count in enumerate(counts):
+        ours, theirs = best_within(lines, count), best_within(plain, count)
+        lost = ours is None or (theirs is not None and ours >= theirs)
+        end = counts[i + 1] - 1 if i + 1 < len(counts) else count
+        if lost:
+            losing.append((count, end, ours, theirs))
+    print("element counts where the meshes with lines are not below adaptive subdivision:")
+    for count, end, ours, theirs in losing:
+        print(f"  {count}-{end}: lines {ours}, plain {theirs}")

@@ -101,6 +101,11 @@ pub struct RadiosityFlags {
     /// line crosses (better at fine meshes, worse at coarse ones).
     #[arg(long)]
     lines_on_regular_mesh: bool,
+    /// Radiosity, matrix solvers, with --discontinuity-meshing: keep a
+    /// penumbra's boundary lines only where the penumbra is narrower than
+    /// this many patch sizes (0: contact lines only) [default: every line].
+    #[arg(long)]
+    max_penumbra: Option<f32>,
 }
 
 impl RadiosityFlags {
@@ -120,6 +125,7 @@ impl RadiosityFlags {
             || self.wireframe
             || self.discontinuity_meshing
             || self.lines_on_regular_mesh
+            || self.max_penumbra.is_some()
     }
 
     /// `settings` with the flags given applied, checked.
@@ -151,6 +157,7 @@ impl RadiosityFlags {
         settings.wireframe |= self.wireframe;
         settings.discontinuity |= self.discontinuity_meshing || self.lines_on_regular_mesh;
         settings.lines_on_regular_mesh |= self.lines_on_regular_mesh;
+        settings.max_penumbra = self.max_penumbra.or(settings.max_penumbra);
         if let Some(display) = self.display {
             settings.display = match display {
                 DisplayArg::Flat => RadiosityDisplay::Flat,

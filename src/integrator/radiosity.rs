@@ -84,6 +84,12 @@ pub struct Radiosity {
     /// meshing every receiver by Delaunay refinement (better from about
     /// 2 000 elements on the Cornell box, worse below: docs/validation.md).
     pub lines_on_regular_mesh: bool,
+    /// Matrix solvers with `discontinuity`: keep a penumbra's boundary lines
+    /// (D1) only where the penumbra is narrower than this many element
+    /// sizes (`patch_size`); contact lines (D0) are always kept. None keeps
+    /// every line. Fewer lines cost fewer pieces, which pays at coarse meshes
+    /// (docs/validation.md).
+    pub max_penumbra: Option<f32>,
 }
 
 /// How the solution is shown.
@@ -146,9 +152,16 @@ impl Technique for Radiosity {
                 String::new()
             },
             match (self.discontinuity, self.lines_on_regular_mesh) {
-                (false, _) => "",
-                (true, false) => ", discontinuity meshing",
-                (true, true) => ", discontinuity meshing on the regular mesh",
+                (false, _) => String::new(),
+                (true, regular) => format!(
+                    ", discontinuity meshing{}{}",
+                    if regular { " on the regular mesh" } else { "" },
+                    match self.max_penumbra {
+                        Some(m) if self.solver.matrix().is_some() =>
+                            format!(" (penumbrae narrower than {m} patches)"),
+                        _ => String::new(),
+                    }
+                ),
             },
             self.form_factors,
             self.form_factor_samples,
@@ -457,10 +470,17 @@ impl Radiosity {
                 use crate::radiosity::discontinuity::Base;
                 let b = scene.geometry.bounds();
                 let max_edge = self.patch_size * (b.max - b.min).length();
+                let max_penumbra = self.max_penumbra.map_or(f32::INFINITY, |m| m * max_edge);
                 if self.lines_on_regular_mesh {
-                    Base::Regular { max_edge }
+                    Base::Regular {
+                        max_edge,
+                        max_penumbra,
+                    }
                 } else {
-                    Base::Delaunay { max_edge }
+                    Base::Delaunay {
+                        max_edge,
+                        max_penumbra,
+                    }
                 }
             });
             let (meshed, notes) = discontinuity_mesh(scene, base);

@@ -55,6 +55,10 @@ pub enum Event {
 pub struct Segment {
     pub ends: [Vec3A; 2],
     pub event: Event,
+    /// The penumbra's width at each end, by similar triangles (the light's
+    /// extent across the line times the ratio of the end's distance past the
+    /// occluder to the light's distance before it); 0 for a contact line.
+    pub penumbra: [f32; 2],
 }
 
 /// The discontinuities of a scene's receivers.
@@ -188,6 +192,9 @@ enum Fan {
         through: [Vec3A; 2],
         light_normal: Vec3A,
         two_sided: bool,
+        /// The light's extent across the occluder's edge (VE) or across its
+        /// own edge (EV): the penumbra's width where the occluder is halfway.
+        light_size: f32,
     },
     Contact {
         edge: [Vec3A; 2],
@@ -228,6 +235,7 @@ impl Tracer<'_> {
                 through,
                 light_normal,
                 two_sided,
+                ..
             } => {
                 let (source, target) = (lerp(from), lerp(through));
                 let d = target - source;
@@ -340,6 +348,21 @@ pub fn find(scene: &Scene) -> Discontinuities {
     for light in &lights {
         let n = light.corners.len();
         let p0 = light.corners[0];
+        // The light's extent across a line along `u` (its diameter where `u`
+        // is along the light's normal).
+        let diameter = light
+            .corners
+            .iter()
+            .flat_map(|a| light.corners.iter().map(move |b| (*a - *b).length()))
+            .fold(0.0, f32::max);
+        let extent_across = |u: Vec3A| {
+            let d = u.cross(light.normal).normalize_or_zero();
+            if d == Vec3A::ZERO {
+                return diameter;
+            }
+            let along = light.corners.iter().map(|c| c.dot(d));
+            along.clone().fold(f32::MIN, f32::max) - along.fold(f32::MAX, f32::min)
+        };
         let in_front = |p: Vec3A| light.two_sided || (p - p0).dot(light.normal) > tolerance;
         // VE: a light corner and an occluder edge.
         for &corner in &light.corners {
@@ -360,6 +383,7 @@ pub fn find(scene: &Scene) -> Discontinuities {
                         through: [pa, pb],
                         light_normal: light.normal,
                         two_sided: light.two_sided,
+                        light_size: extent_across(pb - pa),
                     });
                 }
             }
@@ -385,6 +409,7 @@ pub fn find(scene: &Scene) -> Discontinuities {
                         through: [*p; 2],
                         light_normal: light.normal,
                         two_sided: light.two_sided,
+                        light_size: extent_across(c1 - c0),
                     });
                 }
             }
@@ -481,12 +506,37 @@ pub fn find(scene: &Scene) -> Discontinuities {
                         Fan::Wedge { from, .. } if from[0] == from[1] => Event::VertexEdge,
                         Fan::Wedge { .. } => Event::EdgeVertex,
                     },
+                    penumbra: [a, b].map(|p| penumbra_width(fan, p)),
                 });
             }
         }
     }
     out.rays = tracer.rays;
     out
+}
+
+/// The width of the penumbra a wedge's line bounds, at `p` on it. In the
+/// wedge's plane, the ray from the light through the occluder's edge or
+/// vertex to `p` is cut by a line through the occluder (the edge, or the
+/// parallel to the light's edge through the vertex) in the ratio of the
+/// two points' distances to it.
+fn penumbra_width(fan: &Fan, p: Vec3A) -> f32 {
+    let Fan::Wedge {
+        from,
+        through,
+        light_size,
+        ..
+    } = *fan
+    else {
+        return 0.0;
+    };
+    let (line, source) = if from[0] == from[1] {
+        (through, from[0])
+    } else {
+        ([through[0], through[0] + (from[1] - from[0])], from[0])
+    };
+    let distance = |q: Vec3A| (q - nearest_on_line(line, q)).length();
+    light_size * distance(p) / distance(source).max(f32::MIN_POSITIVE)
 }
 
 /// The point of the line through `edge` nearest `p`.

@@ -188,6 +188,22 @@ fn radiosity(ui: &mut egui::Ui, s: &mut Radiosity) {
                  crosses (better at fine meshes); off: every receiver meshed by Delaunay \
                  refinement (fewer pieces at coarse ones)",
             );
+        let mut some = s.max_penumbra.is_some();
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut some, "Only narrow penumbrae")
+                .on_hover_text(
+                    "Keep a penumbra's boundary lines only where it is narrower than this many \
+                     patch sizes (contact lines are always kept): fewer lines, fewer pieces, \
+                     which pays at coarse meshes",
+                );
+            if some {
+                let mut m = s.max_penumbra.unwrap_or(0.5);
+                ui.add(egui::Slider::new(&mut m, 0.0..=4.0).text("patch sizes"));
+                s.max_penumbra = Some(m);
+            } else {
+                s.max_penumbra = None;
+            }
+        });
     }
     ui.horizontal(|ui| {
         ui.label("Form factors");

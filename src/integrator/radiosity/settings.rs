@@ -21,6 +21,7 @@ impl Default for Radiosity {
             wireframe: false,
             discontinuity: false,
             lines_on_regular_mesh: false,
+            max_penumbra: None,
         }
     }
 }
@@ -34,6 +35,13 @@ impl Settings for Radiosity {
             return Err(format!(
                 "adaptive tolerance must be positive, got {}",
                 self.adaptive_tolerance
+            ));
+        }
+        if let Some(m) = self.max_penumbra
+            && !(m >= 0.0 && m.is_finite())
+        {
+            return Err(format!(
+                "max penumbra must be a number of patch sizes, 0 or more, got {m}"
             ));
         }
         if !(self.patch_size > 0.0 && self.patch_size <= 1.0) || self.form_factor_samples == 0 {

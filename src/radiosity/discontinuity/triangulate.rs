@@ -7,17 +7,20 @@ use crate::scene::Scene;
 use glam::Vec3A;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
-/// How a matrix solver's receivers are meshed around their lines.
+/// How a matrix solver's receivers are meshed around their lines. In both,
+/// a penumbra's boundary lines (D1) are kept only where the penumbra is
+/// narrower than `max_penumbra` (scene units; infinite keeps every line),
+/// contact lines (D0) always.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Base {
     /// Every receiver, lines or not, by constrained Delaunay refinement with
     /// points at most `max_edge` apart along its edges and lines.
-    Delaunay { max_edge: f32 },
+    Delaunay { max_edge: f32, max_penumbra: f32 },
     /// The regular elements of the mesh without lines (edges at most
     /// `max_edge`, [`crate::radiosity::Mesh::build`]'s depth), only those a
     /// line crosses triangulated along it; receivers without lines stay
     /// whole for the mesh to subdivide the same way.
-    Regular { max_edge: f32 },
+    Regular { max_edge: f32, max_penumbra: f32 },
 }
 
 /// Splits receiver triangles along their discontinuities: a constrained
@@ -39,6 +42,7 @@ pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<
         offset: 0.0,
         rays: 0,
     };
+    let mut kept = Vec::new();
     lines
         .segments
         .iter()
@@ -46,21 +50,68 @@ pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<
         .map(|(t, segments)| {
             let v = geometry.triangles()[t];
             let receiver = || tracer.receiver(t);
+            let Some(
+                Base::Delaunay {
+                    max_edge,
+                    max_penumbra,
+                }
+                | Base::Regular {
+                    max_edge,
+                    max_penumbra,
+                },
+            ) = base
+            else {
+                return if segments.is_empty() {
+                    Vec::new()
+                } else {
+                    split_triangle(v, segments, None)
+                };
+            };
+            kept.clear();
+            kept.extend(
+                segments
+                    .iter()
+                    .filter_map(|s| narrower_part(s, max_penumbra)),
+            );
             match base {
-                None if segments.is_empty() => Vec::new(),
-                None => split_triangle(v, segments, None),
-                Some(Base::Delaunay { max_edge }) if !segments.is_empty() || receiver() => {
-                    split_triangle(v, segments, Some(max_edge))
+                Some(Base::Delaunay { .. }) if !kept.is_empty() || receiver() => {
+                    split_triangle(v, &kept, Some(max_edge))
                 }
-                Some(Base::Regular { max_edge }) if !segments.is_empty() => {
-                    split_regular(v, segments, max_edge)
-                }
+                Some(Base::Regular { .. }) if !kept.is_empty() => split_regular(v, &kept, max_edge),
                 // Left whole: the mesh subdivides it (a receiver without
                 // lines on the regular base).
-                Some(_) => Vec::new(),
+                _ => Vec::new(),
             }
         })
         .collect()
+}
+
+/// The part of segment `s` where its penumbra is at most `limit` wide (the
+/// width is linear along it), unless that is none of it.
+fn narrower_part(s: &Segment, limit: f32) -> Option<Segment> {
+    let [wa, wb] = s.penumbra;
+    if wa <= limit && wb <= limit {
+        return Some(*s);
+    }
+    if wa > limit && wb > limit {
+        return None;
+    }
+    let t = (limit - wa) / (wb - wa);
+    let [a, b] = s.ends;
+    let cut = a + t * (b - a);
+    Some(if wa <= limit {
+        Segment {
+            ends: [a, cut],
+            penumbra: [wa, limit],
+            ..*s
+        }
+    } else {
+        Segment {
+            ends: [cut, b],
+            penumbra: [limit, wb],
+            ..*s
+        }
+    })
 }
 
 /// Triangle `v` cut into the regular elements of the mesh without lines
@@ -121,9 +172,11 @@ fn clip(s: &Segment, v: &[Vec3A; 3]) -> Option<Segment> {
     if (t1 - t0) * (b - a).length() <= 1e-3 * longest {
         return None;
     }
+    let [wa, wb] = s.penumbra;
     Some(Segment {
         ends: [a + t0 * (b - a), a + t1 * (b - a)],
         event: s.event,
+        penumbra: [wa + t0 * (wb - wa), wa + t1 * (wb - wa)],
     })
 }
 
@@ -358,6 +411,35 @@ fn split_triangle(v: [Vec3A; 3], segments: &[Segment], max_edge: Option<f32>) ->
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_line_is_cut_where_its_penumbra_reaches_the_limit() {
+        // From a contact (width 0) to a 2 m wide penumbra: a limit of 1 m
+        // keeps the first half, 3 m all of it, and a line starting wider
+        // than the limit is dropped.
+        let line = Segment {
+            ends: [Vec3A::ZERO, Vec3A::new(4.0, 0.0, 0.0)],
+            event: Event::VertexEdge,
+            penumbra: [0.0, 2.0],
+        };
+        let half = narrower_part(&line, 1.0).unwrap();
+        assert!((half.ends[1] - Vec3A::new(2.0, 0.0, 0.0)).length() < 1e-6);
+        assert_eq!(half.ends[0], Vec3A::ZERO);
+        assert_eq!(half.penumbra, [0.0, 1.0]);
+        let reversed = Segment {
+            ends: [line.ends[1], line.ends[0]],
+            penumbra: [2.0, 0.0],
+            ..line
+        };
+        let tail = narrower_part(&reversed, 1.0).unwrap();
+        assert!((tail.ends[0] - Vec3A::new(2.0, 0.0, 0.0)).length() < 1e-6);
+        assert_eq!(narrower_part(&line, 3.0).unwrap().ends, line.ends);
+        let wide = Segment {
+            penumbra: [1.5, 2.0],
+            ..line
+        };
+        assert!(narrower_part(&wide, 1.0).is_none());
+    }
+
     use super::*;
     use crate::radiosity::discontinuity::Event;
 
@@ -380,6 +462,7 @@ mod tests {
         let line = Segment {
             ends: [Vec3A::new(0.0, 0.55, 0.0), Vec3A::new(0.65, 0.0, 0.0)],
             event: Event::VertexEdge,
+            penumbra: [0.0; 2],
         };
         // Longest edge √2 at most 0.3: three levels, 64 elements.
         let pieces = split_regular(v, &[line], 0.3);
@@ -428,6 +511,7 @@ mod tests {
             let line = Segment {
                 ends: [Vec3A::new(0.1, 0.0, 0.0), Vec3A::new(0.0, 0.0, 0.3)].map(|p| scale * p),
                 event: Event::VertexEdge,
+                penumbra: [0.0; 2],
             };
             split_triangle(v, &[line], Some(0.15 * scale))
         };
@@ -451,6 +535,7 @@ mod tests {
         let segment = |a: [f32; 2], b: [f32; 2]| Segment {
             ends: [Vec3A::new(a[0], a[1], 0.0), Vec3A::new(b[0], b[1], 0.0)],
             event: Event::VertexEdge,
+            penumbra: [0.0; 2],
         };
         let pieces = split_triangle(
             v,
