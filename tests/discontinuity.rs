@@ -71,14 +71,8 @@ fn penumbra_lines_fall_where_similar_triangles_put_them_and_pieces_never_straddl
     // of one.
     use discontinuity::Base;
     for base in [
-        Base::Delaunay {
-            max_edge: 0.3,
-            max_penumbra: f32::INFINITY,
-        },
-        Base::Regular {
-            max_edge: 0.3,
-            max_penumbra: f32::INFINITY,
-        },
+        Base::Delaunay { max_edge: 0.3 },
+        Base::Regular { max_edge: 0.3 },
     ] {
         let pieces = discontinuity::split(&scene, &lines, Some(base));
         let mut area = 0.0;
@@ -137,11 +131,8 @@ fn lines_know_their_penumbras_width_and_a_limit_keeps_the_narrow_ones() {
         }
     }
     let on_line = |max_penumbra: f32| {
-        let base = Base::Delaunay {
-            max_edge: 0.3,
-            max_penumbra,
-        };
-        let pieces = discontinuity::split(&scene, &lines, Some(base));
+        let kept = lines.narrower_than(max_penumbra);
+        let pieces = discontinuity::split(&scene, &kept, Some(Base::Delaunay { max_edge: 0.3 }));
         let flagged = pieces
             .iter()
             .flatten()

@@ -470,18 +470,12 @@ impl Radiosity {
                 use crate::radiosity::discontinuity::Base;
                 let b = scene.geometry.bounds();
                 let max_edge = self.patch_size * (b.max - b.min).length();
-                let max_penumbra = self.max_penumbra.map_or(f32::INFINITY, |m| m * max_edge);
-                if self.lines_on_regular_mesh {
-                    Base::Regular {
-                        max_edge,
-                        max_penumbra,
-                    }
+                let base = if self.lines_on_regular_mesh {
+                    Base::Regular { max_edge }
                 } else {
-                    Base::Delaunay {
-                        max_edge,
-                        max_penumbra,
-                    }
-                }
+                    Base::Delaunay { max_edge }
+                };
+                (base, self.max_penumbra.map(|m| m * max_edge))
             });
             let (meshed, notes) = discontinuity_mesh(scene, base);
             (Some(meshed), notes)

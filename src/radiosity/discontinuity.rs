@@ -74,6 +74,34 @@ pub struct Discontinuities {
     pub notes: Vec<String>,
 }
 
+impl Discontinuities {
+    /// These lines with a penumbra's boundary (D1) kept only where the
+    /// penumbra is narrower than `limit` (scene units), cut where it
+    /// reaches it; contact lines (D0) all kept. A wide penumbra's irradiance
+    /// changes slowly, and its lines cost pieces that a coarse mesh needs
+    /// elsewhere (docs/validation.md).
+    pub fn narrower_than(&self, limit: f32) -> Discontinuities {
+        Discontinuities {
+            segments: self
+                .segments
+                .iter()
+                .map(|s| {
+                    s.iter()
+                        .filter_map(|s| triangulate::narrower_part(s, limit))
+                        .collect()
+                })
+                .collect(),
+            notes: self.notes.clone(),
+            ..*self
+        }
+    }
+
+    /// Line segments, over every receiver.
+    pub fn count(&self) -> usize {
+        self.segments.iter().map(Vec::len).sum()
+    }
+}
+
 /// A piece of a receiver triangle after meshing, wound like the triangle.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Piece {

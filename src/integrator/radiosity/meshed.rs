@@ -43,14 +43,20 @@ impl Meshed {
 }
 
 /// `scene` split along the discontinuities its polygonal lights cast, and
-/// notes saying what was found.
+/// notes saying what was found. With a base (the matrix solvers), the
+/// receivers are meshed as it says, keeping a penumbra's lines only where
+/// it is narrower than the limit beside it, if any.
 pub(super) fn discontinuity_mesh(
     scene: &Scene,
-    base: Option<crate::radiosity::discontinuity::Base>,
+    base: Option<(crate::radiosity::discontinuity::Base, Option<f32>)>,
 ) -> (Meshed, Vec<String>) {
     use crate::radiosity::discontinuity;
-    let lines = discontinuity::find(scene);
-    let pieces = discontinuity::split(scene, &lines, base);
+    let found = discontinuity::find(scene);
+    let lines = match base {
+        Some((_, Some(limit))) => found.narrower_than(limit),
+        _ => found.clone(),
+    };
+    let pieces = discontinuity::split(scene, &lines, base.map(|(b, _)| b));
     let corners: Vec<Vec<[glam::Vec3A; 3]>> = pieces
         .iter()
         .map(|p| p.iter().map(|p| p.vertices).collect())
@@ -69,17 +75,23 @@ pub(super) fn discontinuity_mesh(
         .iter()
         .map(|v| flags.get(&key(v)).copied().unwrap_or_default())
         .collect();
-    let count: usize = lines.segments.iter().map(Vec::len).sum();
+    let count = lines.count();
+    let kept = if count == found.count() {
+        String::new()
+    } else {
+        format!(" ({count} kept, in penumbrae narrower than the limit)")
+    };
     let split = pieces.iter().filter(|p| !p.is_empty()).count();
     let mut notes = lines.notes;
     notes.push(format!(
         "discontinuity meshing: {} critical wedges (VE {}, EV {}) and {} contact tests, {} rays, \
-         gave {count} line segments; {split} triangles split into {} pieces",
+         gave {} line segments{kept}; {split} triangles split into {} pieces",
         lines.wedges[0] + lines.wedges[1],
         lines.wedges[0],
         lines.wedges[1],
         lines.wedges[2],
         lines.rays,
+        found.count(),
         pieces.iter().map(Vec::len).sum::<usize>(),
     ));
     (

@@ -7,20 +7,17 @@ use crate::scene::Scene;
 use glam::Vec3A;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
-/// How a matrix solver's receivers are meshed around their lines. In both,
-/// a penumbra's boundary lines (D1) are kept only where the penumbra is
-/// narrower than `max_penumbra` (scene units; infinite keeps every line),
-/// contact lines (D0) always.
+/// How a matrix solver's receivers are meshed around their lines.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Base {
     /// Every receiver, lines or not, by constrained Delaunay refinement with
     /// points at most `max_edge` apart along its edges and lines.
-    Delaunay { max_edge: f32, max_penumbra: f32 },
+    Delaunay { max_edge: f32 },
     /// The regular elements of the mesh without lines (edges at most
     /// `max_edge`, [`crate::radiosity::Mesh::build`]'s depth), only those a
     /// line crosses triangulated along it; receivers without lines stay
     /// whole for the mesh to subdivide the same way.
-    Regular { max_edge: f32, max_penumbra: f32 },
+    Regular { max_edge: f32 },
 }
 
 /// Splits receiver triangles along their discontinuities: a constrained
@@ -42,7 +39,6 @@ pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<
         offset: 0.0,
         rays: 0,
     };
-    let mut kept = Vec::new();
     lines
         .segments
         .iter()
@@ -50,37 +46,18 @@ pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<
         .map(|(t, segments)| {
             let v = geometry.triangles()[t];
             let receiver = || tracer.receiver(t);
-            let Some(
-                Base::Delaunay {
-                    max_edge,
-                    max_penumbra,
-                }
-                | Base::Regular {
-                    max_edge,
-                    max_penumbra,
-                },
-            ) = base
-            else {
-                return if segments.is_empty() {
-                    Vec::new()
-                } else {
-                    split_triangle(v, segments, None)
-                };
-            };
-            kept.clear();
-            kept.extend(
-                segments
-                    .iter()
-                    .filter_map(|s| narrower_part(s, max_penumbra)),
-            );
             match base {
-                Some(Base::Delaunay { .. }) if !kept.is_empty() || receiver() => {
-                    split_triangle(v, &kept, Some(max_edge))
+                None if segments.is_empty() => Vec::new(),
+                None => split_triangle(v, segments, None),
+                Some(Base::Delaunay { max_edge }) if !segments.is_empty() || receiver() => {
+                    split_triangle(v, segments, Some(max_edge))
                 }
-                Some(Base::Regular { .. }) if !kept.is_empty() => split_regular(v, &kept, max_edge),
+                Some(Base::Regular { max_edge }) if !segments.is_empty() => {
+                    split_regular(v, segments, max_edge)
+                }
                 // Left whole: the mesh subdivides it (a receiver without
                 // lines on the regular base).
-                _ => Vec::new(),
+                Some(_) => Vec::new(),
             }
         })
         .collect()
@@ -88,7 +65,7 @@ pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<
 
 /// The part of segment `s` where its penumbra is at most `limit` wide (the
 /// width is linear along it), unless that is none of it.
-fn narrower_part(s: &Segment, limit: f32) -> Option<Segment> {
+pub(super) fn narrower_part(s: &Segment, limit: f32) -> Option<Segment> {
     let [wa, wb] = s.penumbra;
     if wa <= limit && wb <= limit {
         return Some(*s);
@@ -97,6 +74,12 @@ fn narrower_part(s: &Segment, limit: f32) -> Option<Segment> {
         return None;
     }
     let t = (limit - wa) / (wb - wa);
+    // A part a thousandth of the line long (one that only touches the
+    // limit, as a line from a contact does at 0) would be a lone point.
+    let kept = if wa <= limit { t } else { 1.0 - t };
+    if kept < 1e-3 {
+        return None;
+    }
     let [a, b] = s.ends;
     let cut = a + t * (b - a);
     Some(if wa <= limit {
@@ -438,6 +421,8 @@ mod tests {
             ..line
         };
         assert!(narrower_part(&wide, 1.0).is_none());
+        // Only touching the limit, as a line from a contact at limit 0.
+        assert!(narrower_part(&line, 0.0).is_none());
     }
 
     use super::*;
