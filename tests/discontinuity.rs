@@ -4,7 +4,7 @@
 //! beats a uniform one of as many elements.
 
 use glam::Vec3A;
-use tracelab::integrator::radiosity::RadiosityDisplay;
+use tracelab::integrator::radiosity::{Radiosity, RadiosityDisplay};
 use tracelab::integrator::{IntegratorKind, IntegratorOptions};
 use tracelab::radiosity::RadiositySolver;
 use tracelab::radiosity::discontinuity::{self, Event};
@@ -150,6 +150,33 @@ fn lines_know_their_penumbras_width_and_a_limit_keeps_the_narrow_ones() {
     );
 }
 
+/// The Cornell box by Gauss–Seidel with the smooth display, as `radiosity`
+/// otherwise says: the image (its mean), its elements and its masked RMSE
+/// against Mitsuba's path-traced reference.
+fn cornell_radiosity(radiosity: Radiosity) -> ([f64; 3], u64, f64) {
+    let options = IntegratorOptions {
+        radiosity: Radiosity {
+            solver: RadiositySolver::GaussSeidel,
+            display: RadiosityDisplay::Smooth,
+            ..radiosity
+        },
+        ..IntegratorOptions::of(IntegratorKind::Radiosity)
+    };
+    let (render, stats) = crate::common::render_with(
+        crate::common::cornell_box(),
+        options.build(),
+        tracelab::sampling::SamplerKind::Independent,
+        64,
+        0,
+        0,
+        64,
+    );
+    let reference = crate::common::reference("cornell_box_path_ref.exr");
+    let elements = stats.solver.map(|p| p.elements).unwrap_or(0);
+    let rmse = crate::radiosity::masked_rmse(&render.image, &reference);
+    (render.image.mean(), elements, rmse)
+}
+
 /// Gauss–Seidel on the Cornell box at patch size 0.15, smooth display,
 /// against Mitsuba's path-traced reference with the light's pixels left
 /// out. Solve and display are deterministic, so the bounds are the
@@ -159,33 +186,14 @@ fn lines_know_their_penumbras_width_and_a_limit_keeps_the_narrow_ones() {
 #[test]
 fn discontinuity_meshing_beats_a_uniform_mesh_of_as_many_elements_on_the_cornell_box() {
     let render = |discontinuity: bool| {
-        let options = IntegratorOptions {
-            radiosity: tracelab::integrator::radiosity::Radiosity {
-                solver: RadiositySolver::GaussSeidel,
-                patch_size: 0.15,
-                display: RadiosityDisplay::Smooth,
-                discontinuity,
-                ..Default::default()
-            },
-            ..IntegratorOptions::of(IntegratorKind::Radiosity)
-        };
-        crate::common::render_with(
-            crate::common::cornell_box(),
-            options.build(),
-            tracelab::sampling::SamplerKind::Independent,
-            64,
-            0,
-            0,
-            64,
-        )
+        cornell_radiosity(Radiosity {
+            patch_size: 0.15,
+            discontinuity,
+            ..Default::default()
+        })
     };
-    let reference = crate::common::reference("cornell_box_path_ref.exr");
-    let (uniform, uniform_stats) = render(false);
-    let (meshed, meshed_stats) = render(true);
-    let elements = |s: &tracelab::render::RenderStats| s.solver.map(|p| p.elements).unwrap_or(0);
-    let (n_uniform, n_meshed) = (elements(&uniform_stats), elements(&meshed_stats));
-    let uniform_rmse = crate::radiosity::masked_rmse(&uniform.image, &reference);
-    let meshed_rmse = crate::radiosity::masked_rmse(&meshed.image, &reference);
+    let (_, n_uniform, uniform_rmse) = render(false);
+    let (mean, n_meshed, meshed_rmse) = render(true);
     eprintln!(
         "uniform {n_uniform} elements {uniform_rmse:.5}, discontinuity {n_meshed} elements {meshed_rmse:.5}"
     );
@@ -197,7 +205,7 @@ fn discontinuity_meshing_beats_a_uniform_mesh_of_as_many_elements_on_the_cornell
         meshed_rmse < 0.00485 && meshed_rmse < uniform_rmse,
         "{meshed_rmse} against {uniform_rmse}"
     );
-    let (mean, expected) = (meshed.image.mean(), reference.mean());
+    let expected = crate::common::reference("cornell_box_path_ref.exr").mean();
     for c in 0..3 {
         assert!(
             (mean[c] / expected[c] - 1.0).abs() < 0.01,
@@ -225,47 +233,18 @@ fn discontinuity_meshing_beats_a_uniform_mesh_of_as_many_elements_on_the_cornell
 /// below.
 #[test]
 fn contact_lines_alone_beat_adaptive_subdivision_at_the_coarse_end() {
-    let render = |discontinuity: bool| {
-        let radiosity = tracelab::integrator::radiosity::Radiosity {
-            solver: RadiositySolver::GaussSeidel,
-            patch_size: 0.25,
-            display: RadiosityDisplay::Smooth,
-            ..Default::default()
-        };
-        let radiosity = if discontinuity {
-            tracelab::integrator::radiosity::Radiosity {
-                discontinuity: true,
-                max_penumbra: Some(0.0),
-                ..radiosity
-            }
-        } else {
-            tracelab::integrator::radiosity::Radiosity {
-                adaptive_rounds: 1,
-                adaptive_tolerance: 2.5,
-                ..radiosity
-            }
-        };
-        let options = IntegratorOptions {
-            radiosity,
-            ..IntegratorOptions::of(IntegratorKind::Radiosity)
-        };
-        crate::common::render_with(
-            crate::common::cornell_box(),
-            options.build(),
-            tracelab::sampling::SamplerKind::Independent,
-            64,
-            0,
-            0,
-            64,
-        )
-    };
-    let reference = crate::common::reference("cornell_box_path_ref.exr");
-    let (adaptive, adaptive_stats) = render(false);
-    let (meshed, meshed_stats) = render(true);
-    let elements = |s: &tracelab::render::RenderStats| s.solver.map(|p| p.elements).unwrap_or(0);
-    let (n_adaptive, n_meshed) = (elements(&adaptive_stats), elements(&meshed_stats));
-    let adaptive_rmse = crate::radiosity::masked_rmse(&adaptive.image, &reference);
-    let meshed_rmse = crate::radiosity::masked_rmse(&meshed.image, &reference);
+    let (_, n_adaptive, adaptive_rmse) = cornell_radiosity(Radiosity {
+        patch_size: 0.25,
+        adaptive_rounds: 1,
+        adaptive_tolerance: 2.5,
+        ..Default::default()
+    });
+    let (_, n_meshed, meshed_rmse) = cornell_radiosity(Radiosity {
+        patch_size: 0.25,
+        discontinuity: true,
+        max_penumbra: Some(0.0),
+        ..Default::default()
+    });
     eprintln!(
         "adaptive {n_adaptive} elements {adaptive_rmse:.5}, contact lines {n_meshed} elements {meshed_rmse:.5}"
     );
