@@ -41,6 +41,7 @@ mod meshed;
 mod settings;
 pub use meshed::Meshed;
 use meshed::discontinuity_mesh;
+pub use settings::RadiosityDisplay;
 
 /// Most elements (the form factor matrix of 16 384 elements takes 1 GiB).
 pub const MAX_ELEMENTS: usize = 16_384;
@@ -90,35 +91,6 @@ pub struct Radiosity {
     /// every line. Fewer lines cost fewer pieces, which pays at coarse meshes
     /// (docs/validation.md).
     pub max_penumbra: Option<f32>,
-}
-
-/// How the solution is shown.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum RadiosityDisplay {
-    /// Each element's constant radiance.
-    Flat,
-    /// Radiance interpolated from the elements' vertices.
-    Smooth,
-    /// Direct light sampled, indirect gathered from the solution.
-    #[default]
-    Gather,
-}
-
-impl RadiosityDisplay {
-    pub const ALL: [RadiosityDisplay; 3] = [
-        RadiosityDisplay::Flat,
-        RadiosityDisplay::Smooth,
-        RadiosityDisplay::Gather,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            RadiosityDisplay::Flat => "flat",
-            RadiosityDisplay::Smooth => "smooth",
-            RadiosityDisplay::Gather => "gather",
-        }
-    }
 }
 
 impl Technique for Radiosity {

@@ -1,7 +1,7 @@
-//! Radiosity's defaults and the checks of its settings (the technique's
-//! struct is its settings).
+//! Radiosity's defaults, the checks of its settings (the technique's
+//! struct is its settings) and how its solution is shown.
 
-use super::{Radiosity, RadiosityDisplay};
+use super::Radiosity;
 use crate::integrator::Settings;
 use crate::radiosity::{FormFactorMethod, RadiositySolver};
 
@@ -51,5 +51,34 @@ impl Settings for Radiosity {
             ));
         }
         Ok(())
+    }
+}
+
+/// How the solution is shown.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RadiosityDisplay {
+    /// Each element's constant radiance.
+    Flat,
+    /// Radiance interpolated from the elements' vertices.
+    Smooth,
+    /// Direct light sampled, indirect gathered from the solution.
+    #[default]
+    Gather,
+}
+
+impl RadiosityDisplay {
+    pub const ALL: [RadiosityDisplay; 3] = [
+        RadiosityDisplay::Flat,
+        RadiosityDisplay::Smooth,
+        RadiosityDisplay::Gather,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            RadiosityDisplay::Flat => "flat",
+            RadiosityDisplay::Smooth => "smooth",
+            RadiosityDisplay::Gather => "gather",
+        }
     }
 }
