@@ -61,6 +61,42 @@ pub struct Segment {
     pub penumbra: [f32; 2],
 }
 
+impl Segment {
+    /// The part of this segment where its penumbra is at most `limit` wide
+    /// (the width is linear along it), unless that is none of it.
+    fn narrower_part(&self, limit: f32) -> Option<Segment> {
+        let [wa, wb] = self.penumbra;
+        if wa <= limit && wb <= limit {
+            return Some(*self);
+        }
+        if wa > limit && wb > limit {
+            return None;
+        }
+        let t = (limit - wa) / (wb - wa);
+        // A part a thousandth of the line long (one that only touches the
+        // limit, as a line from a contact does at 0) would be a lone point.
+        let kept = if wa <= limit { t } else { 1.0 - t };
+        if kept < 1e-3 {
+            return None;
+        }
+        let [a, b] = self.ends;
+        let cut = a + t * (b - a);
+        Some(if wa <= limit {
+            Segment {
+                ends: [a, cut],
+                penumbra: [wa, limit],
+                ..*self
+            }
+        } else {
+            Segment {
+                ends: [cut, b],
+                penumbra: [limit, wb],
+                ..*self
+            }
+        })
+    }
+}
+
 /// The discontinuities of a scene's receivers.
 #[derive(Clone, Debug, Default)]
 pub struct Discontinuities {
@@ -85,11 +121,7 @@ impl Discontinuities {
             segments: self
                 .segments
                 .iter()
-                .map(|s| {
-                    s.iter()
-                        .filter_map(|s| triangulate::narrower_part(s, limit))
-                        .collect()
-                })
+                .map(|s| s.iter().filter_map(|s| s.narrower_part(limit)).collect())
                 .collect(),
             notes: self.notes.clone(),
             ..*self
@@ -594,4 +626,40 @@ fn snap_to_edges(v: [Vec3A; 3], p: Vec3A, apex: Vec3A, m: Vec3A, tolerance: f32)
         return x + t * (y - x);
     }
     p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_line_is_cut_where_its_penumbra_reaches_the_limit() {
+        // From a contact (width 0) to a 2 m wide penumbra: a limit of 1 m
+        // keeps the first half, 3 m all of it, and a line starting wider
+        // than the limit is dropped.
+        let line = Segment {
+            ends: [Vec3A::ZERO, Vec3A::new(4.0, 0.0, 0.0)],
+            event: Event::VertexEdge,
+            penumbra: [0.0, 2.0],
+        };
+        let half = line.narrower_part(1.0).unwrap();
+        assert!((half.ends[1] - Vec3A::new(2.0, 0.0, 0.0)).length() < 1e-6);
+        assert_eq!(half.ends[0], Vec3A::ZERO);
+        assert_eq!(half.penumbra, [0.0, 1.0]);
+        let reversed = Segment {
+            ends: [line.ends[1], line.ends[0]],
+            penumbra: [2.0, 0.0],
+            ..line
+        };
+        let tail = reversed.narrower_part(1.0).unwrap();
+        assert!((tail.ends[0] - Vec3A::new(2.0, 0.0, 0.0)).length() < 1e-6);
+        assert_eq!(line.narrower_part(3.0).unwrap().ends, line.ends);
+        let wide = Segment {
+            penumbra: [1.5, 2.0],
+            ..line
+        };
+        assert!(wide.narrower_part(1.0).is_none());
+        // Only touching the limit, as a line from a contact at limit 0.
+        assert!(line.narrower_part(0.0).is_none());
+    }
 }

@@ -52,9 +52,10 @@ pub(super) fn discontinuity_mesh(
 ) -> (Meshed, Vec<String>) {
     use crate::radiosity::discontinuity;
     let found = discontinuity::find(scene);
+    let total = found.count();
     let lines = match base {
         Some((_, Some(limit))) => found.narrower_than(limit),
-        _ => found.clone(),
+        _ => found,
     };
     let pieces = discontinuity::split(scene, &lines, base.map(|(b, _)| b));
     let corners: Vec<Vec<[glam::Vec3A; 3]>> = pieces
@@ -76,7 +77,7 @@ pub(super) fn discontinuity_mesh(
         .map(|v| flags.get(&key(v)).copied().unwrap_or_default())
         .collect();
     let count = lines.count();
-    let kept = if count == found.count() {
+    let kept = if count == total {
         String::new()
     } else {
         format!(" ({count} kept, in penumbrae narrower than the limit)")
@@ -91,7 +92,7 @@ pub(super) fn discontinuity_mesh(
         lines.wedges[1],
         lines.wedges[2],
         lines.rays,
-        found.count(),
+        total,
         pieces.iter().map(Vec::len).sum::<usize>(),
     ));
     (

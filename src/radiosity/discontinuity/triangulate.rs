@@ -63,40 +63,6 @@ pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<
         .collect()
 }
 
-/// The part of segment `s` where its penumbra is at most `limit` wide (the
-/// width is linear along it), unless that is none of it.
-pub(super) fn narrower_part(s: &Segment, limit: f32) -> Option<Segment> {
-    let [wa, wb] = s.penumbra;
-    if wa <= limit && wb <= limit {
-        return Some(*s);
-    }
-    if wa > limit && wb > limit {
-        return None;
-    }
-    let t = (limit - wa) / (wb - wa);
-    // A part a thousandth of the line long (one that only touches the
-    // limit, as a line from a contact does at 0) would be a lone point.
-    let kept = if wa <= limit { t } else { 1.0 - t };
-    if kept < 1e-3 {
-        return None;
-    }
-    let [a, b] = s.ends;
-    let cut = a + t * (b - a);
-    Some(if wa <= limit {
-        Segment {
-            ends: [a, cut],
-            penumbra: [wa, limit],
-            ..*s
-        }
-    } else {
-        Segment {
-            ends: [cut, b],
-            penumbra: [limit, wb],
-            ..*s
-        }
-    })
-}
-
 /// Triangle `v` cut into the regular elements of the mesh without lines
 /// (edges at most `max_edge`), each element that `segments` cross split
 /// along the part of them inside it.
@@ -394,36 +360,6 @@ fn split_triangle(v: [Vec3A; 3], segments: &[Segment], max_edge: Option<f32>) ->
 
 #[cfg(test)]
 mod tests {
-    #[test]
-    fn a_line_is_cut_where_its_penumbra_reaches_the_limit() {
-        // From a contact (width 0) to a 2 m wide penumbra: a limit of 1 m
-        // keeps the first half, 3 m all of it, and a line starting wider
-        // than the limit is dropped.
-        let line = Segment {
-            ends: [Vec3A::ZERO, Vec3A::new(4.0, 0.0, 0.0)],
-            event: Event::VertexEdge,
-            penumbra: [0.0, 2.0],
-        };
-        let half = narrower_part(&line, 1.0).unwrap();
-        assert!((half.ends[1] - Vec3A::new(2.0, 0.0, 0.0)).length() < 1e-6);
-        assert_eq!(half.ends[0], Vec3A::ZERO);
-        assert_eq!(half.penumbra, [0.0, 1.0]);
-        let reversed = Segment {
-            ends: [line.ends[1], line.ends[0]],
-            penumbra: [2.0, 0.0],
-            ..line
-        };
-        let tail = narrower_part(&reversed, 1.0).unwrap();
-        assert!((tail.ends[0] - Vec3A::new(2.0, 0.0, 0.0)).length() < 1e-6);
-        assert_eq!(narrower_part(&line, 3.0).unwrap().ends, line.ends);
-        let wide = Segment {
-            penumbra: [1.5, 2.0],
-            ..line
-        };
-        assert!(narrower_part(&wide, 1.0).is_none());
-        // Only touching the limit, as a line from a contact at limit 0.
-        assert!(narrower_part(&line, 0.0).is_none());
-    }
 
     use super::*;
     use crate::radiosity::discontinuity::Event;
