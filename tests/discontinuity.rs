@@ -150,6 +150,46 @@ fn lines_know_their_penumbras_width_and_a_limit_keeps_the_narrow_ones() {
     );
 }
 
+/// The limit is a length, so the lines kept do not depend on the scene's
+/// units: tests/data/penumbra.toml in metres, in millimetres and in units
+/// of 1/1024 m, with limits on both sides of its 0.5 m penumbrae. At the
+/// power of two the arithmetic is the same, and so are the pieces; at 1000
+/// rounding moves the traced lines, and spade's refinement makes other
+/// pieces (docs/validation.md, "Lines only where they pay").
+#[test]
+fn the_penumbra_limit_does_not_depend_on_the_scenes_units() {
+    use discontinuity::Base;
+    let input = |scale: f32| {
+        let path = crate::common::repo_path("tests/data/penumbra.toml");
+        let input = tracelab::scene::load::load_scene_file(&path, &Default::default()).unwrap();
+        Scene::build(tracelab::stress::transform(input, scale, Vec3A::ZERO)).unwrap()
+    };
+    let pieces = |scene: &Scene, scale: f32, limit: f32| {
+        let lines = discontinuity::find(scene).narrower_than(limit * scale);
+        let base = Base::Delaunay {
+            max_edge: 0.3 * scale,
+        };
+        let pieces = discontinuity::split(scene, &lines, Some(base));
+        (lines.count(), pieces.iter().map(Vec::len).sum::<usize>())
+    };
+    let metres = input(1.0);
+    for limit in [0.3, 0.7] {
+        let a = pieces(&metres, 1.0, limit);
+        let b = pieces(&input(1024.0), 1024.0, limit);
+        assert_eq!(
+            a, b,
+            "limit {limit} m: (segments, pieces) at scales 1 and 1024"
+        );
+        let (segments, _) = pieces(&input(1000.0), 1000.0, limit);
+        assert_eq!(segments, a.0, "limit {limit} m: segments in m and in mm");
+    }
+    assert_ne!(
+        pieces(&metres, 1.0, 0.3),
+        pieces(&metres, 1.0, 0.7),
+        "the limit changed nothing"
+    );
+}
+
 /// The Cornell box by Gauss–Seidel with the smooth display, as `radiosity`
 /// otherwise says: the image (its mean), its elements and its masked RMSE
 /// against Mitsuba's path-traced reference.
