@@ -129,9 +129,10 @@ impl Technique for Radiosity {
                     ", discontinuity meshing{}{}",
                     if regular { " on the regular mesh" } else { "" },
                     match self.max_penumbra {
-                        Some(m) if self.solver.matrix().is_some() =>
-                            format!(" (penumbrae narrower than {m} patches)"),
-                        _ => String::new(),
+                        _ if self.solver.matrix().is_none() => String::new(),
+                        Some(0.0) => " (contact lines only)".to_string(),
+                        Some(m) => format!(" (lines of penumbrae narrower than {m} patch sizes)"),
+                        None => String::new(),
                     }
                 ),
             },
