@@ -101,7 +101,7 @@ pub struct RadiosityFlags {
     /// line crosses (better at fine meshes, worse at coarse ones).
     #[arg(long)]
     lines_on_regular_mesh: bool,
-    /// Radiosity, matrix solvers, with --discontinuity-meshing: keep a
+    /// Radiosity, matrix solvers: discontinuity meshing that keeps a
     /// penumbra's boundary lines only where the penumbra is narrower than
     /// this many patch sizes (0: contact lines only) [default: every line].
     #[arg(long)]
@@ -155,7 +155,8 @@ impl RadiosityFlags {
             .unwrap_or(settings.adaptive_tolerance);
         settings.ambient |= self.ambient_term;
         settings.wireframe |= self.wireframe;
-        settings.discontinuity |= self.discontinuity_meshing || self.lines_on_regular_mesh;
+        settings.discontinuity |=
+            self.discontinuity_meshing || self.lines_on_regular_mesh || self.max_penumbra.is_some();
         settings.lines_on_regular_mesh |= self.lines_on_regular_mesh;
         settings.max_penumbra = self.max_penumbra.or(settings.max_penumbra);
         if let Some(display) = self.display {

@@ -128,8 +128,7 @@ impl Technique for Radiosity {
                 (true, regular) => format!(
                     ", discontinuity meshing{}{}",
                     if regular { " on the regular mesh" } else { "" },
-                    match self.max_penumbra {
-                        _ if self.solver.matrix().is_none() => String::new(),
+                    match self.max_penumbra.filter(|_| self.solver.matrix().is_some()) {
                         Some(0.0) => " (contact lines only)".to_string(),
                         Some(m) => format!(" (lines of penumbrae narrower than {m} patch sizes)"),
                         None => String::new(),
@@ -450,7 +449,14 @@ impl Radiosity {
                 };
                 (base, self.max_penumbra.map(|m| m * max_edge))
             });
-            let (meshed, notes) = discontinuity_mesh(scene, base);
+            let (meshed, mut notes) = discontinuity_mesh(scene, base);
+            if self.max_penumbra.is_some() && base.is_none() {
+                notes.push(
+                    "max penumbra ignored: the hierarchy keeps every line (it applies to the \
+                     matrix solvers' meshes)"
+                        .into(),
+                );
+            }
             (Some(meshed), notes)
         } else if let Some(flat) = flat {
             let note = format!(

@@ -360,7 +360,6 @@ fn split_triangle(v: [Vec3A; 3], segments: &[Segment], max_edge: Option<f32>) ->
 
 #[cfg(test)]
 mod tests {
-
     use super::*;
     use crate::radiosity::discontinuity::Event;
 
