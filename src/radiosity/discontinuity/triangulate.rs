@@ -80,7 +80,12 @@ fn split_regular(v: [Vec3A; 3], segments: &[Segment], max_edge: f32) -> Vec<Piec
     let mut inside = Vec::new();
     for element in elements {
         inside.clear();
-        inside.extend(segments.iter().filter_map(|s| clip(s, &element)));
+        inside.extend(
+            segments
+                .iter()
+                .filter(|s| !along_an_edge(s, &v))
+                .filter_map(|s| clip(s, &element)),
+        );
         if inside.is_empty() {
             pieces.push(Piece {
                 vertices: element,
@@ -91,6 +96,21 @@ fn split_regular(v: [Vec3A; 3], segments: &[Segment], max_edge: f32) -> Vec<Piec
         }
     }
     pieces
+}
+
+/// Whether segment `s` lies along one of triangle `v`'s edges (within a
+/// thousandth of its longest edge): a crease's contact line, which splits
+/// nothing.
+fn along_an_edge(s: &Segment, v: &[Vec3A; 3]) -> bool {
+    let tolerance = 1e-3 * crate::radiosity::mesh::longest_edge(v);
+    (0..3).any(|i| {
+        let (a, b) = (v[i], v[(i + 1) % 3]);
+        let direction = (b - a).normalize_or_zero();
+        s.ends.iter().all(|&p| {
+            let d = p - a;
+            (d - d.dot(direction) * direction).length() < tolerance
+        })
+    })
 }
 
 /// The part of segment `s` inside triangle `v` (both in one plane), unless
@@ -414,6 +434,23 @@ mod tests {
                 .fold((0.0f32, 0.0f32), |(l, h), &x| (l.min(x), h.max(x)));
             assert!(lo > -1e-5 || hi < 1e-5, "{p:?} straddles the line");
         }
+    }
+
+    #[test]
+    fn a_line_along_the_receivers_edge_leaves_its_regular_elements_whole() {
+        // A crease's contact line, traced a thousandth of the edge short
+        // of its corners (as on the Cornell box's walls): its ends, inside
+        // the corner elements' edges, used to split them for nothing (20
+        // pieces for a wall's 16 elements there).
+        let v = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
+        let crease = Segment {
+            ends: [Vec3A::new(1e-3, 0.0, 0.0), Vec3A::new(0.999, 0.0, 0.0)],
+            event: Event::VertexEdge,
+            penumbra: [0.0; 2],
+        };
+        let pieces = split_regular(v, &[crease], 0.3);
+        assert_eq!(pieces.len(), 64);
+        assert!(pieces.iter().all(|p| p.on_line == [false; 3]));
     }
 
     #[test]
