@@ -1,4 +1,5 @@
-//! Bitterli's Mitsuba 3 releases of Veach's scenes, as shipped in scenes/,
+//! Bitterli's Mitsuba 3 releases of Veach's scenes and his Cornell box, as
+//! shipped in scenes/,
 //! imported and rendered against Mitsuba 3 renders of the same files at the
 //! same resolution (tests/data/bitterli, from bench/references/bitterli.py)
 //! and against the Tungsten renders that ship with them, box-downsampled
@@ -107,4 +108,11 @@ fn veach_mis_matches_mitsuba_and_tungsten() {
 #[test]
 fn veach_bidir_matches_mitsuba_and_tungsten() {
     check("veach-bidir", 128, 128, 256);
+}
+
+#[test]
+fn cornell_box_matches_mitsuba_and_tungsten() {
+    // Bitterli's box (two cubes and rectangles, max_depth 30), not tracelab's
+    // measured one of scenes/cornell_box.toml.
+    check("cornell-box", 128, 128, 256);
 }

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""References for Bitterli's scenes shipped in scenes/ (veach-mis, veach-bidir).
+"""References for Bitterli's scenes shipped in scenes/ (veach-mis, veach-bidir,
+cornell-box).
 
 Renders each scene.xml with Mitsuba 3 (path tracer, the file's
 max_depth and tent filter) at the test's resolution, and
@@ -12,6 +13,7 @@ the same factor).
 
     pip install mitsuba numpy      # and apt-get install libllvm19
     python3 bench/references/bitterli.py --tungsten DIR   # DIR/<scene>/TungstenRender.exr
+        [--scenes cornell-box,...]                        # only these
 
 The Tungsten renders come with Bitterli's scene archives
 (https://benedikt-bitterli.me/resources/); they are not in this repository.
@@ -27,17 +29,23 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
 OUT = os.path.join(REPO, "tests", "data", "bitterli")
 # name: (width, height, downsampling factor of the Tungsten render, spp)
-SCENES = {"veach-mis": (160, 90, 8, 4096), "veach-bidir": (128, 128, 8, 4096)}
+SCENES = {
+    "veach-mis": (160, 90, 8, 4096),
+    "veach-bidir": (128, 128, 8, 4096),
+    "cornell-box": (128, 128, 8, 4096),
+}
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--tungsten", help="folder with <scene>/TungstenRender.exr")
     ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--scenes", default=",".join(SCENES), help="comma-separated")
     args = ap.parse_args()
     mi.set_variant(args.variant)
     os.makedirs(OUT, exist_ok=True)
-    for name, (w, h, factor, spp) in SCENES.items():
+    for name in args.scenes.split(","):
+        w, h, factor, spp = SCENES[name]
         path = os.path.join(REPO, "scenes", name, "scene.xml")
         scene = mi.load_file(path, integrator="path", resx=w, resy=h, spp=spp)
         # Independent passes: their spread gives the variance of the mean.
