@@ -42,7 +42,7 @@ import mitsuba as mi  # noqa: E402
 import numpy as np  # noqa: E402
 
 REPO = os.path.dirname(os.path.dirname(HERE))
-SCENES = {"veach-mis": (640, 360), "veach-bidir": (512, 512)}
+SCENES = {"veach-mis": (640, 360), "veach-bidir": (512, 512), "cornell-box": (512, 512)}
 
 
 def main():
@@ -52,7 +52,7 @@ def main():
     ap.add_argument("--variant", default="llvm_ad_rgb")
     ap.add_argument("--extra", nargs="*", default=[])
     ap.add_argument("--rmse", action="store_true", help="time to equal RMSE instead (see above)")
-    ap.add_argument("--rmse-size", default="veach-mis=320x180,veach-bidir=128x128")
+    ap.add_argument("--rmse-size", default="veach-mis=320x180,veach-bidir=128x128,cornell-box=128x128")
     ap.add_argument("--reference-spp", type=int, default=8192)
     ap.add_argument("--max-spp", type=int, default=1024)
     args = ap.parse_args()
