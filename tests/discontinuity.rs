@@ -267,16 +267,17 @@ fn discontinuity_meshing_beats_a_uniform_mesh_of_as_many_elements_on_the_cornell
 /// 9% low without lines, the ceiling beside the shade dark with both).
 /// The coarse end of issue 39's Must 3 (docs/validation.md): contact lines
 /// only (`max_penumbra` 0) at patch size 0.25 make 278 elements; adaptive
-/// subdivision's best mesh of at most as many in the grid there is one round
-/// from 0.25 at tolerance 2.5 (263 elements). Deterministic, as above: the
-/// measured figures are 0.00964 against 0.01050, and the test asks for 5%
-/// below.
+/// subdivision's best mesh of at most as many in the grid there (patch
+/// sizes 0.15-0.5, up to two rounds, tolerances 1-4) is one round from 0.4
+/// at tolerance 2.2 (266 elements). Deterministic, as above: the measured
+/// figures are 0.00964 against 0.01020 (5.5% below), and the test asks
+/// for 2% below.
 #[test]
 fn contact_lines_alone_beat_adaptive_subdivision_at_the_coarse_end() {
     let (_, n_adaptive, adaptive_rmse) = cornell_radiosity(Radiosity {
-        patch_size: 0.25,
+        patch_size: 0.4,
         adaptive_rounds: 1,
-        adaptive_tolerance: 2.5,
+        adaptive_tolerance: 2.2,
         ..Default::default()
     });
     let (_, n_meshed, meshed_rmse) = cornell_radiosity(Radiosity {
@@ -293,7 +294,7 @@ fn contact_lines_alone_beat_adaptive_subdivision_at_the_coarse_end() {
         "{n_meshed} against {n_adaptive} elements"
     );
     assert!(
-        meshed_rmse < 0.95 * adaptive_rmse,
+        meshed_rmse < 0.98 * adaptive_rmse,
         "{meshed_rmse} against {adaptive_rmse}"
     );
 }
