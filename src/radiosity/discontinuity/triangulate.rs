@@ -67,6 +67,7 @@ pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<
 /// (edges at most `max_edge`), each element that `segments` cross split
 /// along the part of them inside it.
 fn split_regular(v: [Vec3A; 3], segments: &[Segment], max_edge: f32) -> Vec<Piece> {
+    let lines: Vec<&Segment> = segments.iter().filter(|s| !along_an_edge(s, &v)).collect();
     let longest = crate::radiosity::mesh::longest_edge(&v);
     let depth = crate::radiosity::mesh::depth_for(longest, max_edge);
     let mut elements = vec![v];
@@ -80,12 +81,7 @@ fn split_regular(v: [Vec3A; 3], segments: &[Segment], max_edge: f32) -> Vec<Piec
     let mut inside = Vec::new();
     for element in elements {
         inside.clear();
-        inside.extend(
-            segments
-                .iter()
-                .filter(|s| !along_an_edge(s, &v))
-                .filter_map(|s| clip(s, &element)),
-        );
+        inside.extend(lines.iter().filter_map(|s| clip(s, &element)));
         if inside.is_empty() {
             pieces.push(Piece {
                 vertices: element,
