@@ -13,6 +13,7 @@ pub mod convergence;
 pub mod error;
 pub mod film;
 pub mod filter;
+pub mod heap;
 pub mod image;
 pub mod integrator;
 pub mod lab;

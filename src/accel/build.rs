@@ -314,7 +314,9 @@ impl Geometry {
     }
 
     /// Stores `packed`'s triangle `order[i]` as triangle i, one array at
-    /// a time on every core, each source array dropped once read.
+    /// a time on every core, each source array dropped once read and its
+    /// pages returned (from the heap during a load, [`crate::heap`], they
+    /// would otherwise stay through the peak).
     fn store_in_order(&mut self, packed: Packed, order: &[usize]) {
         let Packed {
             corners,
@@ -322,17 +324,27 @@ impl Geometry {
             uvs,
             normals,
         } = packed;
+        // A trim walks the arenas: worth it only for arrays of megabytes.
+        let large = order.len() >= 1 << 16;
+        let release = || {
+            if large {
+                crate::heap::release_free_pages();
+            }
+        };
         let order = || order.par_iter().with_min_len(4096);
         self.tri_vertices = order().map(|&i| corners[i].get()).collect();
         drop(corners);
+        release();
         self.tri_shading = (order().zip(&self.tri_vertices))
             .map(|(&i, v)| TriangleShading::new(v, materials[i]))
             .collect();
         drop(materials);
+        release();
         if self.keep_uvs {
             self.tri_uvs = order().map(|&i| uvs[i]).collect();
         }
         drop(uvs);
+        release();
         if self.keep_normals {
             self.tri_normals = order().map(|&i| normals[i].map(Vec3A::from)).collect();
         }

@@ -271,6 +271,7 @@ impl Scene {
 
     /// Loads a scene file of any format ([`load::load_any`]).
     pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene> {
+        let _reuse = crate::heap::HeapReuse::begin();
         Scene::build(load::load_any(path, options)?)
     }
 

@@ -121,25 +121,6 @@ impl Prefetched {
     }
 }
 
-/// Returns the memory of the meshes the walk has consumed to the system.
-/// They were decoded on worker threads, so glibc freed them into those
-/// threads' arenas, where the BVH build on this thread cannot reuse them:
-/// on a scene of a million triangles, 165 MB held through the build's peak
-/// (docs/performance.md, "Loading and memory").
-pub(super) fn release_freed_memory() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    {
-        unsafe extern "C" {
-            fn malloc_trim(pad: usize) -> std::ffi::c_int;
-        }
-        // SAFETY: glibc's malloc_trim only returns free pages of its arenas
-        // to the system; it touches no live allocation.
-        unsafe {
-            malloc_trim(0);
-        }
-    }
-}
-
 enum Decoded {
     Bitmap(Key, Arc<Bitmap>),
     Mesh(MeshFile, MeshData),
