@@ -175,7 +175,8 @@ pub const SPHERE_LIST_MAX: usize = 8;
 /// Largest mesh tested without a BVH. `cargo bench --bench throughput --
 /// rays` (closest hit, incoherent, one thread): on the 32-triangle Cornell
 /// box the soup does 13.1 M rays/s, the 8-wide BVH 9.9 M. The two met at
-/// about this size when the BVH was obvhs's CWBVH; not re-measured since.
+/// about this size when the BVH was obvhs's CWBVH; with the 8-wide nodes
+/// they meet at 40–50 (docs/performance.md, "Traversal and the BVH").
 pub const SOUP_MAX_TRIANGLES: usize = 64;
 
 /// The scene's geometry with its acceleration structures.
