@@ -14,9 +14,12 @@
 
 /// While alive, large allocations come from the heap, not fresh mappings;
 /// dropped, the default returns and the free pages go back to the system.
+/// The setting is the process's: a load that ends first restores it for
+/// one still running, which then only loads as before.
 pub struct HeapReuse(());
 
 impl HeapReuse {
+    #[must_use = "the default returns when this is dropped"]
     pub fn begin() -> HeapReuse {
         // Above any one array of the largest scene allowed.
         set_mmap_threshold(1 << 30);
