@@ -21,16 +21,21 @@ pub struct HeapReuse(());
 impl HeapReuse {
     #[must_use = "the default returns when this is dropped"]
     pub fn begin() -> HeapReuse {
-        // Above any one array of the largest scene allowed.
-        set_mmap_threshold(1 << 30);
+        // Above any one array of the largest scene allowed; the trim
+        // threshold glibc's default (a higher one held 90 MB more through
+        // the kitchen's peak).
+        set_thresholds(1 << 30, 128 << 10);
         HeapReuse(())
     }
 }
 
 impl Drop for HeapReuse {
     fn drop(&mut self) {
-        // glibc's initial threshold (it stops adapting once set).
-        set_mmap_threshold(128 << 10);
+        // Where glibc's own thresholds end after a large block is freed
+        // (the mmap threshold rises to at most 32 MiB, the trim threshold
+        // to twice that); once set they no longer adapt, and a fixed
+        // 128 KiB would map and fault every later buffer above it anew.
+        set_thresholds(32 << 20, 64 << 20);
         release_free_pages();
     }
 }
@@ -41,18 +46,21 @@ unsafe extern "C" {
     fn mallopt(param: std::ffi::c_int, value: std::ffi::c_int) -> std::ffi::c_int;
 }
 
-fn set_mmap_threshold(bytes: i32) {
+/// glibc's mmap and trim thresholds, in bytes.
+fn set_thresholds(mmap: i32, trim: i32) {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     {
+        const M_TRIM_THRESHOLD: std::ffi::c_int = -1;
         const M_MMAP_THRESHOLD: std::ffi::c_int = -3;
-        // SAFETY: mallopt only changes a tuning parameter under the
+        // SAFETY: mallopt only changes tuning parameters under the
         // allocator's lock; no allocation is touched.
         unsafe {
-            mallopt(M_MMAP_THRESHOLD, bytes);
+            mallopt(M_MMAP_THRESHOLD, mmap);
+            mallopt(M_TRIM_THRESHOLD, trim);
         }
     }
     #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-    let _ = bytes;
+    let _ = (mmap, trim);
 }
 
 /// Returns the free pages of every arena to the system: memory freed on
