@@ -13,17 +13,18 @@
 //! are no-ops.
 
 /// While alive, large allocations come from the heap, not fresh mappings;
-/// dropped, the default returns and the free pages go back to the system.
+/// dropped, the thresholds are left as glibc's own would be after a large
+/// load, and the free pages go back to the system.
 /// The setting is the process's: a load that ends first restores it for
 /// one still running, which then only loads as before.
 pub struct HeapReuse(());
 
 impl HeapReuse {
-    #[must_use = "the default returns when this is dropped"]
+    #[must_use = "the thresholds are reset when this is dropped"]
     pub fn begin() -> HeapReuse {
         // Above any one array of the largest scene allowed; the trim
-        // threshold glibc's default (a higher one held 90 MB more through
-        // the kitchen's peak).
+        // threshold glibc's default, as measured (the explicit trims
+        // return what the peak must not hold).
         set_thresholds(1 << 30, 128 << 10);
         HeapReuse(())
     }
