@@ -456,8 +456,13 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         settings.integrator,
         Integrator::Camera(CameraIntegrator::Path(_) | CameraIntegrator::Whitted(_))
     ) {
-        let mut skipped = session.scene().features.skipped();
-        if !session.scene().lights.has_choice() {
+        let whitted = matches!(
+            settings.integrator,
+            Integrator::Camera(CameraIntegrator::Whitted(_))
+        );
+        let scene = session.scene();
+        let mut skipped = scene.features.skipped(whitted, scene.geometry.is_plain());
+        if !scene.lights.has_choice() {
             skipped.push("light choice (one light)");
         }
         if matches!(settings.integrator, Integrator::Camera(e) if e.is_general()) {

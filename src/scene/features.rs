@@ -87,18 +87,24 @@ impl Features {
         !self.specular() && !self.glossy && !self.rich_materials
     }
 
-    /// What the specialised code paths leave out, for render summaries.
-    pub fn skipped(&self) -> Vec<&'static str> {
+    /// What the code specialised for this scene leaves out, for render
+    /// summaries: only what the technique's code really skips (`whitted`:
+    /// Whitted's, else path tracing's), since a line that names a skip the
+    /// code does not make misleads whoever reads the summary to measure it.
+    /// `plain`: the geometry is [`Geometry::is_plain`].
+    pub fn skipped(&self, whitted: bool, plain: bool) -> Vec<&'static str> {
         let mut v = Vec::new();
-        if !self.dielectric {
-            v.push("refraction");
-            v.push("transparent-shadow tests");
-        }
-        if self.diffuse_only() {
-            v.push("specular-bounce branches and non-Lambertian BSDF code");
-        }
-        if !self.point_lights {
-            v.push("point lights");
+        if whitted {
+            if !self.dielectric {
+                v.push("walks of tinted shadow rays through glass (no glass)");
+            }
+        } else {
+            if self.diffuse_only() {
+                v.push("specular-bounce branches and non-Lambertian BSDF code");
+            }
+            if plain {
+                v.push("mask, instance and moving-object tests");
+            }
         }
         if !self.spheres {
             v.push("sphere intersection");
