@@ -115,3 +115,43 @@ impl Features {
         v
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_skipped_list_is_the_techniques_own() {
+        // A Lambertian static scene without spheres or glass.
+        let f = Features::default();
+        let path = f.skipped(false, true);
+        assert!(path.contains(&"specular-bounce branches and non-Lambertian BSDF code"));
+        assert!(path.contains(&"mask, instance and moving-object tests"));
+        assert!(!path.iter().any(|s| s.contains("glass")), "{path:?}");
+        // Masks or instances: the plain loop does not run.
+        assert!(!f.skipped(false, false).iter().any(|s| s.contains("mask")));
+        let whitted = f.skipped(true, true);
+        assert!(whitted.iter().any(|s| s.contains("through glass")));
+        assert!(
+            !whitted
+                .iter()
+                .any(|s| s.contains("Lambertian") || s.contains("mask"))
+        );
+        let glass = Features {
+            dielectric: true,
+            ..f
+        };
+        assert!(
+            !glass
+                .skipped(true, true)
+                .iter()
+                .any(|s| s.contains("glass"))
+        );
+        assert!(
+            !glass
+                .skipped(false, true)
+                .iter()
+                .any(|s| s.contains("Lambertian"))
+        );
+    }
+}
