@@ -108,7 +108,7 @@ fn instantaneous_shutter_has_no_time_dimension() {
     assert!(
         scene
             .features
-            .skipped(false, scene.geometry.is_plain())
+            .skipped(false, false, scene.geometry.is_plain())
             .contains(&"time dimension (static scene)")
     );
     // At time 0 the sphere is 5 units off the axis: nothing is blocked.

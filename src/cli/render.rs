@@ -460,15 +460,23 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
             settings.integrator,
             Integrator::Camera(CameraIntegrator::Whitted(_))
         );
+        let general = matches!(settings.integrator, Integrator::Camera(e) if e.is_general());
         let scene = session.scene();
-        let mut skipped = scene.features.skipped(whitted, scene.geometry.is_plain());
+        let mut skipped = scene
+            .features
+            .skipped(whitted, general, scene.geometry.is_plain());
         if !scene.lights.has_choice() {
             skipped.push("light choice (one light)");
         }
-        if matches!(settings.integrator, Integrator::Camera(e) if e.is_general()) {
-            eprintln!("general code (--general): nothing skipped");
+        let what = if general {
+            "general code (--general)"
         } else {
-            eprintln!("specialised for this scene: skipped {}", skipped.join(", "));
+            "specialised for this scene"
+        };
+        if skipped.is_empty() {
+            eprintln!("{what}: nothing skipped");
+        } else {
+            eprintln!("{what}: skipped {}", skipped.join(", "));
         }
     }
     for line in session.shortcut_report() {

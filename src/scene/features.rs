@@ -91,26 +91,27 @@ impl Features {
     /// summaries: only what the technique's code really skips (`whitted`:
     /// Whitted's, else path tracing's), since a line that names a skip the
     /// code does not make misleads whoever reads the summary to measure it.
+    /// `general` (`--general`) turns off the skips made by feature
+    /// detection; those the geometry and lights make themselves stay.
     /// `plain`: the geometry is [`Geometry::is_plain`].
-    pub fn skipped(&self, whitted: bool, plain: bool) -> Vec<&'static str> {
+    pub fn skipped(&self, whitted: bool, general: bool, plain: bool) -> Vec<&'static str> {
         let mut v = Vec::new();
-        if whitted {
-            if !self.dielectric {
+        if !general {
+            if whitted && !self.dielectric {
                 v.push("walks of tinted shadow rays through glass (no glass)");
             }
-        } else {
-            if self.diffuse_only() {
+            if !whitted && self.diffuse_only() {
                 v.push("specular-bounce branches and non-Lambertian BSDF code");
             }
-            if plain {
-                v.push("mask, instance and moving-object tests");
+            if !self.motion {
+                v.push("time dimension (static scene)");
             }
+        }
+        if !whitted && plain {
+            v.push("mask, instance and moving-object tests");
         }
         if !self.spheres {
             v.push("sphere intersection");
-        }
-        if !self.motion {
-            v.push("time dimension (static scene)");
         }
         v
     }
@@ -124,18 +125,31 @@ mod tests {
     fn the_skipped_list_is_the_techniques_own() {
         // A Lambertian static scene without spheres or glass.
         let f = Features::default();
-        let path = f.skipped(false, true);
+        let path = f.skipped(false, false, true);
         assert!(path.contains(&"specular-bounce branches and non-Lambertian BSDF code"));
         assert!(path.contains(&"mask, instance and moving-object tests"));
         assert!(!path.iter().any(|s| s.contains("glass")), "{path:?}");
         // Masks or instances: the plain loop does not run.
-        assert!(!f.skipped(false, false).iter().any(|s| s.contains("mask")));
-        let whitted = f.skipped(true, true);
+        assert!(
+            !f.skipped(false, false, false)
+                .iter()
+                .any(|s| s.contains("mask"))
+        );
+        let whitted = f.skipped(true, false, true);
         assert!(whitted.iter().any(|s| s.contains("through glass")));
         assert!(
             !whitted
                 .iter()
                 .any(|s| s.contains("Lambertian") || s.contains("mask"))
+        );
+        // --general: feature detection's skips go, the geometry's stay.
+        let general = f.skipped(false, true, true);
+        assert_eq!(
+            general,
+            [
+                "mask, instance and moving-object tests",
+                "sphere intersection"
+            ]
         );
         let glass = Features {
             dielectric: true,
@@ -143,13 +157,13 @@ mod tests {
         };
         assert!(
             !glass
-                .skipped(true, true)
+                .skipped(true, false, true)
                 .iter()
                 .any(|s| s.contains("glass"))
         );
         assert!(
             !glass
-                .skipped(false, true)
+                .skipped(false, false, true)
                 .iter()
                 .any(|s| s.contains("Lambertian"))
         );
