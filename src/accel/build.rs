@@ -8,12 +8,37 @@ use obvhs::BvhBuildParams;
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
-use obvhs::ploc::PlocBuilder;
+use obvhs::ploc::{PlocBuilder, PlocSearchDistance};
 use rayon::prelude::*;
 
-fn build_params() -> BvhBuildParams {
-    BvhBuildParams::medium_build()
+/// obvhs's `medium_build` for `count` primitives; above
+/// [`LARGE_TREE`], with `fast_build`'s shorter PLOC search and at most
+/// [`REINSERTION_MAX_CANDIDATES`] reinsertions a batch. On the kitchen
+/// (1.05M triangles) and a million-triangle sphere the trees' SAH cost
+/// stayed where it was and the build took 0.15 s less; smaller trees keep
+/// the preset, as the living-room rendered no faster with the shorter
+/// search (docs/performance.md, "Loading and memory").
+fn build_params(count: usize) -> BvhBuildParams {
+    let medium = BvhBuildParams::medium_build();
+    if count < LARGE_TREE {
+        return medium;
+    }
+    BvhBuildParams {
+        ploc_search_distance: PlocSearchDistance::Low,
+        search_depth_threshold: 2,
+        reinsertion_batch_ratio: (medium.reinsertion_batch_ratio)
+            .min(REINSERTION_MAX_CANDIDATES / (2 * count) as f32),
+        ..medium
+    }
 }
+
+/// Primitives from which a tree is built with [`build_params`]'s cheaper
+/// settings.
+const LARGE_TREE: usize = 500_000;
+
+/// Reinsertion's candidates per batch at most, for a large tree (a binary
+/// tree has about two nodes a primitive).
+const REINSERTION_MAX_CANDIDATES: f32 = 40_000.0;
 
 /// obvhs traverses a CWBVH with a stack of this many entries; a deeper tree
 /// would silently lose nodes (its push saturates).
@@ -32,7 +57,11 @@ fn cwbvh_depth(bvh: &CwBvh, node: usize) -> u32 {
 
 /// obvhs's binary BVH over `prims`: PLOC, then reinsertion.
 pub(super) fn build_bvh2<T: obvhs::Boundable>(prims: &[T]) -> Bvh2 {
-    let params = build_params();
+    build_bvh2_with(prims, build_params(prims.len()))
+}
+
+/// [`build_bvh2`] with `params`' PLOC search and reinsertion.
+fn build_bvh2_with<T: obvhs::Boundable>(prims: &[T], params: BvhBuildParams) -> Bvh2 {
     // `new`, not `with_capacity`: that sizes the Morton codes' buffer for
     // 128-bit codes, twice what the 64-bit sort uses.
     let mut bvh2 = PlocBuilder::new().build(
@@ -69,7 +98,7 @@ pub(super) fn build_wide_bvh_with<T: obvhs::Boundable>(
 /// traverse. The steps of obvhs's `build_cwbvh`, without its debug-build
 /// validation, which panics on such a tree where this returns None.
 pub(super) fn build_shallow_cwbvh(aabbs: &[Aabb]) -> Option<CwBvh> {
-    let params = build_params();
+    let params = build_params(aabbs.len());
     let bvh2 = build_bvh2(aabbs);
     let bvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
     (bvh.nodes.is_empty() || cwbvh_depth(&bvh, 0) < CWBVH_STACK_DEPTH).then_some(bvh)
@@ -424,5 +453,68 @@ impl Packed {
         packed.uvs.reverse();
         packed.normals.reverse();
         packed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// SAH cost of a binary tree: its nodes' areas relative to the root's,
+    /// a leaf's counted once for each of its primitives.
+    fn sah(bvh: &Bvh2) -> f64 {
+        let root = f64::from(bvh.nodes[0].aabb().half_area());
+        let weight = |n: &obvhs::bvh2::node::Bvh2Node| match n.is_leaf() {
+            true => f64::from(n.prim_count),
+            false => 1.0,
+        };
+        (bvh.nodes.iter())
+            .map(|n| f64::from(n.aabb().half_area()) * weight(n))
+            .sum::<f64>()
+            / root
+    }
+
+    /// A large tree's cheaper settings build as good a tree as the preset,
+    /// on 600 000 triangles of a sphere in a box (the kitchen's and a
+    /// million-triangle sphere's costs moved by under 0.3%): a tree 1%
+    /// worse would fail.
+    #[test]
+    fn a_large_trees_cheaper_build_costs_no_sah() {
+        let (rings, segments) = (400, 750);
+        let point = |i: usize, j: usize| {
+            let theta = std::f32::consts::PI * i as f32 / rings as f32;
+            let phi = std::f32::consts::TAU * j as f32 / segments as f32;
+            Vec3A::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            )
+        };
+        let mut aabbs = Vec::new();
+        for i in 0..rings {
+            for j in 0..segments {
+                let quad = [
+                    point(i, j),
+                    point(i + 1, j),
+                    point(i + 1, j + 1),
+                    point(i, j + 1),
+                ];
+                aabbs.push(Aabb::from_points(&[quad[0], quad[1], quad[2]]));
+                aabbs.push(Aabb::from_points(&[quad[0], quad[2], quad[3]]));
+            }
+        }
+        // The box's six walls.
+        for (axis, side) in (0..3).flat_map(|axis| [(axis, -3.0), (axis, 3.0)]) {
+            let (mut lo, mut hi) = (Vec3A::splat(-3.0), Vec3A::splat(3.0));
+            (lo[axis], hi[axis]) = (side, side);
+            aabbs.push(Aabb::new(lo, hi));
+        }
+        assert!(aabbs.len() >= LARGE_TREE);
+        let cheaper = sah(&build_bvh2(&aabbs));
+        let preset = sah(&build_bvh2_with(&aabbs, BvhBuildParams::medium_build()));
+        assert!(
+            cheaper < 1.01 * preset,
+            "SAH {cheaper} against the preset's {preset}"
+        );
     }
 }

@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::math::Rgb;
 use crate::scene::light::LightSampling;
 use glam::{Mat3A, Mat4, Vec3A};
+use rayon::prelude::*;
 use std::path::Path;
 
 /// Looks at the bounding box from the front (+z, y up), all of it in view.
@@ -36,11 +37,13 @@ pub fn bounds(
     spheres: &[Sphere],
     instances: &super::InstancesInput,
 ) -> Option<(Vec3A, Vec3A)> {
-    let mut lo = Vec3A::splat(f32::INFINITY);
-    let mut hi = Vec3A::splat(f32::NEG_INFINITY);
-    for v in triangles.iter().flat_map(|t| t.vertices) {
-        (lo, hi) = (lo.min(v), hi.max(v));
-    }
+    let empty = || (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY));
+    let (mut lo, mut hi) = (triangles.par_iter().with_min_len(1 << 12))
+        .fold(empty, |(lo, hi), t| {
+            let [a, b, c] = t.vertices;
+            (lo.min(a).min(b).min(c), hi.max(a).max(b).max(c))
+        })
+        .reduce(empty, |(a, b), (c, d)| (a.min(c), b.max(d)));
     for (_, v) in instances.placed_corners().flatten().flatten() {
         (lo, hi) = (lo.min(v), hi.max(v));
     }

@@ -519,6 +519,10 @@ impl<'a> Importer<'a> {
     /// tracelab's camera does not: a note for each that the scene's box
     /// crosses, by depth along the view (Mitsuba clips by depth).
     fn clipping(&self, camera: &Camera, (near, far): (Option<f32>, Option<f32>)) -> Vec<String> {
+        // The box is a pass over every triangle: only where a clip is given.
+        if near.is_none() && far.is_none() {
+            return Vec::new();
+        }
         let Some((lo, hi)) =
             super::framing::bounds(&self.triangles, &self.spheres, &self.instances)
         else {
