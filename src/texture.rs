@@ -52,6 +52,37 @@ enum Texels {
     Floats(Vec<[f32; 3]>),
 }
 
+/// Side of the square tiles texels are stored in. A bilinear lookup reads
+/// two rows; stored row-major, a wide image's rows lie kilobytes apart and
+/// each lookup missed the cache twice (28% of BDPT's time on a glTF
+/// asset's 2048² textures); an 8 × 8 tile of bytes is three cache lines
+/// (docs/performance.md, "Bidirectional techniques"). Float images are
+/// kept row-major ([`Bitmap::new`]).
+const TILE: usize = 8;
+
+/// `row_major` (`channels` values a texel, `width` × `height` texels,
+/// row-major from the top row) in tiles of [`TILE`] × [`TILE`], the
+/// partial tiles at the right and bottom edges padded.
+fn tiled<T: Copy + Default>(
+    row_major: &[T],
+    channels: usize,
+    width: usize,
+    height: usize,
+) -> Vec<T> {
+    let (across, down) = (width.div_ceil(TILE), height.div_ceil(TILE));
+    let mut out = vec![T::default(); across * down * TILE * TILE * channels];
+    for y in 0..height {
+        for tile_x in 0..across {
+            let (x0, x1) = (tile_x * TILE, (tile_x * TILE + TILE).min(width));
+            let to = ((y / TILE) * across + tile_x) * (TILE * TILE) + (y % TILE) * TILE;
+            let from = y * width + x0;
+            out[to * channels..(to + x1 - x0) * channels]
+                .copy_from_slice(&row_major[from * channels..(y * width + x1) * channels]);
+        }
+    }
+    out
+}
+
 /// The affine map from a surface's texture coordinates to the texture's:
 /// uv · scale + offset (Mitsuba's `to_uv` with a scale and a translation).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -185,7 +216,17 @@ impl Texture {
 }
 
 impl Bitmap {
+    /// A bitmap of `texels` given row-major from the top row; bytes are
+    /// stored in tiles ([`TILE`]). Floats stay as given: an EXR sky of
+    /// 62 MiB took 0.05 s longer to load tiled, for no faster render.
     fn new(width: usize, height: usize, texels: Texels) -> Bitmap {
+        let texels = match texels {
+            Texels::Bytes { bytes, decode } => Texels::Bytes {
+                bytes: tiled(&bytes, 3, width, height),
+                decode,
+            },
+            floats => floats,
+        };
         Bitmap {
             width,
             height,
@@ -198,8 +239,21 @@ impl Bitmap {
     pub fn mean(&self) -> Rgb {
         *self.mean.get_or_init(|| {
             let n = self.width * self.height;
-            (0..n).map(|i| self.at_index(i)).sum::<Rgb>() / n.max(1) as f32
+            self.row_major().sum::<Rgb>() / n.max(1) as f32
         })
+    }
+
+    /// Every texel, row-major from the top row, linear.
+    fn row_major(&self) -> impl Iterator<Item = Rgb> + '_ {
+        (0..self.height).flat_map(move |y| (0..self.width).map(move |x| self.at(x, y)))
+    }
+
+    /// Where byte texel (`x`, `y`) is stored: tiles row-major, texels
+    /// row-major within a tile.
+    #[inline]
+    fn tiled_index(&self, x: usize, y: usize) -> usize {
+        let tiles_across = self.width.div_ceil(TILE);
+        ((y / TILE) * tiles_across + x / TILE) * (TILE * TILE) + (y % TILE) * TILE + x % TILE
     }
 
     /// Reads an image (PNG, JPEG, TGA, EXR, HDR, by extension). 8- and
@@ -290,8 +344,8 @@ impl Bitmap {
     pub fn first_channel_range(&self) -> (f32, f32, f32) {
         let n = self.width * self.height;
         let (mut lo, mut hi, mut sum) = (f32::INFINITY, f32::NEG_INFINITY, 0.0f64);
-        for i in 0..n {
-            let v = self.at_index(i).x;
+        for texel in self.row_major() {
+            let v = texel.x;
             (lo, hi, sum) = (lo.min(v), hi.max(v), sum + f64::from(v));
         }
         (lo, hi, (sum / n.max(1) as f64) as f32)
@@ -341,23 +395,20 @@ impl Bitmap {
         )
     }
 
-    /// Texel number `i` (row-major from the top row), linear.
-    #[inline]
-    pub fn at_index(&self, i: usize) -> Rgb {
-        match &self.texels {
-            Texels::Bytes { bytes, decode } => Rgb::new(
-                decode[bytes[3 * i] as usize],
-                decode[bytes[3 * i + 1] as usize],
-                decode[bytes[3 * i + 2] as usize],
-            ),
-            Texels::Floats(texels) => Rgb::from_array(texels[i]),
-        }
-    }
-
     /// The texel in column `x` of row `y` (from the top), linear.
     #[inline]
     pub fn at(&self, x: usize, y: usize) -> Rgb {
-        self.at_index(y * self.width + x)
+        match &self.texels {
+            Texels::Bytes { bytes, decode } => {
+                let i = 3 * self.tiled_index(x, y);
+                Rgb::new(
+                    decode[bytes[i] as usize],
+                    decode[bytes[i + 1] as usize],
+                    decode[bytes[i + 2] as usize],
+                )
+            }
+            Texels::Floats(texels) => Rgb::from_array(texels[y * self.width + x]),
+        }
     }
 
     /// Bytes the texels take.
@@ -489,6 +540,35 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 mod tests {
     use super::*;
 
+    /// Stored in tiles, every texel reads back where it was given, byte
+    /// and float images alike, at sizes that leave partial tiles.
+    #[test]
+    fn tiled_texels_read_back_in_place() {
+        let (width, height) = (13, 10);
+        let value = |x: usize, y: usize| Rgb::new(x as f32, y as f32, (x * y) as f32);
+        let given: Vec<Rgb> = (0..height)
+            .flat_map(|y| (0..width).map(move |x| value(x, y)))
+            .collect();
+        let floats = Bitmap::from_texels(width, height, &given);
+        let bytes: Vec<u8> = (given.iter())
+            .flat_map(|t| t.to_array().map(|c| c as u8))
+            .collect();
+        let raw = Bitmap::new(
+            width,
+            height,
+            Texels::Bytes {
+                bytes,
+                decode: Box::new(std::array::from_fn(|i| i as f32)),
+            },
+        );
+        for (y, x) in (0..height).flat_map(|y| (0..width).map(move |x| (y, x))) {
+            assert_eq!(floats.at(x, y), value(x, y), "float texel ({x}, {y})");
+            assert_eq!(raw.at(x, y), value(x, y), "byte texel ({x}, {y})");
+        }
+        let mean = given.iter().copied().sum::<Rgb>() / given.len() as f32;
+        assert_eq!(floats.mean(), mean);
+    }
+
     fn two_by_two() -> Bitmap {
         Bitmap::from_texels(
             2,
@@ -586,8 +666,9 @@ mod tests {
             assert_eq!(colour.at(texel, 0)[channel], srgb_to_linear(c));
             assert_eq!(data.at(texel, 0)[channel], c);
         }
-        // Three bytes a texel (and the table), not sixteen.
-        assert_eq!(colour.memory_bytes(), 6 + 1024);
+        // Three bytes a texel (and the table), not sixteen; the two texels
+        // lie in one tile, padded to 8 × 8.
+        assert_eq!(colour.memory_bytes(), 3 * TILE * TILE + 1024);
     }
 
     #[test]
