@@ -60,24 +60,18 @@ enum Texels {
 /// kept row-major ([`Bitmap::new`]).
 const TILE: usize = 8;
 
-/// `row_major` (`channels` values a texel, `width` × `height` texels,
-/// row-major from the top row) in tiles of [`TILE`] × [`TILE`], the
-/// partial tiles at the right and bottom edges padded.
-fn tiled<T: Copy + Default>(
-    row_major: &[T],
-    channels: usize,
-    width: usize,
-    height: usize,
-) -> Vec<T> {
+/// `bytes` (three a texel, `width` × `height` texels, row-major from the
+/// top row) in tiles of [`TILE`] × [`TILE`], the partial tiles at the
+/// right and bottom edges padded.
+fn tiled(bytes: &[u8], width: usize, height: usize) -> Vec<u8> {
     let (across, down) = (width.div_ceil(TILE), height.div_ceil(TILE));
-    let mut out = vec![T::default(); across * down * TILE * TILE * channels];
+    let mut out = vec![0; 3 * across * down * TILE * TILE];
     for y in 0..height {
         for tile_x in 0..across {
             let (x0, x1) = (tile_x * TILE, (tile_x * TILE + TILE).min(width));
             let to = ((y / TILE) * across + tile_x) * (TILE * TILE) + (y % TILE) * TILE;
             let from = y * width + x0;
-            out[to * channels..(to + x1 - x0) * channels]
-                .copy_from_slice(&row_major[from * channels..(y * width + x1) * channels]);
+            out[3 * to..3 * (to + x1 - x0)].copy_from_slice(&bytes[3 * from..3 * (from + x1 - x0)]);
         }
     }
     out
@@ -222,7 +216,7 @@ impl Bitmap {
     fn new(width: usize, height: usize, texels: Texels) -> Bitmap {
         let texels = match texels {
             Texels::Bytes { bytes, decode } => Texels::Bytes {
-                bytes: tiled(&bytes, 3, width, height),
+                bytes: tiled(&bytes, width, height),
                 decode,
             },
             floats => floats,
