@@ -534,8 +534,8 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 mod tests {
     use super::*;
 
-    /// Stored in tiles, every texel reads back where it was given, byte
-    /// and float images alike, at sizes that leave partial tiles.
+    /// Every texel reads back where it was given: bytes stored in tiles, at
+    /// a size that leaves partial tiles, and floats stored row-major.
     #[test]
     fn tiled_texels_read_back_in_place() {
         let (width, height) = (13, 10);
