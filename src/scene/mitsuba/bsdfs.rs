@@ -11,7 +11,9 @@ use crate::scene::appearance::build_material;
 use crate::scene::description::{IorDesc, MaterialDesc, MaterialKind};
 use crate::scene::material::{Material, MaterialTextures, NormalMap, Opacity};
 use crate::texture::{Bitmap, Filter, Texture, UvTransform, Wrap};
+use crate::bsdf::Distribution;
 use glam::Vec2;
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// Plugins whose parameters are read but whose effect is not rendered:
@@ -165,12 +167,6 @@ impl<'a> Importer<'a> {
             ..Default::default()
         };
         let mut textures = MaterialTextures::default();
-        let ior = |p: &Props, name: &str| -> Result<Option<IorDesc>> {
-            if p.tag_of(name) == Some("string") {
-                return Ok(p.string(name)?.map(|s| IorDesc::Name(s.to_string())));
-            }
-            Ok(p.float(name)?.map(IorDesc::Value))
-        };
         match kind {
             "diffuse" | "roughdiffuse" => {
                 d.kind = match (kind, two_sided) {
@@ -326,15 +322,7 @@ impl<'a> Importer<'a> {
         d: &mut MaterialDesc,
         textures: &mut MaterialTextures,
     ) -> Result<()> {
-        d.distribution = match p.string("distribution")? {
-            None | Some("beckmann") => Some(crate::bsdf::Distribution::Beckmann),
-            Some("ggx") => Some(crate::bsdf::Distribution::Ggx),
-            Some(other) => {
-                return Err(p
-                    .loc()
-                    .error(format!("distribution \"{other}\" is not beckmann or ggx")));
-            }
-        };
+        d.distribution = Some(distribution(p)?);
         // Visible-normal sampling is always on: it changes noise, not the image.
         let _ = p.bool("sample_visible")?;
         let mut read = |name: &str, slot: &mut Option<u32>| -> Result<Option<f32>> {
@@ -465,6 +453,46 @@ impl<'a> Importer<'a> {
 }
 
 /// Interior over exterior IOR, names or numbers, Mitsuba's defaults.
+/// An IOR property: a number, or a name of Mitsuba's table.
+fn ior(p: &Props, name: &str) -> Result<Option<IorDesc>> {
+    if p.tag_of(name) == Some("string") {
+        return Ok(p.string(name)?.map(|s| IorDesc::Name(s.to_string())));
+    }
+    Ok(p.float(name)?.map(IorDesc::Value))
+}
+
+/// A microfacet model's `distribution`, Beckmann unless given.
+fn distribution(p: &Props) -> Result<Distribution> {
+    match p.string("distribution")? {
+        None | Some("beckmann") => Ok(Distribution::Beckmann),
+        Some("ggx") => Ok(Distribution::Ggx),
+        Some(other) => Err(p
+            .loc()
+            .error(format!("distribution \"{other}\" is not beckmann or ggx"))),
+    }
+}
+
+/// What a `roughplastic` element's coating tables are made from, read as
+/// [`Importer::bsdf`] reads it, where its roughness is one `alpha` number:
+/// the tables take 64 × 2 integrals, and made ahead on any core
+/// (prefetching) they no longer wait on the walk's one thread. None where
+/// anything else decides them, or the element is wrong (the walk then
+/// says so).
+pub(super) fn coating(e: &Element, ids: &HashMap<String, &Element>) -> Option<MaterialDesc> {
+    let p = Props::new(e, ids);
+    if p.float("alpha_u").ok()?.is_some() || p.float("alpha_v").ok()?.is_some() {
+        return None;
+    }
+    Some(MaterialDesc {
+        kind: MaterialKind::RoughPlastic,
+        distribution: Some(distribution(&p).ok()?),
+        alpha: Some(p.float("alpha").ok()?.unwrap_or(0.1)),
+        int_ior: ior(&p, "int_ior").ok()?,
+        ext_ior: ior(&p, "ext_ior").ok()?,
+        ..Default::default()
+    })
+}
+
 fn relative_ior(
     loc: &super::xml::Loc,
     int: Option<IorDesc>,

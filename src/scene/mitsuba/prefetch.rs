@@ -10,6 +10,8 @@
 use super::meshes::MeshFile;
 use super::props::Props;
 use super::xml::{Document, Element};
+use crate::scene::appearance::build_material;
+use crate::scene::description::MaterialDesc;
 use crate::scene::mesh::MeshData;
 use crate::texture::Bitmap;
 use rayon::prelude::*;
@@ -27,6 +29,26 @@ enum Job {
     /// A bitmap, and whether a texture reads it (materials ask for its mean).
     Bitmap(Key, bool),
     Mesh(MeshFile),
+}
+
+impl Job {
+    /// About how long decoding takes, in the bytes of an OBJ file that
+    /// parse as fast (measured on the kitchen: a pixel of a JPEG took about
+    /// as long as 3 bytes of OBJ text; 4 allows for float images).
+    fn cost(&self) -> u64 {
+        let bytes = |path: &Path| std::fs::metadata(path).map_or(0, |m| m.len());
+        match self {
+            Job::Bitmap((path, _), _) => image::image_dimensions(path)
+                .map_or_else(|_| bytes(path), |(w, h)| 4 * u64::from(w) * u64::from(h)),
+            Job::Mesh(file) => bytes(&file.path),
+        }
+    }
+}
+
+/// A file to decode, or a coating whose tables to make.
+enum Task {
+    File(Job),
+    Coating(MaterialDesc),
 }
 
 /// Bitmaps and meshes decoded ahead.
@@ -48,8 +70,8 @@ impl Prefetched {
         ids: &HashMap<String, &Element>,
         max_triangles: usize,
     ) -> Prefetched {
-        let mut jobs = Vec::new();
-        collect(&doc.root, doc, ids, &mut jobs);
+        let (mut jobs, mut coatings) = (Vec::new(), Vec::new());
+        collect(&doc.root, doc, ids, &mut jobs, &mut coatings);
         jobs.sort();
         // One job per file; a bitmap read both as a texture and as an
         // environment is a texture (sorted after, `true` > `false`).
@@ -60,19 +82,38 @@ impl Prefetched {
             }
             (later, kept) => later == kept,
         });
-        // Largest first, so that no core is left with a big file at the end.
-        jobs.sort_by_cached_key(|job| {
-            let path = match job {
-                Job::Bitmap((path, _), _) => path,
-                Job::Mesh(file) => &file.path,
-            };
-            std::cmp::Reverse(std::fs::metadata(path).map_or(0, |m| m.len()))
-        });
+        // Longest first, taken in that order by whichever core is free, so
+        // that no core is left with a long job at the end. An image's
+        // decoding costs by its pixels, not its compressed bytes: a 760 KB
+        // progressive JPEG of the kitchen took as long as a 5 MB OBJ file,
+        // and, sorted by bytes among them, was its load's last job.
+        jobs.sort_by_cached_key(|job| std::cmp::Reverse(job.cost()));
+        // A coating's tables took about as long as a megabyte of OBJ text.
+        let same = |a: &MaterialDesc, b: &MaterialDesc| {
+            (a.distribution, a.alpha) == (b.distribution, b.alpha)
+                && (&a.int_ior, &a.ext_ior) == (&b.int_ior, &b.ext_ior)
+        };
+        let mut distinct: Vec<MaterialDesc> = Vec::new();
+        for c in coatings {
+            if !distinct.iter().any(|d| same(d, &c)) {
+                distinct.push(c);
+            }
+        }
+        let split = jobs.partition_point(|job| job.cost() > 1 << 20);
+        let later = jobs.split_off(split);
+        let tasks = (jobs.into_iter().map(Task::File))
+            .chain(distinct.into_iter().map(Task::Coating))
+            .chain(later.into_iter().map(Task::File));
         let triangles = AtomicUsize::new(0);
-        let decoded: Vec<Decoded> = jobs
-            .into_par_iter()
-            .with_max_len(1)
-            .filter_map(|job| match job {
+        let decoded: Vec<Decoded> = tasks
+            .par_bridge()
+            .filter_map(|task| match task {
+                Task::Coating(desc) => {
+                    // Made once per process; the walk's material finds them.
+                    let _ = build_material("coating", &desc);
+                    None
+                }
+                Task::File(job) => match job {
                 Job::Bitmap(key, texture) => {
                     let bitmap = Bitmap::read(&key.0, key.1).ok()?;
                     if texture {
@@ -89,6 +130,7 @@ impl Prefetched {
                     triangles.fetch_add(mesh.indices.len(), Ordering::Relaxed);
                     Some(Decoded::Mesh(file, mesh))
                 }
+                },
             })
             .collect();
         let mut prefetched = Prefetched::default();
@@ -127,7 +169,13 @@ enum Decoded {
 }
 
 /// The files that `e` and the elements inside it name.
-fn collect(e: &Element, doc: &Document, ids: &HashMap<String, &Element>, jobs: &mut Vec<Job>) {
+fn collect(
+    e: &Element,
+    doc: &Document,
+    ids: &HashMap<String, &Element>,
+    jobs: &mut Vec<Job>,
+    coatings: &mut Vec<MaterialDesc>,
+) {
     for c in &e.children {
         match (c.tag.as_str(), c.plugin()) {
             ("texture", "bitmap") | ("emitter", "envmap") => {
@@ -142,6 +190,11 @@ fn collect(e: &Element, doc: &Document, ids: &HashMap<String, &Element>, jobs: &
                     jobs.push(Job::Bitmap((path, raw), c.tag == "texture"));
                 }
             }
+            ("bsdf", "roughplastic") => {
+                if let Some(desc) = super::bsdfs::coating(c, ids) {
+                    coatings.push(desc);
+                }
+            }
             ("shape", _) => {
                 if let Ok(Some(file)) = MeshFile::of(c, &Props::new(c, ids), doc) {
                     jobs.push(Job::Mesh(file));
@@ -149,6 +202,6 @@ fn collect(e: &Element, doc: &Document, ids: &HashMap<String, &Element>, jobs: &
             }
             _ => {}
         }
-        collect(c, doc, ids, jobs);
+        collect(c, doc, ids, jobs, coatings);
     }
 }
