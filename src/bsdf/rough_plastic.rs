@@ -291,17 +291,38 @@ impl CoatingLevels {
     }
 }
 
+/// (distribution, α_u, α_v, η), exactly.
+type CoatingKey = (Distribution, u32, u32, u32);
+
+fn coating_key(microfacet: Microfacet, eta: f32) -> CoatingKey {
+    let Microfacet {
+        distribution,
+        alpha_u,
+        alpha_v,
+    } = microfacet;
+    (
+        distribution,
+        alpha_u.to_bits(),
+        alpha_v.to_bits(),
+        eta.to_bits(),
+    )
+}
+
+/// Every coating's tables made so far in this process.
+static CACHE: Mutex<Vec<(CoatingKey, &'static CoatingTables)>> = Mutex::new(Vec::new());
+
+/// Whether the tables for (distribution, α, η) are made already.
+#[cfg(test)]
+pub(crate) fn coating_tables_made(microfacet: Microfacet, eta: f32) -> bool {
+    let key = coating_key(microfacet, eta);
+    let cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    cache.iter().any(|(k, _)| *k == key)
+}
+
 /// The coating tables for (distribution, α, η), computed on first use.
 fn coating_tables(microfacet: Microfacet, eta: f32) -> &'static CoatingTables {
-    type Key = (Distribution, u32, u32, u32);
-    static CACHE: Mutex<Vec<(Key, &'static CoatingTables)>> = Mutex::new(Vec::new());
-    let key = (
-        microfacet.distribution,
-        microfacet.alpha_u.to_bits(),
-        microfacet.alpha_v.to_bits(),
-        eta.to_bits(),
-    );
-    let cached = |cache: &[(Key, &'static CoatingTables)]| {
+    let key = coating_key(microfacet, eta);
+    let cached = |cache: &[(CoatingKey, &'static CoatingTables)]| {
         cache.iter().find(|(k, _)| *k == key).map(|&(_, t)| t)
     };
     // Not locked while computing: a rayon worker waiting on the loop below

@@ -5,13 +5,13 @@
 use super::Importer;
 use super::props::{Colour, Props};
 use super::xml::Element;
+use crate::bsdf::Distribution;
 use crate::error::Result;
 use crate::math::Rgb;
 use crate::scene::appearance::build_material;
 use crate::scene::description::{IorDesc, MaterialDesc, MaterialKind};
 use crate::scene::material::{Material, MaterialTextures, NormalMap, Opacity};
 use crate::texture::{Bitmap, Filter, Texture, UvTransform, Wrap};
-use crate::bsdf::Distribution;
 use glam::Vec2;
 use std::collections::HashMap;
 use std::sync::Arc;

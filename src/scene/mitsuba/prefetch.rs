@@ -114,22 +114,22 @@ impl Prefetched {
                     None
                 }
                 Task::File(job) => match job {
-                Job::Bitmap(key, texture) => {
-                    let bitmap = Bitmap::read(&key.0, key.1).ok()?;
-                    if texture {
-                        // Materials read it in the walk, on one thread.
-                        bitmap.mean();
+                    Job::Bitmap(key, texture) => {
+                        let bitmap = Bitmap::read(&key.0, key.1).ok()?;
+                        if texture {
+                            // Materials read it in the walk, on one thread.
+                            bitmap.mean();
+                        }
+                        Some(Decoded::Bitmap(key, Arc::new(bitmap)))
                     }
-                    Some(Decoded::Bitmap(key, Arc::new(bitmap)))
-                }
-                Job::Mesh(file) => {
-                    if triangles.load(Ordering::Relaxed) > max_triangles {
-                        return None;
+                    Job::Mesh(file) => {
+                        if triangles.load(Ordering::Relaxed) > max_triangles {
+                            return None;
+                        }
+                        let mesh = file.read().ok()?;
+                        triangles.fetch_add(mesh.indices.len(), Ordering::Relaxed);
+                        Some(Decoded::Mesh(file, mesh))
                     }
-                    let mesh = file.read().ok()?;
-                    triangles.fetch_add(mesh.indices.len(), Ordering::Relaxed);
-                    Some(Decoded::Mesh(file, mesh))
-                }
                 },
             })
             .collect();
@@ -203,5 +203,47 @@ fn collect(
             _ => {}
         }
         collect(c, doc, ids, jobs, coatings);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::rough_plastic::coating_tables_made;
+    use crate::bsdf::{Distribution, Microfacet};
+
+    /// A rough plastic's tables are made while files decode, for the values
+    /// the walk will read (Mitsuba 0.6 names here); the α and η are this
+    /// test's own, so no other test can have made them first.
+    #[test]
+    fn a_rough_plastics_coating_is_made_ahead() {
+        let dir = std::env::temp_dir().join(format!("tracelab_coating_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("scene.xml");
+        std::fs::write(
+            &path,
+            r#"<scene version="0.6.0">
+                <bsdf type="twosided" id="a"><bsdf type="roughplastic">
+                    <string name="distribution" value="ggx"/>
+                    <float name="alpha" value="0.0371"/>
+                    <float name="intIOR" value="1.317"/>
+                </bsdf></bsdf>
+                <bsdf type="roughplastic" id="b"><float name="alpha" value="0.0373"/>
+                    <texture name="alpha_u" type="checkerboard"/></bsdf>
+            </scene>"#,
+        )
+        .unwrap();
+        let doc = super::super::xml::read(&path, &[]).unwrap();
+        let mut ids = HashMap::new();
+        super::super::collect_ids(&doc.root, &mut ids).unwrap();
+        let ggx = Microfacet::new(Distribution::Ggx, 0.0371, 0.0371);
+        let eta = 1.317f32 / 1.000277;
+        let beckmann = Microfacet::new(Distribution::Beckmann, 0.0373, 0.0373);
+        assert!(!coating_tables_made(ggx, eta));
+        let _ = Prefetched::new(&doc, &ids, usize::MAX);
+        assert!(coating_tables_made(ggx, eta));
+        // An α given by a texture is the walk's to read.
+        assert!(!coating_tables_made(beckmann, 1.49 / 1.000277));
+        std::fs::remove_dir_all(&dir).ok();
     }
 }
