@@ -87,8 +87,8 @@ impl Prefetched {
         // decoding costs by its pixels, not its compressed bytes: a 760 KB
         // progressive JPEG of the kitchen took as long as a 5 MB OBJ file,
         // and, sorted by bytes among them, was its load's last job.
-        jobs.sort_by_cached_key(|job| std::cmp::Reverse(job.cost()));
-        // A coating's tables took about as long as a megabyte of OBJ text.
+        let mut jobs: Vec<(u64, Job)> = jobs.into_iter().map(|job| (job.cost(), job)).collect();
+        jobs.sort_by_key(|&(cost, _)| std::cmp::Reverse(cost));
         let same = |a: &MaterialDesc, b: &MaterialDesc| {
             (a.distribution, a.alpha) == (b.distribution, b.alpha)
                 && (&a.int_ior, &a.ext_ior) == (&b.int_ior, &b.ext_ior)
@@ -99,11 +99,12 @@ impl Prefetched {
                 distinct.push(c);
             }
         }
-        let split = jobs.partition_point(|job| job.cost() > 1 << 20);
-        let later = jobs.split_off(split);
-        let tasks = (jobs.into_iter().map(Task::File))
+        // A coating's tables took about as long as a megabyte of OBJ text.
+        let later = jobs.split_off(jobs.partition_point(|&(cost, _)| cost > 1 << 20));
+        let file = |(_, job): (u64, Job)| Task::File(job);
+        let tasks = (jobs.into_iter().map(file))
             .chain(distinct.into_iter().map(Task::Coating))
-            .chain(later.into_iter().map(Task::File));
+            .chain(later.into_iter().map(file));
         let triangles = AtomicUsize::new(0);
         let decoded: Vec<Decoded> = tasks
             .par_bridge()
