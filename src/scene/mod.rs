@@ -176,22 +176,19 @@ struct Dropped {
 impl Dropped {
     /// Keeps triangles with a representable area and normal: a zero-area one
     /// has no normal, no hits and emits nothing.
-    fn triangles(&mut self, mut all: Vec<TriangleInput>) -> Vec<TriangleInput> {
+    fn triangles(&mut self, all: Vec<TriangleInput>) -> Vec<TriangleInput> {
         let total = all.len();
-        let proper = |t: &TriangleInput| {
-            let [a, b, c] = t.vertices;
-            let n = (b - a).cross(c - a);
-            n.length_squared() > 0.0 && n.is_finite() && n.normalize().is_finite()
-        };
-        // Checked on every core first: most scenes have none to drop, and
-        // compacting a million triangles in place is a serial pass over
-        // 150 MB.
-        if !all.par_iter().all(proper) {
-            all.retain(proper);
-        }
+        let kept: Vec<TriangleInput> = all
+            .into_iter()
+            .filter(|t| {
+                let [a, b, c] = t.vertices;
+                let n = (b - a).cross(c - a);
+                n.length_squared() > 0.0 && n.is_finite() && n.normalize().is_finite()
+            })
+            .collect();
         self.triangle_total += total;
-        self.triangles += total - all.len();
-        all
+        self.triangles += total - kept.len();
+        kept
     }
 
     fn spheres(&mut self, all: Vec<Sphere>) -> Vec<Sphere> {

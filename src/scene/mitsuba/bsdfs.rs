@@ -452,7 +452,6 @@ impl<'a> Importer<'a> {
     }
 }
 
-/// Interior over exterior IOR, names or numbers, Mitsuba's defaults.
 /// An IOR property: a number, or a name of Mitsuba's table.
 fn ior(p: &Props, name: &str) -> Result<Option<IorDesc>> {
     if p.tag_of(name) == Some("string") {
@@ -493,6 +492,7 @@ pub(super) fn coating(e: &Element, ids: &HashMap<String, &Element>) -> Option<Ma
     })
 }
 
+/// Interior over exterior IOR, names or numbers, Mitsuba's defaults.
 fn relative_ior(
     loc: &super::xml::Loc,
     int: Option<IorDesc>,
