@@ -57,6 +57,7 @@ fn path_runs(threads: usize, general: bool) -> Vec<f64> {
                 adaptive: None,
                 domains: Default::default(),
                 clamp: None,
+                filter_sampling: Default::default(),
             };
             let session = Session::new(scene.clone(), settings).unwrap();
             for _ in 0..4 {

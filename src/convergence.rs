@@ -227,6 +227,7 @@ pub fn measure(
                 .map(|warmup_spp| Adaptive::Distribute { warmup_spp }),
             domains: config.domains,
             clamp: None,
+            filter_sampling: Default::default(),
         };
         let session = Session::with_pool(scene.clone(), settings, pool.clone());
         let start = Instant::now();

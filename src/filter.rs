@@ -5,6 +5,8 @@
 //! stays a plain mean. Splatting techniques spread each splat over the
 //! pixels whose filter covers it, weighted by the same normalised filter,
 //! so that both estimate ∫ f(p − c) L(p) dp for a pixel centred at c.
+//! Camera samples can be splatted the same way ([`FilterSampling::Splat`],
+//! Mitsuba's film): see `crate::film::filtered`.
 
 use crate::math::{erf, erfinv};
 use glam::Vec2;
@@ -26,6 +28,31 @@ pub enum PixelFilter {
 impl Default for PixelFilter {
     fn default() -> Self {
         PixelFilter::Box
+    }
+}
+
+/// How camera samples meet a filter wider than the box.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FilterSampling {
+    /// Each sample is taken uniformly in its pixel and added to every pixel
+    /// the filter covers, with the filter's weight; a pixel is the weighted
+    /// mean of what it received (Mitsuba's film). A pixel then averages
+    /// the samples of (∫f)² / ∫f² pixels' area (2.25 for the tent, π for
+    /// Mitsuba's Gaussian), at the price of correlated neighbours.
+    #[default]
+    Splat,
+    /// Each sample's position is drawn from the filter and counts for its
+    /// own pixel alone, with weight 1 (pbrt-v4): pixels stay independent.
+    Importance,
+}
+
+impl FilterSampling {
+    /// The name as the command line spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            FilterSampling::Splat => "splat",
+            FilterSampling::Importance => "importance",
+        }
     }
 }
 
@@ -80,6 +107,24 @@ impl PixelFilter {
             PixelFilter::Tent { radius } => tent(d.x, radius) * tent(d.y, radius),
             PixelFilter::Gaussian { stddev, radius } => {
                 gaussian(d.x, stddev, radius) * gaussian(d.y, stddev, radius)
+            }
+        }
+    }
+
+    /// The 1D filter at `x` up to a constant factor (the 2D filter is the
+    /// product in x and y): what a weighted mean needs, without the
+    /// Gaussian's erf.
+    #[inline]
+    pub fn shape_1d(&self, x: f32) -> f32 {
+        match *self {
+            PixelFilter::Box => f32::from(u8::from(x.abs() <= 0.5)),
+            PixelFilter::Tent { radius } => (radius - x.abs()).max(0.0),
+            PixelFilter::Gaussian { stddev, radius } => {
+                if x.abs() > radius {
+                    0.0
+                } else {
+                    (-(x * x) / (2.0 * stddev * stddev)).exp()
+                }
             }
         }
     }

@@ -458,6 +458,7 @@ mod tests {
                 adaptive: None,
                 domains: Default::default(),
                 clamp: None,
+                filter_sampling: Default::default(),
             },
             target_spp: Some(spp),
         }

@@ -313,6 +313,7 @@ pub fn render(scene: &Scene, spp: u32, seed: u64) -> Result<(Image, u64)> {
         adaptive: None,
         domains: Default::default(),
         clamp: None,
+        filter_sampling: Default::default(),
     };
     let session = Session::new(Arc::new(scene.clone()), settings)?;
     session.render_pass(spp);

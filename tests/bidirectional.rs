@@ -253,6 +253,7 @@ fn multi_pass_session(scene: Scene, technique: MultiPassIntegrator, seed: u64) -
         adaptive: None,
         domains: Default::default(),
         clamp: None,
+        filter_sampling: Default::default(),
     };
     Session::new(Arc::new(scene), settings).expect("session starts")
 }

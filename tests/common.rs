@@ -70,6 +70,7 @@ pub fn render_adaptive(
         adaptive,
         domains: Default::default(),
         clamp: None,
+        filter_sampling: Default::default(),
     };
     let session = Session::new(Arc::new(scene), settings).expect("session starts");
     let mut done = 0;

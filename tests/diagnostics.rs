@@ -22,6 +22,7 @@ fn settings(sampler: SamplerKind, spp: u32, clamp: Option<f32>) -> RenderSetting
         adaptive: None,
         domains: Default::default(),
         clamp,
+        filter_sampling: Default::default(),
     }
 }
 

@@ -283,6 +283,7 @@ fn cached_reference(
             adaptive: None,
             domains: config.domains,
             clamp: None,
+            filter_sampling: Default::default(),
         },
     )?;
     render_spp(&session, spp);

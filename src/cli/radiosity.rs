@@ -251,6 +251,7 @@ fn run(
         adaptive: None,
         domains: Default::default(),
         clamp: None,
+        filter_sampling: Default::default(),
     };
     let session = Session::new(scene, settings)?;
     if echo {

@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tracelab::film::{EXTREME_LUMINANCE, FinalImage, FlaggedPixel};
+use tracelab::filter::FilterSampling;
 use tracelab::image::check_writable;
 use tracelab::integrator::{CameraIntegrator, Integrator, SplattingIntegrator};
 use tracelab::math::OffsetMode;
@@ -100,6 +101,13 @@ pub struct RenderArgs {
     /// (removes fireflies; biased, and the summary says how often it acted).
     #[arg(long)]
     clamp: Option<f32>,
+    /// How camera samples meet a tent or Gaussian pixel filter: `splat`
+    /// (Mitsuba's film: each sample, uniform in its pixel, adds to every
+    /// pixel the filter covers, weighted) or `importance` (pbrt-v4: the
+    /// sample's position drawn from the filter, counted in one pixel).
+    /// Adaptive sampling and deterministic techniques always use `importance`.
+    #[arg(long, value_parser = parse_filter_sampling, default_value = "splat")]
+    filter_sampling: FilterSampling,
     /// Replay one sample of the render instead, `X,Y,S` (pixel and sample
     /// index), printing its path's vertices, pdfs and weights.
     #[arg(long, value_parser = parse_debug_sample)]
@@ -267,6 +275,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         },
         domains: args.domains.unwrap_or_default(),
         clamp: args.clamp,
+        filter_sampling: args.filter_sampling,
     };
     if let Integrator::Camera(CameraIntegrator::Mcrt(m)) = settings.integrator
         && m.rays_per_sample_closed() > args.max_branch_rays
@@ -327,6 +336,13 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     print_flagged(&flagged, non_finite, width, &seed);
     eprintln!("wrote {}", out.display());
     Ok(())
+}
+
+fn parse_filter_sampling(text: &str) -> std::result::Result<FilterSampling, String> {
+    [FilterSampling::Splat, FilterSampling::Importance]
+        .into_iter()
+        .find(|f| f.name() == text)
+        .ok_or_else(|| format!("expected splat or importance, got {text:?}"))
 }
 
 fn parse_domains(text: &str) -> std::result::Result<Domains, String> {

@@ -3,9 +3,11 @@
 //!
 //! Each tile has its own lock, held only while a pass adds that tile's
 //! samples, so a snapshot can be taken at any time while passes run and waits
-//! at most for one tile. The reconstruction filter is a box of one pixel:
-//! a pixel is the plain mean of the samples taken inside it (Mitsuba's `box`).
+//! at most for one tile. A pixel is the plain mean of its samples, taken
+//! inside it (the box) or drawn from the pixel filter; or, where samples
+//! are splatted through the filter ([`filtered`]), their weighted mean.
 
+pub mod filtered;
 pub mod splats;
 
 use crate::allocation::PixelNoise;
@@ -190,6 +192,10 @@ pub struct Tile {
     pub pixels: Vec<PixelSums>,
     /// The tile's pixels that had non-finite or extreme samples (few).
     pub flags: Vec<FlaggedPixel>,
+    /// The weights each pixel received where samples are splatted through
+    /// the filter ([`filtered`]); empty where each sample counts once for
+    /// its own pixel.
+    pub weights: Vec<filtered::WeightSums>,
 }
 
 /// The whole film.
@@ -270,6 +276,7 @@ impl Film {
                     height: h,
                     pixels: vec![PixelSums::default(); (w * h) as usize],
                     flags: Vec::new(),
+                    weights: Vec::new(),
                 }));
             }
         }
@@ -294,7 +301,13 @@ impl Film {
             let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
             tile.pixels.fill(PixelSums::default());
             tile.flags.clear();
+            tile.weights = Vec::new();
         }
+    }
+
+    /// Tiles in a row of the film ([`Film::tiles`] is rows of them).
+    pub fn tiles_across(&self) -> u32 {
+        self.width.div_ceil(TILE_SIZE)
     }
 
     /// The tiles, for passes to fill in parallel.
@@ -374,7 +387,11 @@ impl Film {
                     let p = &tile.pixels[(ty * tile.width + tx) as usize];
                     let i = ((tile.y0 + ty) * self.width + tile.x0 + tx) as usize;
                     image.pixels[i] = p.mean();
-                    standard_error.pixels[i] = p.standard_error();
+                    standard_error.pixels[i] =
+                        match tile.weights.get((ty * tile.width + tx) as usize) {
+                            Some(w) => filtered::standard_error(p, w),
+                            None => p.standard_error(),
+                        };
                     samples[i] = p.count;
                 }
             }

@@ -32,9 +32,34 @@ pub fn camera_ray(
     deterministic: bool,
     general: bool,
 ) -> Ray {
+    camera_ray_through(
+        scene,
+        sampler,
+        x,
+        y,
+        deterministic,
+        general,
+        scene.camera.filter,
+    )
+    .0
+}
+
+/// [`camera_ray`] with the film position drawn from `filter` (the box: uniform
+/// in the pixel, for samples splatted through the camera's filter), and
+/// that position.
+#[inline(always)]
+pub fn camera_ray_through(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    x: u32,
+    y: u32,
+    deterministic: bool,
+    general: bool,
+    filter: PixelFilter,
+) -> (Ray, Vec2) {
     let u_pixel = sampler.next_2d_for(Domain::Pixel);
     // Filter importance sampling; the box keeps its exact arithmetic.
-    let mut film_point = match scene.camera.filter {
+    let mut film_point = match filter {
         PixelFilter::Box => Vec2::new(x as f32, y as f32) + u_pixel,
         filter => Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + filter.sample(u_pixel),
     };
@@ -50,5 +75,8 @@ pub fn camera_ray(
         lens = Vec2::splat(0.5);
         time = scene.camera.time(0.5);
     }
-    scene.camera.generate_ray(film_point, lens).at_time(time)
+    (
+        scene.camera.generate_ray(film_point, lens).at_time(time),
+        film_point,
+    )
 }

@@ -34,7 +34,7 @@ pub mod vcm;
 pub mod whitted;
 
 pub use bdpt::Bdpt;
-pub use camera_ray::{camera_ray, sample_time};
+pub use camera_ray::{camera_ray, camera_ray_through, sample_time};
 pub use light::{LightTracer, Splat};
 pub use mcrt::McRayTracer;
 pub use mis::MisHeuristic;

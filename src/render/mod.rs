@@ -13,10 +13,12 @@
 //! the thread count or tile schedule.
 
 use crate::error::{Error, Result};
+use crate::film::filtered::{self, Apron};
 use crate::film::splats::{PendingSplats, SplatBuffer};
 use crate::film::{Film, FilmSnapshot, Tile, classify, non_finite_of, note_flagged};
+use crate::filter::{FilterSampling, PixelFilter};
 use crate::integrator::{
-    ErrorEstimate, Integrator, RayCounts, SolverProgress, SplattingIntegrator, camera_ray,
+    ErrorEstimate, Integrator, RayCounts, SolverProgress, SplattingIntegrator, camera_ray_through,
 };
 use crate::math::{Ray, Rgb};
 use crate::sampling::hash::hash_combine;
@@ -47,6 +49,10 @@ pub struct RenderSettings {
     /// Scale down any sample whose largest component exceeds this (off by
     /// default): removes fireflies at the price of bias, and is reported so.
     pub clamp: Option<f32>,
+    /// How camera samples meet a pixel filter wider than the box (splatted
+    /// by default, as Mitsuba's film; importance-sampled under adaptive
+    /// sampling, whose per-pixel counts a splat would mix).
+    pub filter_sampling: FilterSampling,
 }
 
 /// Adaptive sampling: samples go where the noise is rather than evenly.
@@ -363,6 +369,20 @@ impl Session {
         let general = matches!(settings.integrator, Integrator::Camera(e) if e.is_general());
         let width = self.film.width();
         let primary = scene.primary_candidates();
+        // Samples uniform in their pixels, splatted through the filter
+        // (crate::film::filtered), or drawn from it and kept in their pixel.
+        let filter = scene.camera.filter;
+        let splat = settings.filter_sampling == FilterSampling::Splat
+            && filtered::can_splat(filter)
+            && !deterministic
+            && settings.adaptive.is_none();
+        let (position_filter, aprons) = match splat {
+            true => {
+                let aprons = self.film.tiles().iter().map(|_| Mutex::new(None)).collect();
+                (PixelFilter::Box, aprons)
+            }
+            false => (filter, Vec::new()),
+        };
         self.pool.install(|| {
             self.film
                 .tiles()
@@ -381,6 +401,7 @@ impl Session {
                         return;
                     }
                     let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
+                    let mut apron = splat.then(|| Apron::new(&tile, filter));
                     let mut sampler = Sampler::new(sampler, settings.seed, settings.planned_spp)
                         .with_domains(settings.domains);
                     // The next sample's, whose camera ray is made while this
@@ -418,16 +439,25 @@ impl Session {
                         // of holding up its own.
                         let end = begin + count;
                         let known = primary.map(|p| p.pixel(pixel_index)).unwrap_or_default();
+                        let through = |s: &mut Sampler| {
+                            camera_ray_through(
+                                scene,
+                                s,
+                                x,
+                                y,
+                                deterministic,
+                                general,
+                                position_filter,
+                            )
+                        };
                         ahead.start(pixel_index, begin);
-                        let mut ray_ahead =
-                            camera_ray(scene, &mut ahead, x, y, deterministic, general);
+                        let mut ray_ahead = through(&mut ahead);
                         for s in begin..end {
                             std::mem::swap(&mut sampler, &mut ahead);
-                            let ray = ray_ahead;
+                            let (ray, film_point) = ray_ahead;
                             if s + 1 < end {
                                 ahead.start(pixel_index, s + 1);
-                                ray_ahead =
-                                    camera_ray(scene, &mut ahead, x, y, deterministic, general);
+                                ray_ahead = through(&mut ahead);
                             }
                             counts.camera += 1;
                             let mut value =
@@ -442,16 +472,36 @@ impl Session {
                                 clamped += u64::from(clamp_sample(&mut value, limit));
                             }
                             if finite {
-                                pixel.add(value);
+                                match apron.as_mut() {
+                                    Some(apron) => {
+                                        apron.splat(film_point, value);
+                                        pixel.count += 1;
+                                    }
+                                    None => pixel.add(value),
+                                }
                             }
                         }
                     }
                     drop(tile);
+                    if let Some(apron) = apron {
+                        *lock(&aprons[index]) = Some(apron);
+                    }
                     self.add_counts(counts.camera, &counts, non_finite);
                     self.skipped.fetch_add(skipped, Ordering::Relaxed);
                     self.extreme.fetch_add(extreme, Ordering::Relaxed);
                     self.clamped.fetch_add(clamped, Ordering::Relaxed);
                 });
+            if splat && !self.cancelled.load(Ordering::Relaxed) {
+                let aprons: Vec<Option<Apron>> = aprons
+                    .into_iter()
+                    .map(|a| a.into_inner().unwrap_or_else(|e| e.into_inner()))
+                    .collect();
+                let (across, reach) = (self.film.tiles_across(), filtered::reach(filter));
+                self.film.tiles().par_iter().for_each(|tile| {
+                    let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
+                    filtered::fold(&mut tile, &aprons, across, reach);
+                });
+            }
         });
     }
 

@@ -19,6 +19,7 @@ fn session() -> Session {
         adaptive: None,
         domains: Default::default(),
         clamp: None,
+        filter_sampling: Default::default(),
     };
     Session::new(Arc::new(scene), settings).unwrap()
 }

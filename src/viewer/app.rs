@@ -325,6 +325,7 @@ impl ViewerApp {
                         }),
                         domains: c.domains,
                         clamp: None,
+                        filter_sampling: Default::default(),
                     },
                     target_spp: if integrator.is_deterministic() {
                         Some(1)
