@@ -102,7 +102,9 @@ pub fn temp_dir(name: &str) -> PathBuf {
 }
 
 /// Mean of a per-channel quantity over an image and the standard error of
-/// that mean from per-pixel standard errors (pixels are independent).
+/// that mean from per-pixel standard errors: summed as independent, times
+/// the film's correlation (samples splatted through a filter count in
+/// several pixels; `FilmSnapshot::correlation`).
 pub fn mean_and_standard_error(snapshot: &FilmSnapshot) -> ([f64; 3], [f64; 3]) {
     let n = snapshot.image.pixels.len() as f64;
     let mean = snapshot.image.mean();
@@ -112,7 +114,7 @@ pub fn mean_and_standard_error(snapshot: &FilmSnapshot) -> ([f64; 3], [f64; 3]) 
             var[c] += (se[c] as f64).powi(2);
         }
     }
-    (mean, var.map(|v| v.sqrt() / n))
+    (mean, var.map(|v| (v * snapshot.correlation).sqrt() / n))
 }
 
 /// A unit UV sphere of `nu` x `nv` quads as OBJ text, faces counter-clockwise

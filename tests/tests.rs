@@ -9,6 +9,8 @@ mod reference;
 mod material_references;
 // Veach's scenes from Bitterli's Mitsuba files against Mitsuba 3 and Tungsten.
 mod bitterli;
+// Samples splatted through the pixel filter: errors as stated, and lower.
+mod filtered_film;
 // Mitsuba XML, PLY and serialized import: every element, every error.
 mod import;
 // Mitsuba sensors: the clips the importer does not apply are warnings.

@@ -12,21 +12,27 @@
 //! reach around it), without locks. Once every tile of the pass is done,
 //! [`fold`] gives each pixel the cells of the aprons that cover it, summed
 //! in tile order, so the film does not depend on the schedule, and merges
-//! them into the pixel as one weighted group (West's weighted form of
-//! Chan et al.'s merge), which keeps its running mean and spread exact
-//! whatever the grouping.
+//! them into the pixel as one weighted group, which keeps its running mean
+//! and its error term exact whatever the grouping (as Chan et al.'s merge
+//! does for plain samples). A pixel's standard error is the delta method's
+//! for a ratio, Σ w² (L − R)² / W²: it weighs a sample by w², so the
+//! far samples of a neighbour, which see a little of another image, count
+//! for little in it.
 
 use super::{PixelSums, Tile};
 use crate::filter::PixelFilter;
 use crate::math::Rgb;
 use glam::Vec2;
 
-/// The weights a pixel received: their sum and the sum of their squares
-/// (the weighted mean's standard error needs both).
+/// The weights a pixel received: their sum, the sum of their squares, and
+/// Σ w² (L − mean) at the current mean, which moves the pixel's
+/// `m2` (here Σ w² (L − mean)², the weighted mean's error times W²) along
+/// with the mean.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WeightSums {
     pub sum: f32,
     pub sum_sq: f32,
+    pub moment: [f32; 3],
 }
 
 /// What one pixel received in one pass.
@@ -34,8 +40,10 @@ pub struct WeightSums {
 pub struct SplatCell {
     /// Σ w L.
     pub sum: [f32; 3],
-    /// Σ w L².
+    /// Σ w² L².
     pub sum_sq: [f32; 3],
+    /// Σ w² L.
+    pub moment: [f32; 3],
     /// Σ w.
     pub weight: f32,
     /// Σ w².
@@ -43,11 +51,25 @@ pub struct SplatCell {
 }
 
 impl SplatCell {
+    /// One sample of value `value` with weight `w`.
     #[inline]
-    fn add(&mut self, other: &SplatCell) {
+    pub fn sample(value: Rgb, w: f32) -> SplatCell {
+        let w2 = w * w;
+        SplatCell {
+            sum: [0, 1, 2].map(|c| w * value[c]),
+            sum_sq: [0, 1, 2].map(|c| w2 * value[c] * value[c]),
+            moment: [0, 1, 2].map(|c| w2 * value[c]),
+            weight: w,
+            weight_sq: w2,
+        }
+    }
+
+    #[inline]
+    pub fn add(&mut self, other: &SplatCell) {
         for c in 0..3 {
             self.sum[c] += other.sum[c];
             self.sum_sq[c] += other.sum_sq[c];
+            self.moment[c] += other.moment[c];
         }
         self.weight += other.weight;
         self.weight_sq += other.weight_sq;
@@ -119,7 +141,6 @@ impl Apron {
         for (j, w) in wy.iter_mut().enumerate().take(side_y) {
             *w = self.filter.shape_1d(centre(j, fy, self.y0) - film.y);
         }
-        let squared = value * value;
         for (j, &w_y) in wy.iter().enumerate().take(side_y) {
             if w_y == 0.0 {
                 continue;
@@ -130,13 +151,7 @@ impl Apron {
                 if w == 0.0 {
                     continue;
                 }
-                let cell = &mut self.cells[row + i];
-                for c in 0..3 {
-                    cell.sum[c] += w * value[c];
-                    cell.sum_sq[c] += w * squared[c];
-                }
-                cell.weight += w;
-                cell.weight_sq += w * w;
+                self.cells[row + i].add(&SplatCell::sample(value, w));
             }
         }
     }
@@ -186,39 +201,48 @@ pub fn fold(tile: &mut Tile, aprons: &[Option<Apron>], tiles_across: u32, reach:
 }
 
 /// Adds a weighted group of samples to a pixel's weighted running mean
-/// and spread (`pixel.m2` is Σ w (L − mean)²); its count is the caller's.
+/// and its error (`pixel.m2` holds Σ w² (L − mean)² about the current
+/// mean, moved with it through [`WeightSums::moment`]); its count is the
+/// caller's.
 pub fn merge(pixel: &mut PixelSums, weights: &mut WeightSums, group: &SplatCell) {
     if !(group.weight > 0.0) {
         return;
     }
     let (old, added) = (f64::from(weights.sum), f64::from(group.weight));
+    let (old_sq, added_sq) = (f64::from(weights.sum_sq), f64::from(group.weight_sq));
     let total = old + added;
     for c in 0..3 {
-        let (sum, sum_sq) = (f64::from(group.sum[c]), f64::from(group.sum_sq[c]));
-        let group_mean = sum / added;
-        let group_m2 = (sum_sq - sum * group_mean).max(0.0);
-        let delta = group_mean - f64::from(pixel.mean[c]);
-        pixel.mean[c] = (f64::from(pixel.mean[c]) + delta * added / total) as f32;
-        pixel.m2[c] =
-            (f64::from(pixel.m2[c]) + group_m2 + delta * delta * old * added / total) as f32;
+        let mean = f64::from(pixel.mean[c]);
+        let new_mean = mean + (f64::from(group.sum[c]) - mean * added) / total;
+        let shift = new_mean - mean;
+        // The old samples' Σ w² (L − m)² and Σ w² (L − m), moved to the new mean.
+        let moment = f64::from(weights.moment[c]);
+        let spread = f64::from(pixel.m2[c]) - 2.0 * shift * moment + shift * shift * old_sq;
+        let moment = moment - shift * old_sq;
+        // The group's about the new mean.
+        let (sum_sq, group_moment) = (f64::from(group.sum_sq[c]), f64::from(group.moment[c]));
+        let group_spread = sum_sq - 2.0 * new_mean * group_moment + new_mean * new_mean * added_sq;
+        pixel.mean[c] = new_mean as f32;
+        pixel.m2[c] = (spread + group_spread).max(0.0) as f32;
+        weights.moment[c] = (moment + group_moment - new_mean * added_sq) as f32;
     }
     weights.sum = total as f32;
-    weights.sum_sq += group.weight_sq;
+    weights.sum_sq = (old_sq + added_sq) as f32;
 }
 
-/// Standard error of a weighted mean: the spread per unit weight,
-/// m2 / (W − W₂ / W) (unbiased for reliability weights), times W₂ / W²;
-/// with unit weights, s² / n. Infinite until the weights make two samples'
-/// worth.
+/// Standard error of a weighted mean R = Σ w L / W by the delta method:
+/// Σ w² (L − R)² / W², over 1 − W₂ / W² for the mean estimated from the
+/// same samples (with unit weights, s² / n). Infinite until the weights
+/// make more than one sample's worth.
 pub fn standard_error(pixel: &PixelSums, weights: &WeightSums) -> [f32; 3] {
     let (w, w2) = (f64::from(weights.sum), f64::from(weights.sum_sq));
-    let effective = w - w2 / w.max(f64::MIN_POSITIVE);
-    if !(w > 0.0) || !(effective > 1e-6 * w) {
+    let denominator = w * w - w2;
+    if !(w > 0.0) || !(denominator > 1e-6 * w * w) {
         return [f32::INFINITY; 3];
     }
     pixel
         .m2
-        .map(|m| ((f64::from(m).max(0.0) / effective) * w2 / (w * w)).sqrt() as f32)
+        .map(|m| (f64::from(m).max(0.0) / denominator).sqrt() as f32)
 }
 
 #[cfg(test)]
@@ -241,12 +265,7 @@ mod tests {
         for chunk in values.chunks(3) {
             let mut group = SplatCell::default();
             for &v in chunk {
-                group.add(&SplatCell {
-                    sum: [v; 3],
-                    sum_sq: [v * v; 3],
-                    weight: 1.0,
-                    weight_sq: 1.0,
-                });
+                group.add(&SplatCell::sample(Rgb::splat(v), 1.0));
             }
             merge(&mut merged, &mut weights, &group);
         }
@@ -256,8 +275,8 @@ mod tests {
         assert!((se[0] - plain_se[0]).abs() < 1e-6, "{se:?} vs {plain_se:?}");
     }
 
-    /// A weighted group's mean is Σ w L / Σ w, and its spread Σ w (L − mean)²,
-    /// merged in any grouping.
+    /// A weighted group's mean is Σ w L / Σ w, and its error term
+    /// Σ w² (L − mean)², merged in any grouping.
     #[test]
     fn weighted_groups_merge_to_the_weighted_mean() {
         let samples: Vec<(f32, f32)> = (0..50u64)
@@ -271,19 +290,14 @@ mod tests {
         let mean: f64 = samples.iter().map(|&(l, w)| f64::from(w * l)).sum::<f64>() / w_sum;
         let m2: f64 = samples
             .iter()
-            .map(|&(l, w)| f64::from(w) * (f64::from(l) - mean).powi(2))
+            .map(|&(l, w)| f64::from(w * w) * (f64::from(l) - mean).powi(2))
             .sum();
         for size in [1, 7, 50] {
             let (mut pixel, mut weights) = (PixelSums::default(), WeightSums::default());
             for chunk in samples.chunks(size) {
                 let mut group = SplatCell::default();
                 for &(l, w) in chunk {
-                    group.add(&SplatCell {
-                        sum: [w * l; 3],
-                        sum_sq: [w * l * l; 3],
-                        weight: w,
-                        weight_sq: w * w,
-                    });
+                    group.add(&SplatCell::sample(Rgb::splat(l), w));
                 }
                 merge(&mut pixel, &mut weights, &group);
             }

@@ -233,6 +233,13 @@ pub struct FilmSnapshot {
     pub first_flagged: Vec<u32>,
     /// Total non-finite samples left out.
     pub non_finite: u64,
+    /// How many pixels' worth of samples a pixel averages, per sample it
+    /// took: 1 where each sample counts for its own pixel, about
+    /// (∫f)² / ∫f² where samples are splatted through a filter f (the mean
+    /// over pixels of W² / (W₂ n)). A mean over many pixels then has about
+    /// this many times the variance that its pixels' standard errors,
+    /// summed as independent, say: each sample still counts once in it.
+    pub correlation: f64,
 }
 
 impl FilmSnapshot {
@@ -379,6 +386,7 @@ impl Film {
         let mut extreme_pixels = vec![0u32; n];
         let mut first_flagged = vec![NOT_FLAGGED; n];
         let mut non_finite = 0u64;
+        let (mut correlation, mut weighted_pixels) = (0.0f64, 0u64);
         for tile in &self.tiles {
             // A poisoned lock only means a pass panicked; the sums are still valid.
             let tile = tile.lock().unwrap_or_else(|e| e.into_inner());
@@ -393,6 +401,13 @@ impl Film {
                             None => p.standard_error(),
                         };
                     samples[i] = p.count;
+                }
+            }
+            for (p, w) in tile.pixels.iter().zip(&tile.weights) {
+                if w.sum_sq > 0.0 && p.count > 0 {
+                    let (sum, sum_sq) = (f64::from(w.sum), f64::from(w.sum_sq));
+                    correlation += sum * sum / (sum_sq * f64::from(p.count));
+                    weighted_pixels += 1;
                 }
             }
             for f in &tile.flags {
@@ -412,6 +427,10 @@ impl Film {
             extreme_pixels,
             first_flagged,
             non_finite,
+            correlation: match weighted_pixels {
+                0 => 1.0,
+                n => (correlation / n as f64).max(1.0),
+            },
         }
     }
 }
