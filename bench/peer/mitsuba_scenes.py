@@ -114,10 +114,11 @@ def time_to_rmse(args, name, w, h):
         image = np.array(mi.render(scene, seed=seed, spp=spp))[..., :3]
         return image, time.perf_counter() - start
 
-    def tracelab(spp, sampler):
+    def tracelab(spp, sampler, filter_sampling="splat"):
         out = subprocess.run(
             [args.tracelab, "render", path, "-D", f"resx={w}", "-D", f"resy={h}",
              "--integrator", "path", "--sampler", sampler, "--spp", str(spp),
+             "--filter-sampling", filter_sampling,
              "--out", "/tmp/mitsuba_scenes_rmse.exr"],
             capture_output=True, text=True, check=True)
         seconds = float(re.search(r"^spp \d+ \| ([0-9.]+) s", out.stdout + out.stderr, re.M).group(1))
@@ -134,7 +135,10 @@ def time_to_rmse(args, name, w, h):
     runs = [("mitsuba independent", lambda n: mitsuba(n, 1)),
             ("mitsuba multijitter", lambda n: mitsuba(n, 1, "multijitter")),
             ("tracelab independent", lambda n: tracelab(n, "independent")),
-            ("tracelab sobol", lambda n: tracelab(n, "sobol"))]
+            ("tracelab sobol", lambda n: tracelab(n, "sobol")),
+            # The filter importance-sampled, as before 2026-12-06.
+            ("tracelab independent, importance", lambda n: tracelab(n, "independent", "importance")),
+            ("tracelab sobol, importance", lambda n: tracelab(n, "sobol", "importance"))]
     curves = {}
     for label, render in runs:
         points, spp = [], 1

@@ -155,48 +155,48 @@ impl Apron {
             }
         }
     }
-
-    /// The cell of film pixel (`x`, `y`), if the apron covers it.
-    #[inline]
-    fn cell(&self, x: u32, y: u32) -> Option<&SplatCell> {
-        let (i, j) = (i64::from(x) - self.x0, i64::from(y) - self.y0);
-        if i < 0 || j < 0 || i >= i64::from(self.width) || j >= i64::from(self.height) {
-            return None;
-        }
-        self.cells.get((j * i64::from(self.width) + i) as usize)
-    }
 }
 
 /// Merges into `tile` what the pass's aprons gave its pixels. `aprons`
 /// holds one entry per film tile, in the film's order (rows of
 /// `tiles_across` tiles), `None` for a tile not rendered in this part of
 /// the pass; a pixel sums the cells covering it in that order.
-pub fn fold(tile: &mut Tile, aprons: &[Option<Apron>], tiles_across: u32, reach: u32) {
+pub fn fold(tile: &mut Tile, aprons: &[Option<Apron>], tiles_across: u32) {
+    const SIZE: usize = super::TILE_SIZE as usize;
+    // A reach below a tile's side: only the eight neighbours' aprons overlap.
+    const _: () = assert!(MAX_SIDE / 2 < SIZE);
     let tile_size = super::TILE_SIZE;
     let tiles_down = aprons.len() as u32 / tiles_across.max(1);
     if tile.weights.len() != tile.pixels.len() {
         tile.weights = vec![WeightSums::default(); tile.pixels.len()];
     }
-    for ty in 0..tile.height {
-        let y = tile.y0 + ty;
-        let rows =
-            y.saturating_sub(reach) / tile_size..=((y + reach) / tile_size).min(tiles_down - 1);
-        for tx in 0..tile.width {
-            let x = tile.x0 + tx;
-            let columns = x.saturating_sub(reach) / tile_size
-                ..=((x + reach) / tile_size).min(tiles_across - 1);
-            let mut group = SplatCell::default();
-            for row in rows.clone() {
-                for column in columns.clone() {
-                    let apron = &aprons[(row * tiles_across + column) as usize];
-                    if let Some(cell) = apron.as_ref().and_then(|a| a.cell(x, y)) {
-                        group.add(cell);
-                    }
+    let (x0, y0, width) = (i64::from(tile.x0), i64::from(tile.y0), tile.width as usize);
+    let (x1, y1) = (x0 + i64::from(tile.width), y0 + i64::from(tile.height));
+    let mut groups = [SplatCell::default(); SIZE * SIZE];
+    let (column, row) = (tile.x0 / tile_size, tile.y0 / tile_size);
+    for r in row.saturating_sub(1)..=(row + 1).min(tiles_down.saturating_sub(1)) {
+        for c in column.saturating_sub(1)..=(column + 1).min(tiles_across - 1) {
+            let Some(apron) = &aprons[(r * tiles_across + c) as usize] else {
+                continue;
+            };
+            // The rectangle where the apron overlaps this tile.
+            let (ax1, ay1) = (
+                apron.x0 + i64::from(apron.width),
+                apron.y0 + i64::from(apron.height),
+            );
+            let (left, right) = (x0.max(apron.x0), x1.min(ax1));
+            let (top, bottom) = (y0.max(apron.y0), y1.min(ay1));
+            for y in top..bottom {
+                let cells = (y - apron.y0) * i64::from(apron.width) - apron.x0;
+                let pixels = (y - y0) as usize * width;
+                for x in left..right {
+                    groups[pixels + (x - x0) as usize].add(&apron.cells[(cells + x) as usize]);
                 }
             }
-            let i = (ty * tile.width + tx) as usize;
-            merge(&mut tile.pixels[i], &mut tile.weights[i], &group);
         }
+    }
+    for ((pixel, weights), group) in tile.pixels.iter_mut().zip(&mut tile.weights).zip(&groups) {
+        merge(pixel, weights, group);
     }
 }
 
@@ -331,7 +331,7 @@ mod tests {
         let mut total = 0.0;
         for (index, tile) in film.tiles().iter().enumerate() {
             let mut tile = tile.lock().unwrap();
-            fold(&mut tile, &aprons, across, reach(filter));
+            fold(&mut tile, &aprons, across);
             for (i, w) in tile.weights.iter().enumerate() {
                 let (x, y) = (
                     tile.x0 + i as u32 % tile.width,

@@ -192,8 +192,9 @@ impl Session {
     }
 
     /// Bytes a session of `settings` on `scene` allocates, in all: per
-    /// pixel the film's statistics, a splatting estimator's buffer and the
-    /// image it ends with, and VCM's light vertices of an iteration.
+    /// pixel the film's statistics, a splatting estimator's buffer, the
+    /// aprons of camera samples splatted through the filter and the image
+    /// it ends with, and VCM's light vertices of an iteration.
     pub fn memory_estimate(scene: &Scene, settings: &RenderSettings) -> u64 {
         let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
         let film = std::mem::size_of::<crate::film::PixelSums>() as u64;
@@ -202,13 +203,28 @@ impl Session {
             Integrator::Splatting(_) => 24,
             _ => 0,
         };
+        // Camera passes that splat keep the weights each pixel received, and
+        // an apron per tile until the pass ends.
+        let aprons = match settings.integrator {
+            Integrator::Splatting(_) => 0,
+            _ if settings.filter_sampling == FilterSampling::Splat
+                && filtered::can_splat(scene.camera.filter) =>
+            {
+                let side =
+                    u64::from(crate::film::TILE_SIZE + 2 * filtered::reach(scene.camera.filter));
+                let tile = u64::from(crate::film::TILE_SIZE).pow(2);
+                (side * side * std::mem::size_of::<filtered::SplatCell>() as u64).div_ceil(tile)
+                    + std::mem::size_of::<filtered::WeightSums>() as u64
+            }
+            _ => 0,
+        };
         let iteration = match settings.integrator {
             Integrator::MultiPass(crate::integrator::MultiPassIntegrator::Vcm(_)) => {
                 crate::integrator::vcm::Vcm::memory_per_iteration(scene)
             }
             _ => 0,
         };
-        pixels * (film + image + splats) + iteration
+        pixels * (film + image + splats + aprons) + iteration
     }
 
     pub fn scene(&self) -> &Scene {
@@ -496,10 +512,10 @@ impl Session {
                     .into_iter()
                     .map(|a| a.into_inner().unwrap_or_else(|e| e.into_inner()))
                     .collect();
-                let (across, reach) = (self.film.tiles_across(), filtered::reach(filter));
+                let across = self.film.tiles_across();
                 self.film.tiles().par_iter().for_each(|tile| {
                     let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
-                    filtered::fold(&mut tile, &aprons, across, reach);
+                    filtered::fold(&mut tile, &aprons, across);
                 });
             }
         });
