@@ -32,7 +32,7 @@ impl Default for PixelFilter {
 }
 
 /// How camera samples meet a filter wider than the box.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum FilterSampling {
     /// Each sample is taken uniformly in its pixel and added to every pixel
     /// the filter covers, with the filter's weight; a pixel is the weighted

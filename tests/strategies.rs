@@ -37,7 +37,10 @@ fn render_scene(mut scene: Scene, tracer: PathTracer, spp: u32, seed: u64) -> Fi
     snapshot
 }
 
-/// Block means and their squared standard errors.
+/// Block means and their squared standard errors: the pixels' summed as
+/// independent, times the film's correlation where samples were splatted
+/// through a filter (a block's edge pixels share samples with the next
+/// block too, so this overstates a little).
 pub(crate) fn blocks(s: &FilmSnapshot) -> Vec<([f64; 3], [f64; 3])> {
     let per_side = SIZE / BLOCK;
     let mut out = vec![([0.0; 3], [0.0; 3]); (per_side * per_side) as usize];
@@ -53,7 +56,7 @@ pub(crate) fn blocks(s: &FilmSnapshot) -> Vec<([f64; 3], [f64; 3])> {
     }
     let n = (BLOCK * BLOCK) as f64;
     out.into_iter()
-        .map(|(m, v)| (m.map(|x| x / n), v.map(|x| x / (n * n))))
+        .map(|(m, v)| (m.map(|x| x / n), v.map(|x| x * s.correlation / (n * n))))
         .collect()
 }
 

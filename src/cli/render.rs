@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tracelab::film::{EXTREME_LUMINANCE, FinalImage, FlaggedPixel};
-use tracelab::filter::FilterSampling;
+use tracelab::filter::{FilterSampling, PixelFilter};
 use tracelab::image::check_writable;
 use tracelab::integrator::{CameraIntegrator, Integrator, SplattingIntegrator};
 use tracelab::math::OffsetMode;
@@ -459,6 +459,18 @@ fn print_summary(session: &Session, stats: &RenderStats, load_time: Duration) {
         load_time.as_secs_f64()
     );
     eprintln!("{}", memory_line(session.scene()));
+    let filter = session.scene().camera.filter;
+    if filter != PixelFilter::Box {
+        let how = match session.splats_camera_samples() {
+            true => "camera samples splatted (--filter-sampling importance to draw them from it)",
+            false => "camera samples drawn from it",
+        };
+        eprintln!(
+            "pixel filter: {} (radius {}), {how}",
+            filter.name(),
+            filter.radius()
+        );
+    }
     let pixels = f64::from(session.scene().camera.width) * f64::from(session.scene().camera.height);
     let per_pixel = |n: u64| n as f64 / pixels;
     eprintln!(

@@ -312,6 +312,17 @@ impl Session {
         true
     }
 
+    /// True when the technique's camera samples are splatted through the
+    /// scene's pixel filter ([`FilterSampling::Splat`]; not with the box,
+    /// adaptive sampling, a deterministic technique, or light splats).
+    pub fn splats_camera_samples(&self) -> bool {
+        self.settings.filter_sampling == FilterSampling::Splat
+            && filtered::can_splat(self.scene.camera.filter)
+            && self.settings.adaptive.is_none()
+            && !self.settings.integrator.is_deterministic()
+            && !matches!(self.settings.integrator, Integrator::Splatting(_))
+    }
+
     /// Why the technique could not run, if it could not.
     pub fn failure(&self) -> Option<Error> {
         lock(&self.failure).clone()

@@ -325,7 +325,7 @@ impl ViewerApp {
                         }),
                         domains: c.domains,
                         clamp: None,
-                        filter_sampling: Default::default(),
+                        filter_sampling: c.filter_sampling,
                     },
                     target_spp: if integrator.is_deterministic() {
                         Some(1)

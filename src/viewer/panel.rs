@@ -4,6 +4,7 @@
 
 use super::app::ViewerApp;
 use super::settings::{CompareLayout, Config, ToneMap, ViewMode};
+use crate::filter::FilterSampling;
 use crate::integrator::IntegratorKind;
 use crate::live::Lock;
 use crate::math::OffsetMode;
@@ -207,6 +208,23 @@ fn sampler_rows(ui: &mut egui::Ui, config: &mut Config) {
             ui.checkbox(&mut d.light, "Light");
             ui.checkbox(&mut d.bsdf, "BSDF");
         });
+    });
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Tent / Gaussian filter");
+        ui.radio_value(&mut config.filter_sampling, FilterSampling::Splat, "Splat")
+            .on_hover_text(
+                "Each sample, uniform in its pixel, adds to every pixel the filter covers \
+                 (Mitsuba's film): lower noise, correlated neighbours",
+            );
+        ui.radio_value(
+            &mut config.filter_sampling,
+            FilterSampling::Importance,
+            "Importance",
+        )
+        .on_hover_text(
+            "Each sample's position is drawn from the filter and counts in its own \
+             pixel (pbrt-v4): independent pixels. Always so under adaptive sampling",
+        );
     });
     if config.spreads_by_noise() || config.can_spread_by_noise() {
         ui.checkbox(

@@ -2,6 +2,7 @@
 //! persists between runs. Render settings (which restart accumulation) and
 //! display settings (which never do) are kept apart.
 
+use crate::filter::FilterSampling;
 use crate::integrator::{IntegratorKind, IntegratorOptions, TechniqueKind};
 use crate::live::Lock;
 use crate::math::OffsetMode;
@@ -20,6 +21,8 @@ pub struct Config {
     /// Adaptive sampling: after a few samples everywhere, each pass spends
     /// its samples where the noise is ([`crate::render::Adaptive::Distribute`]).
     pub spread_by_noise: bool,
+    /// How camera samples meet a tent or Gaussian pixel filter.
+    pub filter_sampling: FilterSampling,
 }
 
 impl Default for Config {
@@ -30,6 +33,7 @@ impl Default for Config {
             domains: Domains::ALL,
             seed: 0,
             spread_by_noise: false,
+            filter_sampling: FilterSampling::default(),
         }
     }
 }
@@ -94,8 +98,12 @@ impl Config {
         } else {
             ""
         };
+        let filter = match self.filter_sampling {
+            FilterSampling::Splat => "",
+            FilterSampling::Importance => " filter-is",
+        };
         let sampler = self.fixed_sampler().unwrap_or(self.sampler);
-        format!("{estimator} {}{partial}{adaptive}", sampler.name())
+        format!("{estimator} {}{partial}{adaptive}{filter}", sampler.name())
     }
 
     /// The sampler the technique uses whatever the session's is: radiosity's
