@@ -162,6 +162,18 @@ impl Apron {
 /// `tiles_across` tiles), `None` for a tile not rendered in this part of
 /// the pass; a pixel sums the cells covering it in that order.
 pub fn fold(tile: &mut Tile, aprons: &[Option<Apron>], tiles_across: u32) {
+    fold_shifted(tile, aprons, tiles_across, |_| [0.0; 3]);
+}
+
+/// [`fold`], each sample's value a pixel received raised by `shift(i)`
+/// for the tile's pixel `i` (a splatting technique's light image of the
+/// pass, which every one of the pass's samples of the pixel then carries).
+pub fn fold_shifted(
+    tile: &mut Tile,
+    aprons: &[Option<Apron>],
+    tiles_across: u32,
+    shift: impl Fn(usize) -> [f64; 3],
+) {
     const SIZE: usize = super::TILE_SIZE as usize;
     // A reach below a tile's side: only the eight neighbours' aprons overlap.
     const _: () = assert!(MAX_SIDE / 2 < SIZE);
@@ -195,7 +207,23 @@ pub fn fold(tile: &mut Tile, aprons: &[Option<Apron>], tiles_across: u32) {
             }
         }
     }
-    for ((pixel, weights), group) in tile.pixels.iter_mut().zip(&mut tile.weights).zip(&groups) {
+    let pixels = tile.pixels.iter_mut().zip(&mut tile.weights);
+    for (i, ((pixel, weights), group)) in pixels.zip(&mut groups).enumerate() {
+        let e = shift(i);
+        if e != [0.0; 3] {
+            // Σ w (L + e), Σ w² (L + e)² and Σ w² (L + e) from the sums.
+            for c in 0..3 {
+                let (sum, sq, moment) = (
+                    f64::from(group.sum[c]),
+                    f64::from(group.sum_sq[c]),
+                    f64::from(group.moment[c]),
+                );
+                let (w, w2) = (f64::from(group.weight), f64::from(group.weight_sq));
+                group.sum[c] = (sum + e[c] * w) as f32;
+                group.sum_sq[c] = (sq + 2.0 * e[c] * moment + e[c] * e[c] * w2) as f32;
+                group.moment[c] = (moment + e[c] * w2) as f32;
+            }
+        }
         merge(pixel, weights, group);
     }
 }

@@ -69,10 +69,12 @@ pub struct Splat {
     pub film: Vec2,
     pub value: Rgb,
     /// Spread over the pixels the pixel filter covers (a point seen by the
-    /// camera); false for an estimate of the traced sample's own pixel,
-    /// whose camera ray was already drawn through the filter (BDPT's
-    /// camera strategies): filtering it again blurred it and, where the
-    /// filter's weights at whole pixels do not sum to 1 (a Gaussian), scaled it.
+    /// camera); false for an estimate of the traced sample's own pixel
+    /// (BDPT's camera strategies) at its camera ray's film position, which
+    /// the session adds to that pixel (the ray was drawn through the
+    /// filter: filtering it again blurred it and, where the filter's
+    /// weights at whole pixels do not sum to 1, scaled it) or splats
+    /// through the filter as camera samples are.
     pub filtered: bool,
 }
 
@@ -109,6 +111,7 @@ impl SplattingEstimator for LightTracer {
         &self,
         scene: &Scene,
         _pixel: (u32, u32),
+        _camera_filter: crate::filter::PixelFilter,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
         splat: impl FnMut(Splat),

@@ -42,6 +42,7 @@ pub use options::{DEEPEST_WITHOUT_ROULETTE, PathLength, Settings, Strategy};
 pub use path::PathTracer;
 pub use whitted::{GlassShadows, WhittedTracer};
 
+use crate::filter::PixelFilter;
 use crate::math::{Ray, Rgb};
 use crate::sampling::Sampler;
 use crate::scene::Scene;
@@ -138,11 +139,15 @@ pub trait CameraEstimator: Technique {
 pub trait SplattingEstimator: Technique {
     /// Traces one path for a sample of pixel `pixel` (which a light path
     /// may ignore) and hands each contribution that reaches the film to
-    /// `splat`, not yet divided by the number of paths of the pass.
+    /// `splat`, not yet divided by the number of paths of the pass. A
+    /// camera ray's film position is drawn from `camera_filter` (the box
+    /// where the session splats the pixel's own estimates through the
+    /// scene's filter).
     fn trace(
         &self,
         scene: &Scene,
         pixel: (u32, u32),
+        camera_filter: PixelFilter,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
         splat: impl FnMut(Splat),
@@ -471,11 +476,18 @@ macro_rules! register_techniques {
                 &self,
                 scene: &Scene,
                 pixel: (u32, u32),
+                camera_filter: PixelFilter,
                 sampler: &mut Sampler,
                 counts: &mut RayCounts,
                 splat: impl FnMut(Splat),
             ) {
-                match self { $(SplattingIntegrator::$sv(e) => e.trace(scene, pixel, sampler, counts, splat),)* }
+                match self { $(SplattingIntegrator::$sv(e) => e.trace(scene, pixel, camera_filter, sampler, counts, splat),)* }
+            }
+
+            /// True when some of its contributions are estimates of the
+            /// traced sample's own pixel (BDPT's camera strategies).
+            pub fn has_camera_strategies(&self) -> bool {
+                matches!(self.kind(), IntegratorKind::Bdpt)
             }
 
             fn kind(&self) -> IntegratorKind {

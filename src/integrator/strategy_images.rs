@@ -60,7 +60,8 @@ impl StrategyImages {
             for x in 0..width {
                 for sample in 0..spp {
                     sampler.start(y * width + x, sample);
-                    bdpt.trace_strategies(scene, (x, y), &mut sampler, &mut counts, |c| {
+                    let filter = scene.camera.filter;
+                    bdpt.trace_strategies(scene, (x, y), filter, &mut sampler, &mut counts, |c| {
                         let (px, py) = (c.film.x as u32, c.film.y as u32);
                         if px >= width || py >= height {
                             return;

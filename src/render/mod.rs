@@ -206,7 +206,7 @@ impl Session {
         // Camera passes that splat keep the weights each pixel received, and
         // an apron per tile until the pass ends.
         let aprons = match settings.integrator {
-            Integrator::Splatting(_) => 0,
+            Integrator::Splatting(e) if !e.has_camera_strategies() => 0,
             _ if settings.filter_sampling == FilterSampling::Splat
                 && filtered::can_splat(scene.camera.filter) =>
             {
@@ -314,13 +314,17 @@ impl Session {
 
     /// True when the technique's camera samples are splatted through the
     /// scene's pixel filter ([`FilterSampling::Splat`]; not with the box,
-    /// adaptive sampling, a deterministic technique, or light splats).
+    /// adaptive sampling, a deterministic technique, or a splatting
+    /// technique without camera strategies).
     pub fn splats_camera_samples(&self) -> bool {
         self.settings.filter_sampling == FilterSampling::Splat
             && filtered::can_splat(self.scene.camera.filter)
             && self.settings.adaptive.is_none()
             && !self.settings.integrator.is_deterministic()
-            && !matches!(self.settings.integrator, Integrator::Splatting(_))
+            && match self.settings.integrator {
+                Integrator::Splatting(e) => e.has_camera_strategies(),
+                _ => true,
+            }
     }
 
     /// Why the technique could not run, if it could not.
@@ -550,50 +554,103 @@ impl Session {
         let settings = &self.settings;
         let (width, height) = (self.film.width(), self.film.height());
         let splats = SplatBuffer::with_filter(width, height, scene.camera.filter);
+        // A pixel's own estimates (BDPT's camera strategies) are splatted
+        // through the filter as camera samples are, into aprons; the light
+        // splats stay in the buffer.
+        let filter = scene.camera.filter;
+        let own_splatted = self.splats_camera_samples();
+        let (camera_filter, aprons) = match own_splatted {
+            true => {
+                let aprons = self.film.tiles().iter().map(|_| Mutex::new(None)).collect();
+                (PixelFilter::Box, aprons)
+            }
+            false => (filter, Vec::new()),
+        };
+        // A camera strategy's value is scaled for the buffer, which divides by W H n.
+        let pixel_scale = 1.0 / (width as f32 * height as f32);
         self.film
             .tiles()
             .par_iter()
+            .enumerate()
             .with_max_len(1)
-            .for_each(|tile| {
+            .for_each(|(index, tile)| {
                 if self.cancelled.load(Ordering::Relaxed) {
                     return;
                 }
-                let (x0, y0, tile_width, tile_height) = {
+                let (x0, y0, tile_width, tile_height, mut apron) = {
                     let t = tile.lock().unwrap_or_else(|e| e.into_inner());
-                    (t.x0, t.y0, t.width, t.height)
+                    let apron = own_splatted.then(|| Apron::new(&t, filter));
+                    (t.x0, t.y0, t.width, t.height, apron)
                 };
                 let mut sampler =
                     Sampler::new(settings.sampler, settings.seed, settings.planned_spp)
                         .with_domains(settings.domains);
                 let mut counts = RayCounts::default();
                 let mut pending = PendingSplats::new();
+                let mut rejected = 0u64;
                 for i in 0..tile_width * tile_height {
                     let (x, y) = (x0 + i % tile_width, y0 + i / tile_width);
+                    let centre = glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
                     for s in first..first + spp {
                         sampler.start(y * width + x, s);
-                        estimator.trace(scene, (x, y), &mut sampler, &mut counts, |splat| {
-                            pending.push(&splats, splat.film, splat.value, splat.filtered)
-                        });
+                        let trace =
+                            |splat: crate::integrator::Splat| match (splat.filtered, &mut apron) {
+                                (true, _) => pending.push(&splats, splat.film, splat.value, true),
+                                (false, Some(apron)) => {
+                                    let value = splat.value * pixel_scale;
+                                    match value.is_finite() && value.min_element() >= 0.0 {
+                                        true => apron.splat(splat.film, value),
+                                        false => rejected += 1,
+                                    }
+                                }
+                                (false, None) => pending.push(&splats, centre, splat.value, false),
+                            };
+                        estimator.trace(
+                            scene,
+                            (x, y),
+                            camera_filter,
+                            &mut sampler,
+                            &mut counts,
+                            trace,
+                        );
                         pending.flush(&splats);
                     }
+                }
+                if let Some(apron) = apron {
+                    *lock(&aprons[index]) = Some(apron);
                 }
                 self.add_counts(
                     u64::from(tile_width * tile_height * spp),
                     &counts,
-                    pending.rejected,
+                    pending.rejected + rejected,
                 );
             });
         if self.cancelled.load(Ordering::Relaxed) {
             return;
         }
         let particles = f64::from(width) * f64::from(height) * f64::from(spp);
+        let aprons: Vec<Option<Apron>> = aprons
+            .into_iter()
+            .map(|a| a.into_inner().unwrap_or_else(|e| e.into_inner()))
+            .collect();
+        let across = self.film.tiles_across();
         self.film.tiles().par_iter().for_each(|tile| {
             let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
             let (x0, y0, tile_width) = (tile.x0, tile.y0, tile.width);
-            for (i, pixel) in tile.pixels.iter_mut().enumerate() {
+            let light = |i: usize| {
                 let (x, y) = (x0 + i as u32 % tile_width, y0 + i as u32 / tile_width);
-                let estimate = splats.get(y * width + x).map(|v| v / particles);
-                pixel.add_repeated(estimate, spp);
+                splats.get(y * width + x).map(|v| v / particles)
+            };
+            if own_splatted {
+                // The pass's light image joins each of its samples' values.
+                filtered::fold_shifted(&mut tile, &aprons, across, light);
+                for pixel in &mut tile.pixels {
+                    pixel.count += spp;
+                }
+            } else {
+                for (i, pixel) in tile.pixels.iter_mut().enumerate() {
+                    pixel.add_repeated(light(i), spp);
+                }
             }
         });
     }

@@ -32,6 +32,7 @@
 use super::light::{importance_weight, sample_particle, sees_lens, shading_correction};
 use super::{MisHeuristic, PathLength, RayCounts, Settings, Splat, SplattingEstimator, Technique};
 use crate::accel::NO_LIGHT;
+use crate::filter::PixelFilter;
 use crate::math::{Ray, Rgb, ray_between};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
@@ -180,6 +181,7 @@ impl SplattingEstimator for Bdpt {
         &self,
         scene: &Scene,
         pixel: (u32, u32),
+        camera_filter: PixelFilter,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
         mut splat: impl FnMut(Splat),
@@ -188,7 +190,7 @@ impl SplattingEstimator for Bdpt {
         // splat of their sum instead of one atomic add each (8% of the time
         // on SmallVCM's scene went to those adds).
         let mut own_pixel = Rgb::ZERO;
-        self.trace_strategies(scene, pixel, sampler, counts, |c| {
+        let film = self.trace_strategies(scene, pixel, camera_filter, sampler, counts, |c| {
             if c.t > 1 {
                 own_pixel += c.weighted;
             } else {
@@ -199,29 +201,32 @@ impl SplattingEstimator for Bdpt {
                 })
             }
         });
-        if own_pixel != Rgb::ZERO {
-            splat(Splat {
-                film: Vec2::new(pixel.0 as f32 + 0.5, pixel.1 as f32 + 0.5),
-                value: own_pixel,
-                filtered: false,
-            });
-        }
+        // Even when black: splatted through the filter, its weight counts.
+        splat(Splat {
+            film,
+            value: own_pixel,
+            filtered: false,
+        });
     }
 }
 
 impl Bdpt {
-    /// Traces one sample of pixel `pixel` and hands every strategy's
-    /// contribution to `contribute` (the strategy images read them all).
+    /// Traces one sample of pixel `pixel`, its camera ray's film position
+    /// drawn from `camera_filter`, and hands every strategy's contribution
+    /// to `contribute` (the strategy images read them all; camera
+    /// strategies land at the pixel's centre). Returns that film position.
     pub fn trace_strategies(
         &self,
         scene: &Scene,
         (x, y): (u32, u32),
+        camera_filter: PixelFilter,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
         mut contribute: impl FnMut(Contribution),
-    ) {
+    ) -> Vec2 {
         let camera = &scene.camera;
-        let ray = super::camera_ray(scene, sampler, x, y, false, false);
+        let (ray, camera_film) =
+            super::camera_ray_through(scene, sampler, x, y, false, false, camera_filter);
         let time = ray.time;
         counts.camera += 1;
         let film = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
@@ -325,6 +330,7 @@ impl Bdpt {
             }
         }
         SUBPATHS.with(|cell| cell.replace(subpaths));
+        camera_film
     }
 
     /// Extends `path` (which holds its first vertex) by tracing `ray` and
