@@ -318,17 +318,16 @@ fn jensens_photon_map_bias_shrinks_with_the_photon_count() {
     assert!(many.abs() < few.abs() / 3.0, "{few:+.4} -> {many:+.4}");
 }
 
-/// BDPT's camera strategies estimate the traced sample's own pixel, whose
-/// camera ray was drawn through the pixel filter already: they are added to
-/// that pixel as they are. Spread again by a Gaussian, whose weights at
-/// whole pixels sum to 1.027, they made Mitsuba's material previews 2.7%
-/// brighter than path tracing, and this environment-lit scene 2.0% (z 6.8
-/// with the old splat; 1.0008 and z 0.2 now). The whole image's mean
-/// (green: a pixel's channels are correlated) has its standard error from
-/// the pixels' summed as independent, times the film's correlation (path
-/// tracing splats its samples through the Gaussian, about π pixels each);
-/// BDPT's light splats correlate neighbours a little, which the 4.5 bound
-/// leaves room for.
+/// BDPT's camera strategies estimate the traced sample's own pixel: they
+/// are splatted through the filter from the camera ray's film position, as
+/// path tracing's samples are (importance-sampled, they are added to that
+/// pixel as they are: spread again by the Gaussian, whose weights at whole
+/// pixels sum to 1.027, they once made this environment-lit scene 2.0%
+/// brighter than path tracing, z 6.8). The whole image's mean (green: a
+/// pixel's channels are correlated) has its standard error from the
+/// pixels' summed as independent, times each film's correlation (about π
+/// pixels a sample for the Gaussian); BDPT's light splats correlate
+/// neighbours a little more, which the 4.5 bound leaves room for.
 #[test]
 fn bidirectional_agrees_with_path_tracing_under_a_gaussian_filter() {
     let gaussian = || {

@@ -157,6 +157,30 @@ impl Apron {
     }
 }
 
+/// The aprons of one pass, a slot per film tile, filled by the tiles' jobs.
+pub struct PassAprons(Vec<std::sync::Mutex<Option<Apron>>>);
+
+impl PassAprons {
+    /// Empty slots for `tiles` tiles (none at all when `splatting` is off).
+    pub fn new(tiles: usize, splatting: bool) -> PassAprons {
+        let tiles = if splatting { tiles } else { 0 };
+        PassAprons((0..tiles).map(|_| std::sync::Mutex::new(None)).collect())
+    }
+
+    /// Keeps tile `index`'s apron.
+    pub fn put(&self, index: usize, apron: Apron) {
+        *self.0[index].lock().unwrap_or_else(|e| e.into_inner()) = Some(apron);
+    }
+
+    /// The aprons in the film's tile order, `None` for a tile not rendered.
+    pub fn into_aprons(self) -> Vec<Option<Apron>> {
+        self.0
+            .into_iter()
+            .map(|a| a.into_inner().unwrap_or_else(|e| e.into_inner()))
+            .collect()
+    }
+}
+
 /// Merges into `tile` what the pass's aprons gave its pixels. `aprons`
 /// holds one entry per film tile, in the film's order (rows of
 /// `tiles_across` tiles), `None` for a tile not rendered in this part of

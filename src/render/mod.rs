@@ -13,7 +13,7 @@
 //! the thread count or tile schedule.
 
 use crate::error::{Error, Result};
-use crate::film::filtered::{self, Apron};
+use crate::film::filtered::{self, Apron, PassAprons};
 use crate::film::splats::{PendingSplats, SplatBuffer};
 use crate::film::{Film, FilmSnapshot, Tile, classify, non_finite_of, note_flagged};
 use crate::filter::{FilterSampling, PixelFilter};
@@ -407,13 +407,8 @@ impl Session {
             && filtered::can_splat(filter)
             && !deterministic
             && settings.adaptive.is_none();
-        let (position_filter, aprons) = match splat {
-            true => {
-                let aprons = self.film.tiles().iter().map(|_| Mutex::new(None)).collect();
-                (PixelFilter::Box, aprons)
-            }
-            false => (filter, Vec::new()),
-        };
+        let position_filter = if splat { PixelFilter::Box } else { filter };
+        let aprons = PassAprons::new(self.film.tiles().len(), splat);
         self.pool.install(|| {
             self.film
                 .tiles()
@@ -515,7 +510,7 @@ impl Session {
                     }
                     drop(tile);
                     if let Some(apron) = apron {
-                        *lock(&aprons[index]) = Some(apron);
+                        aprons.put(index, apron);
                     }
                     self.add_counts(counts.camera, &counts, non_finite);
                     self.skipped.fetch_add(skipped, Ordering::Relaxed);
@@ -523,10 +518,7 @@ impl Session {
                     self.clamped.fetch_add(clamped, Ordering::Relaxed);
                 });
             if splat && !self.cancelled.load(Ordering::Relaxed) {
-                let aprons: Vec<Option<Apron>> = aprons
-                    .into_iter()
-                    .map(|a| a.into_inner().unwrap_or_else(|e| e.into_inner()))
-                    .collect();
+                let aprons = aprons.into_aprons();
                 let across = self.film.tiles_across();
                 self.film.tiles().par_iter().for_each(|tile| {
                     let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
@@ -559,13 +551,12 @@ impl Session {
         // splats stay in the buffer.
         let filter = scene.camera.filter;
         let own_splatted = self.splats_camera_samples();
-        let (camera_filter, aprons) = match own_splatted {
-            true => {
-                let aprons = self.film.tiles().iter().map(|_| Mutex::new(None)).collect();
-                (PixelFilter::Box, aprons)
-            }
-            false => (filter, Vec::new()),
+        let camera_filter = if own_splatted {
+            PixelFilter::Box
+        } else {
+            filter
         };
+        let aprons = PassAprons::new(self.film.tiles().len(), own_splatted);
         // A camera strategy's value is scaled for the buffer, which divides by W H n.
         let pixel_scale = 1.0 / (width as f32 * height as f32);
         self.film
@@ -617,7 +608,7 @@ impl Session {
                     }
                 }
                 if let Some(apron) = apron {
-                    *lock(&aprons[index]) = Some(apron);
+                    aprons.put(index, apron);
                 }
                 self.add_counts(
                     u64::from(tile_width * tile_height * spp),
@@ -629,10 +620,7 @@ impl Session {
             return;
         }
         let particles = f64::from(width) * f64::from(height) * f64::from(spp);
-        let aprons: Vec<Option<Apron>> = aprons
-            .into_iter()
-            .map(|a| a.into_inner().unwrap_or_else(|e| e.into_inner()))
-            .collect();
+        let aprons = aprons.into_aprons();
         let across = self.film.tiles_across();
         self.film.tiles().par_iter().for_each(|tile| {
             let mut tile = tile.lock().unwrap_or_else(|e| e.into_inner());
