@@ -33,6 +33,7 @@ pub fn build_and_render(input: SceneInput) {
         adaptive: None,
         domains: Default::default(),
         clamp: None,
+        filter_sampling: Default::default(),
     };
     if let Ok(session) = Session::new(Arc::new(scene), settings) {
         session.render_pass(1);
