@@ -314,14 +314,21 @@ impl Session {
     /// adaptive sampling, a deterministic technique, or a splatting
     /// technique without camera strategies).
     pub fn splats_camera_samples(&self) -> bool {
-        self.settings.filter_sampling == FilterSampling::Splat
-            && filtered::can_splat(self.scene.camera.filter)
-            && self.settings.adaptive.is_none()
-            && !self.settings.integrator.is_deterministic()
+        self.splats_through_filter(self.settings.integrator.is_deterministic())
             && match self.settings.integrator {
                 Integrator::Splatting(e) => e.has_camera_strategies(),
                 _ => true,
             }
+    }
+
+    /// Whether a pass's camera samples, `deterministic` or not, are
+    /// splatted through the scene's filter: the one rule of
+    /// [`Session::splats_camera_samples`] and the passes.
+    fn splats_through_filter(&self, deterministic: bool) -> bool {
+        self.settings.filter_sampling == FilterSampling::Splat
+            && filtered::can_splat(self.scene.camera.filter)
+            && self.settings.adaptive.is_none()
+            && !deterministic
     }
 
     /// Why the technique could not run, if it could not.
@@ -400,10 +407,7 @@ impl Session {
         // Samples uniform in their pixels, splatted through the filter
         // (crate::film::filtered), or drawn from it and kept in their pixel.
         let filter = scene.camera.filter;
-        let splat = settings.filter_sampling == FilterSampling::Splat
-            && filtered::can_splat(filter)
-            && !deterministic
-            && settings.adaptive.is_none();
+        let splat = self.splats_through_filter(deterministic);
         let position_filter = if splat { PixelFilter::Box } else { filter };
         let aprons = PassAprons::new(self.film.tiles().len(), splat);
         self.pool.install(|| {
