@@ -7,6 +7,7 @@ use crate::film::filtered::{self, Apron, PassAprons};
 use crate::film::splats::{PendingSplats, SplatBuffer};
 use crate::filter::PixelFilter;
 use crate::integrator::{RayCounts, SplattingIntegrator};
+use crate::math::Rgb;
 use crate::sampling::Sampler;
 use rayon::prelude::*;
 use std::sync::atomic::Ordering;
@@ -78,6 +79,8 @@ impl Session {
                                         false => rejected += 1,
                                     }
                                 }
+                                // A black estimate adds nothing to the buffer.
+                                (false, None) if splat.value == Rgb::ZERO => {}
                                 (false, None) => pending.push(&splats, centre, splat.value, false),
                             };
                         estimator.trace(
