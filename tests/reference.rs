@@ -341,6 +341,21 @@ fn path_tracing_with_sobol_points_matches_mitsuba() {
     check_replicates_against_reference(options(IntegratorKind::Path, 8), None, 8, 16);
 }
 
+/// Light tracing and BDPT draw their particles from one Sobol net over
+/// the whole render (`Sampler::start_particle`): a particle's light path is
+/// tied to another pixel's camera sample in a shuffled order, and the
+/// replicates' spread and mean hold them to the reference as above (8
+/// renders of 8 samples: the 64 samples of the independent tests).
+#[test]
+fn light_tracing_with_sobol_particles_matches_mitsuba() {
+    check_replicates_against_reference(options(IntegratorKind::Light, 8), None, 8, 8);
+}
+
+#[test]
+fn bidirectional_path_tracing_with_sobol_particles_matches_mitsuba() {
+    check_replicates_against_reference(options(IntegratorKind::Bdpt, 8), None, 8, 8);
+}
+
 #[test]
 fn path_tracing_with_sobol_points_spread_by_noise_matches_mitsuba() {
     check_replicates_against_reference(

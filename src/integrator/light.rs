@@ -136,6 +136,7 @@ impl LightTracer {
         counts: &mut RayCounts,
         mut splat: impl FnMut(Splat),
     ) {
+        sampler.start_particle(scene.camera.width * scene.camera.height);
         let emission = sample_particle(scene, sampler);
         let u_lens = sampler.next_2d_for(Domain::Lens);
         let time = super::sample_time(scene, sampler, false);

@@ -177,6 +177,12 @@ pub struct Sampler {
     /// Dimensions from this one on are independent (see
     /// [`Sampler::enter_path_vertex`]).
     independent_from: u32,
+    /// The pixel of the current sample (a particle's number reads it).
+    pixel: u32,
+    /// Sobol: the current sample is a particle whose first three requests
+    /// come from one five-dimensional net over all the render's particles
+    /// (see [`Sampler::start_particle`]).
+    particle: bool,
 }
 
 /// Path vertices (the camera ray's hit is vertex 0) whose numbers the Sobol
@@ -218,6 +224,8 @@ impl Sampler {
             grid_y: batch / grid_x,
             domains: Domains::ALL,
             independent_from: u32::MAX,
+            pixel: 0,
+            particle: false,
         }
     }
 
@@ -316,6 +324,54 @@ impl Sampler {
         self.reversed_index = sample_index.reverse_bits();
         self.dimension = 0;
         self.independent_from = u32::MAX;
+        self.pixel = pixel;
+        self.particle = false;
+    }
+
+    /// Starts the light path of the current camera sample, the render's
+    /// particle number sample index × `pixels` + pixel. Sobol draws its
+    /// light choice, point and direction from one five-dimensional Sobol
+    /// net over all particles, Owen-scrambled by the seed alone, and its
+    /// later numbers from the padded sequence over particles: a pixel's
+    /// own sequence stratifies only its 2^k camera samples, where the
+    /// particles that land in a pixel come from every pixel's samples and
+    /// were drawn independently of each other (light tracing's count noise
+    /// in a lit pixel). The other samplers go on with the camera sample's
+    /// numbers.
+    pub fn start_particle(&mut self, pixels: u32) {
+        if self.kind != SamplerKind::Sobol {
+            return;
+        }
+        // The pass's particles are a block of the sequence, handed to its
+        // pixels in an order shuffled per sample index: a particle number
+        // that followed the pixel's would tie a column's light paths to
+        // one half of the net (the sequence's low bits), a pattern that
+        // BDPT's connections printed as stripes.
+        let key = hash_combine(self.seed_key, u64::from(self.sample_index));
+        let slot = permute(self.pixel.min(pixels - 1), pixels, key as u32);
+        let number = u64::from(self.sample_index) * u64::from(pixels) + u64::from(slot);
+        // One sequence per 2^32 particles, each scrambled afresh.
+        let key = hash_combine(self.seed_key, 0x4000_0000_0000_0000 | (number >> 32));
+        self.pixel_key = key;
+        self.sample_key = hash_combine(key, number);
+        self.sample_index = number as u32;
+        self.reversed_index = self.sample_index.reverse_bits();
+        self.dimension = 0;
+        self.independent_from = u32::MAX;
+        self.particle = true;
+    }
+
+    /// Coordinate `j` of the particles' five-dimensional net at the
+    /// current particle, Owen-scrambled.
+    #[inline]
+    fn particle_coordinate(&self, j: usize) -> f32 {
+        let seed = hash_combine(self.pixel_key, 0x100 + j as u64) as u32;
+        let index = self.sample_index;
+        bits_to_unit_float(match j {
+            0 => sobol_dimension_0(index, seed),
+            1 => sobol_dimension_1(index, seed),
+            _ => owen_scramble(sobol_by_matrix(index, &PARTICLE_MATRICES[j - 2]), seed),
+        })
     }
 
     /// The dimension the next request will use (for replaying a sample).
@@ -363,6 +419,9 @@ impl Sampler {
     #[inline(always)]
     fn get_1d(&self, dim: u32) -> f32 {
         if self.kind == SamplerKind::Sobol {
+            if self.particle && dim == 0 {
+                return self.particle_coordinate(0);
+            }
             let key = hash_combine(self.pixel_key, dim as u64);
             let index = self.sobol_index(key as u32);
             return bits_to_unit_float(sobol_dimension_0(index, (key >> 32) as u32));
@@ -380,6 +439,10 @@ impl Sampler {
     #[inline(always)]
     fn get_2d(&self, dim: u32) -> Vec2 {
         if self.kind == SamplerKind::Sobol {
+            if self.particle && (dim == 1 || dim == 2) {
+                let j = 2 * dim as usize - 1;
+                return Vec2::new(self.particle_coordinate(j), self.particle_coordinate(j + 1));
+            }
             let key = hash_combine(self.pixel_key, dim as u64);
             let index = self.sobol_index(key as u32);
             let x = sobol_dimension_0(index, (key >> 32) as u32);
@@ -461,6 +524,64 @@ fn pascal_superset_xor(mut b: u32) -> u32 {
     b ^= (b >> 8) & 0x00ff_00ff;
     b ^= (b >> 16) & 0x0000_ffff;
     b
+}
+
+/// Sobol's dimensions 3 to 5 (Joe and Kuo's d = 3, 4, 5: degree s,
+/// polynomial a, initial direction numbers m), as generator matrices'
+/// columns, the fraction's top bit first: with dimensions 1 and 2 they
+/// make the particles' five-dimensional net.
+const PARTICLE_MATRICES: [[u32; 32]; 3] = [
+    sobol_matrix(2, 1, [1, 3, 0]),
+    sobol_matrix(3, 1, [1, 3, 1]),
+    sobol_matrix(3, 2, [1, 1, 1]),
+];
+
+/// The generator matrix of a Sobol dimension from its primitive
+/// polynomial's degree `s` and coefficients `a` and its first direction
+/// numbers `m` (Bratley and Fox's recurrence, as Joe and Kuo state it).
+const fn sobol_matrix(s: usize, a: u32, m: [u32; 3]) -> [u32; 32] {
+    let mut v = [0u32; 32];
+    let mut i = 0;
+    while i < 32 {
+        if i < s {
+            v[i] = m[i] << (31 - i);
+        } else {
+            let mut x = v[i - s] ^ (v[i - s] >> s);
+            let mut k = 1;
+            while k < s {
+                if (a >> (s - 1 - k)) & 1 == 1 {
+                    x ^= v[i - k];
+                }
+                k += 1;
+            }
+            v[i] = x;
+        }
+        i += 1;
+    }
+    v
+}
+
+/// Point `index` of the Sobol dimension with generator `matrix`, as a
+/// 32-bit fraction.
+#[inline]
+fn sobol_by_matrix(mut index: u32, matrix: &[u32; 32]) -> u32 {
+    let mut x = 0;
+    let mut column = 0;
+    while index != 0 {
+        // Branch-free: a mask of the index's lowest bit.
+        x ^= matrix[column] & (index & 1).wrapping_neg();
+        index >>= 1;
+        column += 1;
+    }
+    x
+}
+
+/// Owen's nested uniform scramble of a 32-bit fraction (Laine and Karras's
+/// hash on its mirrored bits, so that each digit is flipped by the digits
+/// above it).
+#[inline]
+fn owen_scramble(x: u32, seed: u32) -> u32 {
+    laine_karras(x.reverse_bits(), seed).reverse_bits()
 }
 
 /// Laine-Karras hash: a random permutation of a 32-bit word in which each
@@ -624,6 +745,65 @@ mod tests {
             c[(p.x * nx as f32) as usize + nx as usize * (p.y * ny as f32) as usize] += 1;
         }
         c
+    }
+
+    #[test]
+    fn a_passs_particles_are_a_five_dimensional_net() {
+        // A pass of 256 pixels at one sample: its 256 particles' light
+        // choice, point and direction are Sobol's first five dimensions,
+        // which at 256 points form a (3, 8, 5)-net (computed from the
+        // matrices; Niederreiter's bound is 5): every box of volume 2^-5
+        // of every shape holds exactly 8 of them. A dimension repeated,
+        // a polynomial mistaken for another, or a pass that is not one
+        // block of the sequence breaks some box; and each coordinate alone
+        // is a (0, 8, 1)-net, one point per 1/256.
+        for (sample, seed) in [(0, 1), (3, 2)] {
+            let mut s = Sampler::new(SamplerKind::Sobol, seed, 0);
+            let points: Vec<[f32; 5]> = (0..256)
+                .map(|pixel| {
+                    s.start(pixel, sample);
+                    s.next_2d(); // the camera path's numbers come first
+                    s.start_particle(256);
+                    let select = s.next_1d();
+                    let (a, b) = (s.next_2d(), s.next_2d());
+                    [select, a.x, a.y, b.x, b.y]
+                })
+                .collect();
+            for j in 0..5 {
+                let mut cells = [0; 256];
+                for p in &points {
+                    cells[(p[j] * 256.0) as usize] += 1;
+                }
+                assert!(cells.iter().all(|&c| c == 1), "coordinate {j}");
+            }
+            for shape in 0..6u32.pow(5) {
+                let digits: Vec<u32> = (0..5).map(|j| shape / 6u32.pow(j) % 6).collect();
+                if digits.iter().sum::<u32>() != 5 {
+                    continue;
+                }
+                let mut boxes = [0; 32];
+                for p in &points {
+                    let mut index = 0;
+                    for j in 0..5 {
+                        index = (index << digits[j]) | (p[j] * (1 << digits[j]) as f32) as usize;
+                    }
+                    boxes[index] += 1;
+                }
+                assert!(
+                    boxes.iter().all(|&c| c == 8),
+                    "sample {sample}, shape {digits:?}: {boxes:?}"
+                );
+            }
+        }
+        // The other samplers go on with the camera sample's numbers.
+        let mut a = Sampler::new(SamplerKind::Independent, 7, 0);
+        let mut b = a.clone();
+        a.start(5, 2);
+        b.start(5, 2);
+        a.next_2d();
+        b.next_2d();
+        b.start_particle(64);
+        assert_eq!(a.next_2d(), b.next_2d());
     }
 
     #[test]

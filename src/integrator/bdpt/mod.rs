@@ -259,6 +259,7 @@ impl Bdpt {
             camera_path,
         );
 
+        sampler.start_particle(camera.width * camera.height);
         let emission = sample_particle(scene, sampler);
         let u_lens = sampler.next_2d_for(Domain::Lens);
         if let Some(emission) = emission {
