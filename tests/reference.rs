@@ -356,6 +356,13 @@ fn bidirectional_path_tracing_with_sobol_particles_matches_mitsuba() {
     check_replicates_against_reference(options(IntegratorKind::Bdpt, 8), None, 8, 8);
 }
 
+/// VCM's light paths, traced in a pass of their own, are the same net's
+/// particles (its bias at this radius is far below the noise, as above).
+#[test]
+fn vertex_connection_and_merging_with_sobol_particles_matches_mitsuba() {
+    check_replicates_against_reference(options(IntegratorKind::Vcm, 8), None, 8, 8);
+}
+
 #[test]
 fn path_tracing_with_sobol_points_spread_by_noise_matches_mitsuba() {
     check_replicates_against_reference(

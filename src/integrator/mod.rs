@@ -161,8 +161,16 @@ pub trait MultiPassEstimator: Technique {
     type Pass: Send + Sync;
     /// Runs the pre-pass of pass number `pass` (0, 1, ...); may use rayon,
     /// as it runs on the session's threads. Randomness must come from
-    /// (`seed`, `pass`) alone so images stay independent of the schedule.
-    fn prepare(&self, scene: &Scene, pass: u32, seed: u64, counts: &mut RayCounts) -> Self::Pass;
+    /// (`seed`, `pass`) alone so images stay independent of the schedule;
+    /// `sampler` is the session's, which a pre-pass may follow.
+    fn prepare(
+        &self,
+        scene: &Scene,
+        pass: u32,
+        seed: u64,
+        sampler: crate::sampling::SamplerKind,
+        counts: &mut RayCounts,
+    ) -> Self::Pass;
     /// One radiance sample along a camera ray through pixel `pixel`,
     /// reading this pass's data.
     fn radiance(

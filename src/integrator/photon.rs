@@ -228,7 +228,14 @@ impl PhotonMap2Pass {
 impl MultiPassEstimator for PhotonMap2Pass {
     type Pass = Maps;
 
-    fn prepare(&self, scene: &Scene, pass: u32, seed: u64, counts: &mut RayCounts) -> Maps {
+    fn prepare(
+        &self,
+        scene: &Scene,
+        pass: u32,
+        seed: u64,
+        _: crate::sampling::SamplerKind,
+        counts: &mut RayCounts,
+    ) -> Maps {
         // Direct light is sampled at x, so the caustic map holds photons of
         // at least one (specular) bounce; the global map holds all, as the
         // gather reads the whole reflected radiance at x'.

@@ -153,7 +153,14 @@ impl PhotonMapper {
 impl MultiPassEstimator for PhotonMapper {
     type Pass = Iteration;
 
-    fn prepare(&self, scene: &Scene, pass: u32, seed: u64, counts: &mut RayCounts) -> Iteration {
+    fn prepare(
+        &self,
+        scene: &Scene,
+        pass: u32,
+        seed: u64,
+        _: crate::sampling::SamplerKind,
+        counts: &mut RayCounts,
+    ) -> Iteration {
         // Direct light is sampled at the camera's hit: the map holds the
         // photons of at least one bounce.
         let (photons, _) = photon_map::shoot(

@@ -26,7 +26,13 @@ impl MultiPassVisitor for MultiPass<'_> {
             let iteration = self.first + i;
             let mut counts = RayCounts::default();
             let pass = session.pool.install(|| {
-                estimator.prepare(&session.scene, iteration, settings.seed, &mut counts)
+                estimator.prepare(
+                    &session.scene,
+                    iteration,
+                    settings.seed,
+                    settings.sampler,
+                    &mut counts,
+                )
             });
             session.add_counts(0, &counts, 0);
             session.camera_pass(

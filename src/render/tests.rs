@@ -40,7 +40,14 @@ impl Technique for PassNumber {
 
 impl MultiPassEstimator for PassNumber {
     type Pass = f32;
-    fn prepare(&self, _: &Scene, pass: u32, _: u64, counts: &mut RayCounts) -> f32 {
+    fn prepare(
+        &self,
+        _: &Scene,
+        pass: u32,
+        _: u64,
+        _: crate::sampling::SamplerKind,
+        counts: &mut RayCounts,
+    ) -> f32 {
         counts.bounce += 10;
         pass as f32
     }

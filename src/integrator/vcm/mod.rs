@@ -431,7 +431,14 @@ impl Vcm {
 impl MultiPassEstimator for Vcm {
     type Pass = Iteration;
 
-    fn prepare(&self, scene: &Scene, pass: u32, seed: u64, counts: &mut RayCounts) -> Iteration {
+    fn prepare(
+        &self,
+        scene: &Scene,
+        pass: u32,
+        seed: u64,
+        sampler: SamplerKind,
+        counts: &mut RayCounts,
+    ) -> Iteration {
         let paths = Self::light_paths(scene);
         let radius = self.radius_at(pass);
         let eta = paths as f32 * PI * radius * radius;
@@ -451,17 +458,28 @@ impl MultiPassEstimator for Vcm {
             time: scene.camera.shutter_open,
         };
         let key = hash_combine(hash_combine(seed, u64::from(pass)), 0x56_434d);
+        // With Sobol the light paths are particles of one net over the
+        // render (as BDPT's), otherwise independent per (seed, pass).
+        let sobol = sampler == SamplerKind::Sobol;
         let chunks: Vec<(Vec<LightVertex>, Vec<u32>, RayCounts)> = (0..paths
             .div_ceil(PARTICLE_CHUNK))
             .into_par_iter()
             .map(|chunk| {
-                let mut sampler = Sampler::new(SamplerKind::Independent, key, 0);
+                let mut sampler = match sobol {
+                    true => Sampler::new(SamplerKind::Sobol, seed, 0),
+                    false => Sampler::new(SamplerKind::Independent, key, 0),
+                };
                 let mut vertices = Vec::new();
                 let mut ends = Vec::new();
                 let mut rays = RayCounts::default();
                 let mut splats = PendingSplats::new();
                 for index in chunk * PARTICLE_CHUNK..((chunk + 1) * PARTICLE_CHUNK).min(paths) {
-                    sampler.start(index, 0);
+                    if sobol {
+                        sampler.start(index, pass);
+                        sampler.start_particle(paths);
+                    } else {
+                        sampler.start(index, 0);
+                    }
                     self.trace_light_path(
                         scene,
                         &iteration,
