@@ -4,9 +4,11 @@
 //! table for discrete choices.
 
 pub mod alias;
+mod domain;
 pub mod hash;
 pub mod piecewise;
 pub mod sampler;
+mod sobol;
 pub mod spherical_triangle;
 pub mod warp;
 

@@ -6,7 +6,12 @@
 //! relate in each dimension. All of them are functions of
 //! (seed, pixel, sample index, dimension) only.
 
+pub use super::domain::{Domain, Domains};
 use super::hash::{hash_combine, mix64, permute, to_unit_float};
+use super::sobol::{
+    PARTICLE_MATRICES, laine_karras, owen_scramble, sobol_by_matrix, sobol_dimension_0,
+    sobol_dimension_1,
+};
 use glam::Vec2;
 
 /// Which sampler to use; selected on the command line.
@@ -50,98 +55,6 @@ impl SamplerKind {
         SamplerKind::MultiJittered,
         SamplerKind::Sobol,
     ];
-}
-
-/// The sampling domains a path draws numbers for. A sampler stratifies (or
-/// uses its low-discrepancy points in) the domains selected in
-/// [`Domains`]; the others get independent numbers, so each domain's effect
-/// on the noise can be seen alone.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Domain {
-    /// Position inside the pixel (antialiasing).
-    Pixel,
-    /// Point on the thin lens (depth of field).
-    Lens,
-    /// Instant within the shutter interval (motion blur).
-    Time,
-    /// Light choice and point on the light (and particle emission).
-    Light,
-    /// BSDF lobe and direction.
-    Bsdf,
-    /// Everything else (Russian roulette).
-    Other,
-}
-
-/// A set of [`Domain`]s.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub struct Domains {
-    pub pixel: bool,
-    pub lens: bool,
-    /// Missing in settings saved before the time domain existed.
-    #[serde(default = "yes")]
-    pub time: bool,
-    pub light: bool,
-    pub bsdf: bool,
-}
-
-impl Domains {
-    pub const ALL: Domains = Domains {
-        pixel: true,
-        lens: true,
-        time: true,
-        light: true,
-        bsdf: true,
-    };
-
-    #[inline]
-    pub fn contains(&self, domain: Domain) -> bool {
-        match domain {
-            Domain::Pixel => self.pixel,
-            Domain::Lens => self.lens,
-            Domain::Time => self.time,
-            Domain::Light => self.light,
-            Domain::Bsdf => self.bsdf,
-            Domain::Other => true,
-        }
-    }
-}
-
-impl Domains {
-    /// Parses names separated by `sep` (`pixel`, `lens`, `time`, `light`, `bsdf`).
-    pub fn parse(text: &str, sep: char) -> Result<Domains, String> {
-        let mut d = Domains {
-            pixel: false,
-            lens: false,
-            time: false,
-            light: false,
-            bsdf: false,
-        };
-        for name in text.split(sep).map(str::trim).filter(|n| !n.is_empty()) {
-            match name {
-                "pixel" => d.pixel = true,
-                "lens" => d.lens = true,
-                "time" => d.time = true,
-                "light" => d.light = true,
-                "bsdf" => d.bsdf = true,
-                other => {
-                    return Err(format!(
-                        "unknown sampling domain `{other}` (pixel, lens, time, light, bsdf)"
-                    ));
-                }
-            }
-        }
-        Ok(d)
-    }
-}
-
-fn yes() -> bool {
-    true
-}
-
-impl Default for Domains {
-    fn default() -> Self {
-        Domains::ALL
-    }
 }
 
 /// Default number of samples stratified together when a render has no planned
@@ -494,143 +407,9 @@ fn bits_to_unit_float(x: u32) -> f32 {
     (x >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
-/// Point `index` of the first Sobol dimension (the van der Corput sequence:
-/// the index's bits mirrored into a fraction), Owen-scrambled with `seed`.
-/// Mirroring and the scramble's own two mirrors cancel down to one.
-#[inline]
-fn sobol_dimension_0(index: u32, seed: u32) -> u32 {
-    laine_karras(index, seed).reverse_bits()
-}
-
-/// Point `index` of the second Sobol dimension, Owen-scrambled with `seed`.
-/// Its generator matrix is Pascal's triangle mod 2: fraction digit j is the
-/// XOR of the index bits k with C(k, j) odd, that is (Lucas) of the bits k
-/// whose binary digits include j's. That superset sum takes five shift-XOR
-/// steps, one per bit of a digit position, instead of a loop over the 32
-/// bits of a scrambled index with a data-dependent branch each (which cost
-/// a third of the render time: 2.0 against 3.0 M paths/s independent).
-#[inline]
-fn sobol_dimension_1(index: u32, seed: u32) -> u32 {
-    laine_karras(pascal_superset_xor(index), seed).reverse_bits()
-}
-
-/// Digit j (bit j, unmirrored) of Sobol's second dimension at `index`: the
-/// XOR of the index bits k whose binary digits include j's.
-#[inline]
-fn pascal_superset_xor(mut b: u32) -> u32 {
-    b ^= (b >> 1) & 0x5555_5555;
-    b ^= (b >> 2) & 0x3333_3333;
-    b ^= (b >> 4) & 0x0f0f_0f0f;
-    b ^= (b >> 8) & 0x00ff_00ff;
-    b ^= (b >> 16) & 0x0000_ffff;
-    b
-}
-
-/// Sobol's dimensions 3 to 5 (Joe and Kuo's d = 3, 4, 5: degree s,
-/// polynomial a, initial direction numbers m), as generator matrices'
-/// columns, the fraction's top bit first: with dimensions 1 and 2 they
-/// make the particles' five-dimensional net.
-const PARTICLE_MATRICES: [[u32; 32]; 3] = [
-    sobol_matrix(2, 1, [1, 3, 0]),
-    sobol_matrix(3, 1, [1, 3, 1]),
-    sobol_matrix(3, 2, [1, 1, 1]),
-];
-
-/// The generator matrix of a Sobol dimension from its primitive
-/// polynomial's degree `s` and coefficients `a` and its first direction
-/// numbers `m` (Bratley and Fox's recurrence, as Joe and Kuo state it).
-const fn sobol_matrix(s: usize, a: u32, m: [u32; 3]) -> [u32; 32] {
-    let mut v = [0u32; 32];
-    let mut i = 0;
-    while i < 32 {
-        if i < s {
-            v[i] = m[i] << (31 - i);
-        } else {
-            let mut x = v[i - s] ^ (v[i - s] >> s);
-            let mut k = 1;
-            while k < s {
-                if (a >> (s - 1 - k)) & 1 == 1 {
-                    x ^= v[i - k];
-                }
-                k += 1;
-            }
-            v[i] = x;
-        }
-        i += 1;
-    }
-    v
-}
-
-/// Point `index` of the Sobol dimension with generator `matrix`, as a
-/// 32-bit fraction.
-#[inline]
-fn sobol_by_matrix(mut index: u32, matrix: &[u32; 32]) -> u32 {
-    let mut x = 0;
-    let mut column = 0;
-    while index != 0 {
-        // Branch-free: a mask of the index's lowest bit.
-        x ^= matrix[column] & (index & 1).wrapping_neg();
-        index >>= 1;
-        column += 1;
-    }
-    x
-}
-
-/// Owen's nested uniform scramble of a 32-bit fraction (Laine and Karras's
-/// hash on its mirrored bits, so that each digit is flipped by the digits
-/// above it).
-#[inline]
-fn owen_scramble(x: u32, seed: u32) -> u32 {
-    laine_karras(x.reverse_bits(), seed).reverse_bits()
-}
-
-/// Laine-Karras hash: a random permutation of a 32-bit word in which each
-/// output bit depends only on the input bits at or below it.
-#[inline]
-fn laine_karras(mut x: u32, seed: u32) -> u32 {
-    x = x.wrapping_add(seed);
-    x ^= x.wrapping_mul(0x6c50_b47c);
-    x ^= x.wrapping_mul(0xb82f_1e52);
-    x ^= x.wrapping_mul(0xc7af_e638);
-    x ^= x.wrapping_mul(0x8d22_f6e6);
-    x
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Sobol's second dimension from its generator matrix's columns
-    /// (v_0 = 2^31, v_{k+1} = v_k ^ (v_k >> 1)), one index bit at a time.
-    fn sobol_dimension_1_by_columns(mut index: u32) -> u32 {
-        let mut v = 1u32 << 31;
-        let mut x = 0;
-        while index != 0 {
-            if index & 1 != 0 {
-                x ^= v;
-            }
-            index >>= 1;
-            v ^= v >> 1;
-        }
-        x
-    }
-
-    #[test]
-    fn sobol_dimension_1_matches_its_generator_matrix() {
-        let mut index = 1u32;
-        for i in 0..20_000 {
-            index = if i < 4096 {
-                i
-            } else {
-                index.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15)
-            };
-            assert_eq!(
-                pascal_superset_xor(index).reverse_bits(),
-                sobol_dimension_1_by_columns(index),
-                "{index:#x}"
-            );
-        }
-    }
 
     #[test]
     fn sobol_paths_turn_independent_at_their_deep_vertices() {
