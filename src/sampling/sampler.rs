@@ -242,7 +242,8 @@ impl Sampler {
     }
 
     /// Starts the light path of the current camera sample, the render's
-    /// particle number sample index × `pixels` + pixel. Sobol draws its
+    /// particle number sample index × `pixels` + the pixel's slot (the
+    /// pixels shuffled per sample index). Sobol draws its
     /// light choice, point and direction from one five-dimensional Sobol
     /// net over all particles, Owen-scrambled by the seed alone, and its
     /// later numbers from the padded sequence over particles: a pixel's
