@@ -126,9 +126,9 @@ fn a_closed_box_reaches_e_over_one_minus_rho_with_every_solver_at_any_scale() {
 fn radiosity_refuses_what_it_cannot_solve() {
     let scene = closed_box(1.0, "radiosity-refusals");
     // Too fine a mesh for the form factor matrix: refused with the count.
-    let e = Mesh::build(&scene, 1e-4, MAX_ELEMENTS).unwrap_err();
+    let e = Mesh::build(&scene, 1e-4, MAX_ELEMENTS, &[]).unwrap_err();
     assert!(e.contains("elements") && e.contains("--patch-size"), "{e}");
-    let e = Mesh::build(&scene, 0.0, MAX_ELEMENTS).unwrap_err();
+    let e = Mesh::build(&scene, 0.0, MAX_ELEMENTS, &[]).unwrap_err();
     assert!(e.contains("positive"), "{e}");
     // No emitter: the materials scene's lights are a quad (diffuse) ... so
     // build one without: the box with its emission removed.
@@ -136,7 +136,7 @@ fn radiosity_refuses_what_it_cannot_solve() {
     for m in &mut dark.materials {
         m.emission = Rgb::ZERO;
     }
-    let e = Mesh::build(&dark, 0.3, MAX_ELEMENTS).unwrap_err();
+    let e = Mesh::build(&dark, 0.3, MAX_ELEMENTS, &[]).unwrap_err();
     assert!(e.contains("emissive"), "{e}");
 }
 

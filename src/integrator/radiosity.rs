@@ -467,7 +467,10 @@ impl Radiosity {
         } else {
             (None, Vec::new())
         };
-        let mut state = self.build_on(meshed.as_ref().map_or(scene, |m| &m.scene))?;
+        let mut state = match &meshed {
+            Some(m) => self.build_on(&m.scene, &m.hidden)?,
+            None => self.build_on(scene, &[])?,
+        };
         state.meshed = meshed;
         match &mut state.model {
             Model::Matrix(m) => notes.append(&mut m.mesh.notes),
@@ -480,7 +483,8 @@ impl Radiosity {
         Ok(state)
     }
 
-    fn build_on(&self, scene: &Scene) -> crate::Result<RadiosityState> {
+    /// The model of `scene`, triangles marked in `hidden` not patches.
+    fn build_on(&self, scene: &Scene, hidden: &[bool]) -> crate::Result<RadiosityState> {
         if self.solver.matrix().is_none() {
             let settings = HierarchySettings {
                 epsilon: self.epsilon,
@@ -490,7 +494,7 @@ impl Radiosity {
                 max_nodes: MAX_NODES,
                 clusters: crate::radiosity::cluster::ClusterKind::Oriented,
             };
-            let hierarchy = Hierarchy::build(scene, settings).map_err(crate::Error::new)?;
+            let hierarchy = Hierarchy::build(scene, settings, hidden).map_err(crate::Error::new)?;
             return Ok(RadiosityState {
                 model: Model::Hierarchical(hierarchy),
                 steps: 0,
@@ -505,7 +509,8 @@ impl Radiosity {
                 senders: lookup::Senders::default(),
             });
         }
-        let mesh = Mesh::build(scene, self.patch_size, MAX_ELEMENTS).map_err(crate::Error::new)?;
+        let mesh =
+            Mesh::build(scene, self.patch_size, MAX_ELEMENTS, hidden).map_err(crate::Error::new)?;
         let (form_factors, solution) = self.matrix_system(scene, &mesh);
         let vertex_radiance = if self.display == RadiosityDisplay::Smooth {
             mesh.vertex_radiance(&solution.radiance, &solution.exposure, &[])

@@ -70,6 +70,7 @@ fn solve(scene: &Scene, kind: ClusterKind) -> Result<Solve, String> {
             max_nodes: MAX_NODES,
             clusters: kind,
         },
+        &[],
     )?;
     while h.steps < u64::from(MAX_STEPS) && h.step(&scene.geometry) > CONVERGED {}
     let (elements, links) = h.counts();

@@ -21,10 +21,14 @@
 //! EEE events (quadric surfaces, D2) are not traced; receivers narrower
 //! than a fan's sampling ([`FAN_RAYS`]) can be missed.
 
-use crate::math::Ray;
+use crate::math::{Ray, Rgb};
+use crate::radiosity::Element;
+use crate::radiosity::form_factor::{EXPOSURE_POINTS, exposure};
+use crate::radiosity::mesh::exposed_backs;
 use crate::scene::Scene;
 use crate::scene::light::Light;
 use glam::Vec3A;
+use rayon::prelude::*;
 use std::collections::{BTreeMap, HashMap};
 
 mod triangulate;
@@ -626,6 +630,35 @@ fn snap_to_edges(v: [Vec3A; 3], p: Vec3A, apex: Vec3A, m: Vec3A, tolerance: f32)
         return x + t * (y - x);
     }
     p
+}
+
+/// Per triangle of `meshed` (the scene split into pieces, each of scene
+/// triangle `from`), whether it lies inside a contact polygon: a piece of a
+/// receiver with contact lines from none of whose points light can leave
+/// (every ray meets the inside of what stands there, [`exposure`]). The
+/// lines bound such pieces, so none is partly open. Such pieces are not
+/// patches (Baum et al. 1991 remove the hidden parts of surfaces that touch):
+/// they would cost elements and receive nothing.
+pub fn enclosed(meshed: &Scene, from: &[u32], lines: &Discontinuities) -> Vec<bool> {
+    let has_contact: Vec<bool> = lines
+        .segments
+        .iter()
+        .map(|s| s.iter().any(|s| s.event == Event::Contact))
+        .collect();
+    let geometry = &meshed.geometry;
+    let two_sided = exposed_backs(meshed);
+    geometry
+        .triangles()
+        .par_iter()
+        .enumerate()
+        .map(|(i, v)| {
+            if !has_contact.get(from[i] as usize).copied().unwrap_or(false) {
+                return false;
+            }
+            let piece = Element::new(i as u32, *v, Rgb::ZERO, Rgb::ZERO);
+            piece.area > 0.0 && exposure(geometry, &two_sided, &piece, EXPOSURE_POINTS).0 == 0.0
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -150,8 +150,14 @@ fn luminance(c: Rgb) -> f32 {
 }
 
 impl Hierarchy {
-    /// Roots for every diffuse triangle and the initial links between them.
-    pub fn build(scene: &Scene, settings: HierarchySettings) -> Result<Hierarchy, String> {
+    /// Roots for every diffuse triangle and the initial links between them;
+    /// triangles marked in `hidden` (empty: none) have no front root (see
+    /// [`super::Mesh::build`]).
+    pub fn build(
+        scene: &Scene,
+        settings: HierarchySettings,
+        hidden: &[bool],
+    ) -> Result<Hierarchy, String> {
         if !(settings.epsilon > 0.0 && settings.epsilon.is_finite()) {
             return Err(format!(
                 "epsilon {} is not a positive number",
@@ -192,7 +198,7 @@ impl Hierarchy {
                 continue;
             };
             let element = Element::new(i as u32, *v, reflectance, material.emission);
-            if !(element.area > 0.0) {
+            if !(element.area > 0.0) || hidden.get(i).copied().unwrap_or(false) {
                 roots.push(NONE);
                 continue;
             }
@@ -211,16 +217,28 @@ impl Hierarchy {
         let mut back_roots = Vec::new();
         if two_sided.contains(&true) {
             back_roots = vec![NONE; roots.len()];
-            for (i, &root) in roots.iter().enumerate() {
-                if two_sided[i] && root != NONE {
-                    let front = nodes[root as usize].clone();
-                    back_roots[i] = nodes.len() as u32;
-                    nodes.push(Node {
-                        element: back_of(&front.element, roots.len()),
-                        radiance: Rgb::ZERO,
-                        ..front
-                    });
+            for (i, v) in geometry.triangles().iter().enumerate() {
+                // A hidden front's back may still be open (a table's
+                // underside below what stands on it).
+                let material = geometry.triangle_material(i);
+                let albedo = scene.diffuse_albedo(material);
+                let (true, Some((reflectance, _))) = (two_sided[i], albedo) else {
+                    continue;
+                };
+                let front = Element::new(i as u32, *v, reflectance, Rgb::ZERO);
+                if !(front.area > 0.0) {
+                    continue;
                 }
+                back_roots[i] = nodes.len() as u32;
+                nodes.push(Node {
+                    element: back_of(&front, roots.len()),
+                    depth: 0,
+                    children: NONE,
+                    gathered: Rgb::ZERO,
+                    radiance: Rgb::ZERO,
+                    exposure: f32::NAN,
+                    links: Vec::new(),
+                });
             }
         }
         if nodes.is_empty() {

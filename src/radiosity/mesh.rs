@@ -49,8 +49,15 @@ const MAX_DEPTH: u8 = 8;
 impl Mesh {
     /// Meshes `scene` into elements of at most `size` (fraction of the
     /// bounding-box diagonal) along their longest edge; refuses meshes of
-    /// more than `max_elements`, with the count.
-    pub fn build(scene: &Scene, size: f32, max_elements: usize) -> Result<Mesh, String> {
+    /// more than `max_elements`, with the count. Triangles marked in
+    /// `hidden` (empty: none) have no front patch: discontinuity meshing's
+    /// pieces that contact lines enclose, which no light reaches or leaves.
+    pub fn build(
+        scene: &Scene,
+        size: f32,
+        max_elements: usize,
+        hidden: &[bool],
+    ) -> Result<Mesh, String> {
         if !(size > 0.0 && size.is_finite()) {
             return Err(format!(
                 "patch size {size} is not a positive fraction of the scene's size"
@@ -81,7 +88,8 @@ impl Mesh {
                 continue;
             }
             let depth = depth_for(longest_edge(v), target);
-            total += (1usize << (2 * depth)) * (1 + usize::from(two_sided[i]));
+            let front = !hidden.get(i).copied().unwrap_or(false);
+            total += (1usize << (2 * depth)) * (usize::from(front) + usize::from(two_sided[i]));
             depths.push(Some(depth));
         }
         if total == 0 {
@@ -127,9 +135,13 @@ impl Mesh {
                 reflectance,
                 emission: material.emission,
             };
-            mesh.roots.push(mesh.cells.len() as u32);
-            mesh.cells.push(Cell::Leaf(NONE));
-            mesh.grow(mesh.roots[i], root, 0, depth);
+            if hidden.get(i).copied().unwrap_or(false) {
+                mesh.roots.push(NONE);
+            } else {
+                mesh.roots.push(mesh.cells.len() as u32);
+                mesh.cells.push(Cell::Leaf(NONE));
+                mesh.grow(mesh.roots[i], root, 0, depth);
+            }
             if mesh.two_sided[i] {
                 mesh.back_roots[i] = mesh.cells.len() as u32;
                 mesh.cells.push(Cell::Leaf(NONE));

@@ -9,6 +9,9 @@ pub struct Meshed {
     /// Per triangle of `scene`, which of its edges (opposite the vertex of
     /// that index) lie on a discontinuity line.
     pub on_line: Vec<[bool; 3]>,
+    /// Per triangle of `scene`, whether it is a piece that contact lines
+    /// enclose (the floor under a block): not a patch.
+    pub hidden: Vec<bool>,
     pub lines: usize,
 }
 
@@ -17,6 +20,7 @@ impl Meshed {
     pub fn whole(scene: Scene) -> Meshed {
         Meshed {
             on_line: vec![[false; 3]; scene.geometry.triangle_count()],
+            hidden: Vec::new(),
             scene: std::sync::Arc::new(scene),
             lines: 0,
         }
@@ -62,7 +66,8 @@ pub(super) fn discontinuity_mesh(
         .iter()
         .map(|p| p.iter().map(|p| p.vertices).collect())
         .collect();
-    let (meshed, _) = scene.with_pieces(&corners);
+    let (meshed, from) = scene.with_pieces(&corners);
+    let hidden = discontinuity::enclosed(&meshed, &from, &lines);
     // Pieces are found again by their corners, which the split keeps to the bit.
     let key = |v: &[glam::Vec3A; 3]| v.map(|p| p.to_array().map(f32::to_bits));
     let flags: std::collections::HashMap<_, [bool; 3]> = pieces
@@ -84,6 +89,13 @@ pub(super) fn discontinuity_mesh(
     };
     let split = pieces.iter().filter(|p| !p.is_empty()).count();
     let mut notes = lines.notes;
+    let enclosed = hidden.iter().filter(|&&h| h).count();
+    if enclosed > 0 {
+        notes.push(format!(
+            "{enclosed} pieces enclosed by contact lines (under what stands on them) are not \
+             patches: no light reaches or leaves them"
+        ));
+    }
     notes.push(format!(
         "discontinuity meshing: {} critical wedges (VE {}, EV {}) and {} contact tests, {} rays, \
          gave {} line segments{kept}; {split} triangles split into {} pieces",
@@ -99,6 +111,7 @@ pub(super) fn discontinuity_mesh(
         Meshed {
             scene: std::sync::Arc::new(meshed),
             on_line,
+            hidden,
             lines: count,
         },
         notes,
