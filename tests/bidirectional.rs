@@ -49,9 +49,18 @@ pub(crate) fn render(scene: Scene, integrator: Integrator, spp: u32, seed: u64) 
 
 #[test]
 fn weighted_strategy_images_sum_to_the_image() {
+    strategy_images_sum_to_the_image(Bdpt::default());
+    // With light subpaths for light tracing alone, the extra ones splat too.
+    strategy_images_sum_to_the_image(Bdpt {
+        light_paths: 3,
+        light_path_vertices: 3,
+        ..Bdpt::default()
+    });
+}
+
+fn strategy_images_sum_to_the_image(bdpt: Bdpt) {
     let mut scene = cornell_box();
     scene.set_resolution(32, 32);
-    let bdpt = Bdpt::default();
     let spp = 4;
     let sampler = Sampler::new(SamplerKind::Independent, 7, spp);
     let (strategies, _) = StrategyImages::render(&scene, &bdpt, &sampler, spp);
@@ -172,6 +181,29 @@ fn vertex_connection_and_merging_agrees_with_path_and_light_tracing() {
     assert!(
         worst < 4.5,
         "caustic: a block differs by {worst:.2} standard errors"
+    );
+}
+
+/// Light subpaths for light tracing alone: their contributions count 1 / m
+/// and light tracing's density m times in every weight; a share or a weight
+/// left at one is a bias of the size of light tracing's part of the image.
+#[test]
+fn extra_light_paths_agree_with_path_tracing() {
+    let bdpt = Integrator::from(Bdpt {
+        light_paths: 4,
+        light_path_vertices: 3,
+        ..Bdpt::default()
+    });
+    let path = Integrator::from(PathTracer::default());
+    assert_agree(
+        "Cornell box, bdpt with 4 light paths / path",
+        &render(scene("cornell_box.toml"), bdpt, 128, 21),
+        &render(scene("cornell_box.toml"), path, 512, 22),
+    );
+    assert_agree(
+        "indirect room, bdpt with 4 light paths / path",
+        &render(scene("indirect.toml"), bdpt, 128, 23),
+        &render(scene("indirect.toml"), path, 1024, 24),
     );
 }
 

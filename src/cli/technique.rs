@@ -50,6 +50,13 @@ pub struct TechniqueFlags {
     /// scene's bounding-box diagonal (0: no limit) [default: 0.1].
     #[arg(long)]
     ao_distance: Option<f32>,
+    /// BDPT: light subpaths per camera sample, the ones after the first
+    /// joined to the lens only (light tracing) [default: 1].
+    #[arg(long)]
+    light_paths: Option<u32>,
+    /// BDPT: bounces of the light subpaths after the first [default: 2].
+    #[arg(long)]
+    light_path_bounces: Option<u32>,
     /// Photon mapping: photons per iteration (0: one per pixel) [default: 0].
     #[arg(long)]
     photons: Option<u32>,
@@ -105,6 +112,8 @@ impl TechniqueFlags {
             || self.shadow_rays.is_some()
             || self.glossy_rays.is_some()
             || self.ao_distance.is_some()
+            || self.light_paths.is_some()
+            || self.light_path_bounces.is_some()
             || self.photons.is_some()
             || self.radius.is_some()
             || self.alpha.is_some()
@@ -237,6 +246,18 @@ impl TechniqueFlags {
                 return Err(missing("--ao-distance"));
             }
             options.ao.distance = d;
+        }
+        match kind {
+            IntegratorKind::Bdpt => {
+                let bdpt = &mut options.bdpt;
+                bdpt.light_paths = self.light_paths.unwrap_or(bdpt.light_paths);
+                bdpt.light_path_bounces =
+                    self.light_path_bounces.unwrap_or(bdpt.light_path_bounces);
+            }
+            _ if self.light_paths.is_some() || self.light_path_bounces.is_some() => {
+                return Err(missing("--light-paths or --light-path-bounces"));
+            }
+            _ => {}
         }
         match kind {
             IntegratorKind::Photon => {

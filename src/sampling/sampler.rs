@@ -90,8 +90,10 @@ pub struct Sampler {
     /// Dimensions from this one on are independent (see
     /// [`Sampler::enter_path_vertex`]).
     independent_from: u32,
-    /// The pixel of the current sample (a particle's number reads it).
+    /// The pixel of the current sample and its camera sample's index (a
+    /// particle's number reads them).
     pixel: u32,
+    camera_index: u32,
     /// Sobol: the current sample is a particle whose first three requests
     /// come from one five-dimensional net over all the render's particles
     /// (see [`Sampler::start_particle`]).
@@ -138,6 +140,7 @@ impl Sampler {
             domains: Domains::ALL,
             independent_from: u32::MAX,
             pixel: 0,
+            camera_index: 0,
             particle: false,
         }
     }
@@ -238,6 +241,7 @@ impl Sampler {
         self.dimension = 0;
         self.independent_from = u32::MAX;
         self.pixel = pixel;
+        self.camera_index = sample_index;
         self.particle = false;
     }
 
@@ -253,6 +257,16 @@ impl Sampler {
     /// in a lit pixel). The other samplers go on with the camera sample's
     /// numbers.
     pub fn start_particle(&mut self, pixels: u32) {
+        self.start_particle_of(pixels, 0, 1);
+    }
+
+    /// Starts particle `j` of the `n` that the current camera sample
+    /// traces (BDPT's extra light-tracing particles): number (sample index
+    /// × n + j) × `pixels` + slot, so that the pass's particles j are a block
+    /// of the sequence, a net of their own (numbered sample index × n × pixels
+    /// + slot × n + j, the particles j = 0 would all lie in one half of the
+    /// first dimension: an even index's radical inverse is below 1/2).
+    pub fn start_particle_of(&mut self, pixels: u32, j: u32, n: u32) {
         if self.kind != SamplerKind::Sobol {
             return;
         }
@@ -261,9 +275,10 @@ impl Sampler {
         // that followed the pixel's would tie a column's light paths to
         // one half of the net (the sequence's low bits), a pattern that
         // BDPT's connections printed as stripes.
-        let key = hash_combine(self.seed_key, u64::from(self.sample_index));
+        let block = u64::from(self.camera_index) * u64::from(n) + u64::from(j);
+        let key = hash_combine(self.seed_key, block);
         let slot = permute(self.pixel.min(pixels - 1), pixels, key as u32);
-        let number = u64::from(self.sample_index) * u64::from(pixels) + u64::from(slot);
+        let number = block * u64::from(pixels) + u64::from(slot);
         // One sequence per 2^32 particles, each scrambled afresh.
         let key = hash_combine(self.seed_key, 0x4000_0000_0000_0000 | (number >> 32));
         self.pixel_key = key;
@@ -574,6 +589,23 @@ mod tests {
                     "sample {sample}, shape {digits:?}: {boxes:?}"
                 );
             }
+        }
+        // With four particles per camera sample, the pass's particles j
+        // are a block of their own: each coordinate one point per 1/256
+        // (numbered so that j followed the pixel, particle 0's first
+        // coordinate would stay below 1/2).
+        let mut s = Sampler::new(SamplerKind::Sobol, 3, 0);
+        for j in [0, 3] {
+            let mut cells = [[0; 256]; 2];
+            for pixel in 0..256 {
+                s.start(pixel, 5);
+                s.start_particle_of(256, j, 4);
+                let select = s.next_1d();
+                let point = s.next_2d();
+                cells[0][(select * 256.0) as usize] += 1;
+                cells[1][(point.x * 256.0) as usize] += 1;
+            }
+            assert!(cells.iter().flatten().all(|&c| c == 1), "particle {j}");
         }
         // The other samplers go on with the camera sample's numbers.
         let mut a = Sampler::new(SamplerKind::Independent, 7, 0);

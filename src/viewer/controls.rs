@@ -2,7 +2,7 @@
 //! viewer's side of the settings that each technique owns in its own file.
 
 use crate::integrator::ambient_occlusion::AoSettings;
-use crate::integrator::bdpt::BdptSettings;
+use crate::integrator::bdpt::{BdptSettings, MAX_BOUNCES, MAX_LIGHT_PATHS};
 use crate::integrator::light::LightSettings;
 use crate::integrator::mcrt::McrtSettings;
 use crate::integrator::path::PathSettings;
@@ -104,6 +104,13 @@ fn bdpt(ui: &mut egui::Ui, s: &mut BdptSettings) {
     max_depth(ui, &mut s.length.max_depth);
     mis_heuristic(ui, &mut s.mis);
     roulette(ui, &mut s.length);
+    ui.add(
+        slider(&mut s.light_paths, 1..=MAX_LIGHT_PATHS)
+            .text("Light paths per sample (the others for light tracing only)"),
+    );
+    if s.light_paths > 1 {
+        ui.add(slider(&mut s.light_path_bounces, 0..=MAX_BOUNCES).text("Their bounces"));
+    }
 }
 
 fn photon(ui: &mut egui::Ui, s: &mut PhotonSettings) {

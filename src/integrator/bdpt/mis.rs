@@ -25,6 +25,18 @@ impl Bdpt {
         }
     }
 
+    /// The heuristic's factor for light tracing's density in paths of
+    /// `light_vertices` light vertices: n^beta where each of the n particles
+    /// makes them, else 1.
+    #[inline]
+    fn lens_count(&self, light_vertices: usize) -> f32 {
+        if self.light_paths > 1 && light_vertices <= self.light_path_vertices {
+            self.mis_power(self.light_paths as f32, 1.0)
+        } else {
+            1.0
+        }
+    }
+
     /// Stores in every vertex the part of the MIS sum that no connection
     /// changes (Georgiev et al.'s recursive quantities in ratio form): for
     /// camera vertex z_j, sum over i <= j of prod_{k=i..j} r_k, where r_k =
@@ -35,12 +47,19 @@ impl Bdpt {
     /// instead of a walk over the path (12% of the time on SmallVCM's scene).
     pub(super) fn prepare_mis(&self, cam: &mut [Vertex], light: &mut [Vertex]) {
         let mut prefix = 0.0f32;
+        let mut lens = 0.0f32;
         for i in 1..cam.len() {
             let counts = !cam[i].delta && !cam[i - 1].delta;
             let r = self.mis_power(cam[i].pdf_rev, cam[i].pdf_fwd);
             // Capped so that a zero ratio later gives 0, not 0 * inf.
             prefix = (r * (f32::from(u8::from(counts)) + prefix)).min(f32::MAX);
             cam[i].mis_prefix = prefix;
+            lens = if i == 1 {
+                prefix
+            } else {
+                (r * lens).min(f32::MAX)
+            };
+            cam[i].mis_lens = lens;
         }
         let mut prefix = 0.0f32;
         for i in 0..light.len() {
@@ -69,17 +88,32 @@ impl Bdpt {
         joint: &Connection,
     ) -> f32 {
         let one_if = |b: bool| f32::from(u8::from(b));
+        // Light tracing's samples: n particles make its paths of up to
+        // `light_path_vertices` light vertices, and its density counts n
+        // times (Veach's multi-sample combination, n_i p_i).
+        let lens_count = self.lens_count(if t == 1 { s } else { s + t - 1 });
         // Strategies with fewer camera vertices: z_i made by the light side.
         let camera_sum = if t >= 2 {
             let r_t1 = self.mis_power(joint.pt_rev, cam[t - 1].pdf_fwd);
-            let deeper = if t >= 3 {
+            let (deeper, lens) = if t >= 3 {
                 let r_t2 = self.mis_power(joint.pt_minus_rev, cam[t - 2].pdf_fwd);
-                let prefix = if t >= 4 { cam[t - 3].mis_prefix } else { 0.0 };
-                r_t2 * (one_if(!cam[t - 2].delta && !cam[t - 3].delta) + prefix)
+                let counts = one_if(!cam[t - 2].delta && !cam[t - 3].delta);
+                let (prefix, lens) = if t >= 4 {
+                    (cam[t - 3].mis_prefix, cam[t - 3].mis_lens)
+                } else {
+                    (0.0, counts)
+                };
+                (r_t2 * (counts + prefix), r_t2 * lens)
+            } else {
+                (0.0, one_if(!cam[t - 2].delta))
+            };
+            // (Only where it counts: 0 * inf would make the weight NaN.)
+            let lens = if lens_count != 1.0 {
+                (lens_count - 1.0) * lens
             } else {
                 0.0
             };
-            r_t1 * (one_if(!cam[t - 2].delta) + deeper)
+            r_t1 * (one_if(!cam[t - 2].delta) + deeper + lens)
         } else {
             0.0
         };
@@ -113,7 +147,11 @@ impl Bdpt {
         } else {
             0.0
         };
-        let weight = 1.0 / (1.0 + camera_sum + light_sum);
+        let weight = if t == 1 {
+            1.0 / (1.0 + light_sum / lens_count)
+        } else {
+            1.0 / (1.0 + camera_sum + light_sum)
+        };
         if weight.is_finite() { weight } else { 0.0 }
     }
 }

@@ -28,6 +28,13 @@
 //! t = 1 against the others. Every contribution is a splat of the session's
 //! splatting pass, which divides by N: a camera strategy's estimate for its
 //! own pixel is multiplied by W H.
+//!
+//! [`BdptSettings::light_paths`] adds light subpaths (of a few bounces)
+//! that only light tracing (t = 1) uses: with m of them in all, each t = 1
+//! contribution of the paths they can make counts 1 / m, and its density
+//! counts m times in every weight (Veach's multi-sample combination,
+//! sum_i n_i p_i); light tracing's count noise falls m times for the
+//! price of short subpaths and their lens connections alone.
 
 use super::light::{importance_weight, sample_particle, sees_lens, shading_correction};
 use super::{MisHeuristic, PathLength, RayCounts, Settings, Splat, SplattingEstimator, Technique};
@@ -52,7 +59,7 @@ pub const MAX_BOUNCES: u32 = 32;
 const MAX_VERTICES: usize = MAX_BOUNCES as usize + 2;
 
 /// Settings of the bidirectional path tracer.
-#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct BdptSettings {
     /// Depth at most [`MAX_BOUNCES`].
@@ -60,11 +67,39 @@ pub struct BdptSettings {
     pub length: PathLength,
     /// How the strategies combine (`None` reads as power).
     pub mis: MisHeuristic,
+    /// Light subpaths per camera sample, 1 to [`MAX_LIGHT_PATHS`]: the
+    /// first is joined to the camera subpath by every strategy, the others
+    /// only to the lens (light tracing). More pay where light tracing
+    /// carries the image and its particles are cheap (a lamp inside its
+    /// shade); elsewhere they cost time for nothing.
+    pub light_paths: u32,
+    /// Bounces of the light subpaths after the first.
+    pub light_path_bounces: u32,
+}
+
+/// The most light subpaths per camera sample.
+pub const MAX_LIGHT_PATHS: u32 = 64;
+
+impl Default for BdptSettings {
+    fn default() -> Self {
+        BdptSettings {
+            length: PathLength::default(),
+            mis: MisHeuristic::default(),
+            light_paths: 1,
+            light_path_bounces: 2,
+        }
+    }
 }
 
 impl Settings for BdptSettings {
     fn validate(&self) -> Result<(), String> {
         self.length.check()?;
+        if !(1..=MAX_LIGHT_PATHS).contains(&self.light_paths) {
+            return Err(format!(
+                "light paths {} is not between 1 and {MAX_LIGHT_PATHS}",
+                self.light_paths
+            ));
+        }
         if self.length.max_depth > MAX_BOUNCES {
             return Err(format!(
                 "max depth {} is more than bidirectional path tracing's {MAX_BOUNCES}",
@@ -98,6 +133,11 @@ pub struct Bdpt {
     pub russian_roulette: bool,
     /// How the strategies are combined (balance or power).
     pub mis: MisHeuristic,
+    /// Light subpaths per camera sample: the first is joined to the camera
+    /// subpath by every strategy, the others only to the lens (t = 1).
+    pub light_paths: u32,
+    /// The most vertices (the light point included) of those others.
+    pub light_path_vertices: usize,
     /// For tests only: the strategy (s, t) whose MIS weight is replaced by
     /// 1, so that its paths are counted twice, as a bug would count them.
     pub faulty_strategy: Option<(u32, u32)>,
@@ -110,6 +150,8 @@ impl Default for Bdpt {
             rr_depth: 5,
             russian_roulette: true,
             mis: MisHeuristic::Power,
+            light_paths: 1,
+            light_path_vertices: 3,
             faulty_strategy: None,
         }
     }
@@ -127,13 +169,24 @@ impl Technique for Bdpt {
             rr_depth: settings.length.rr_depth,
             russian_roulette: settings.length.russian_roulette,
             mis: super::options::combining(settings.mis),
+            light_paths: settings.light_paths.clamp(1, MAX_LIGHT_PATHS),
+            light_path_vertices: settings.light_path_bounces.min(MAX_BOUNCES) as usize + 1,
             faulty_strategy: None,
         }
     }
 
     fn describe(&self) -> String {
+        let light_paths = if self.light_paths > 1 {
+            format!(
+                ", light paths {} ({} bounces)",
+                self.light_paths,
+                self.light_path_vertices - 1
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "bdpt (max depth {}, mis {:?}, rr {})",
+            "bdpt (max depth {}, mis {:?}{light_paths}, rr {})",
             self.max_depth,
             self.mis,
             if self.russian_roulette {
@@ -259,47 +312,10 @@ impl Bdpt {
             camera_path,
         );
 
-        sampler.start_particle(camera.width * camera.height);
-        let emission = sample_particle(scene, sampler);
-        let u_lens = sampler.next_2d_for(Domain::Lens);
-        if let Some(emission) = emission {
-            let infinite = scene.lights.is_infinite(emission.light);
-            light_path.push(Vertex {
-                kind: Kind::Light,
-                point: emission.point,
-                error: emission.error,
-                normal: emission.normal,
-                beta: Rgb::splat(1.0 / emission.pdf_position),
-                // From infinity the particle's origin is its direction
-                // (per solid angle; 0 for a directional light's delta).
-                pdf_fwd: if infinite {
-                    origin_density(scene, emission.light, -emission.direction)
-                } else {
-                    emission.pdf_position
-                },
-                delta_light: emission.normal == Vec3A::ZERO
-                    || scene.lights.is_directional(emission.light),
-                infinite,
-                light: emission.light,
-                emitted: emission.emitted,
-                two_sided: emission.two_sided,
-                u_connect: u_lens,
-                ..Vertex::EMPTY
-            });
-            let ray = emission.ray().at_time(time);
-            counts.bounce += 1;
-            self.random_walk(
-                scene,
-                ray,
-                emission.throughput,
-                emission.pdf_direction,
-                Transport::Importance,
-                max_depth + 1,
-                sampler,
-                counts,
-                light_path,
-            );
-        }
+        let pixels = camera.width * camera.height;
+        let particles = self.light_paths.max(1);
+        sampler.start_particle_of(pixels, 0, particles);
+        self.light_subpath(scene, time, max_depth + 1, sampler, counts, light_path);
 
         self.prepare_mis(&mut camera_path.vertices, &mut light_path.vertices);
         let (cam, light) = (&*camera_path, &*light_path);
@@ -318,7 +334,7 @@ impl Bdpt {
                 };
                 let value = joint.value;
                 let (film, scale) = match joint.film {
-                    Some(f) => (f, 1.0),
+                    Some(f) => (f, self.lens_share(s)),
                     None => (film, pixel_scale),
                 };
                 contribute(Contribution {
@@ -330,8 +346,98 @@ impl Bdpt {
                 });
             }
         }
+        // The extra particles: light subpaths seen by the lens alone.
+        for j in 1..particles {
+            light_path.clear();
+            sampler.start_particle_of(pixels, j, particles);
+            let vertices = self.light_path_vertices.min(max_depth + 1);
+            self.light_subpath(scene, time, vertices, sampler, counts, light_path);
+            self.prepare_mis(&mut [], &mut light_path.vertices);
+            for s in 1..=light_path.len().min(max_depth + 1) {
+                let Some(joint) = self.connect(scene, camera_path, light_path, s, 1, time, counts)
+                else {
+                    continue;
+                };
+                let weight =
+                    self.mis_weight(&camera_path.vertices, &light_path.vertices, s, 1, &joint);
+                let scale = self.lens_share(s);
+                contribute(Contribution {
+                    s: s as u32,
+                    t: 1,
+                    film: joint.film.unwrap_or(film),
+                    weighted: joint.value * (weight * scale),
+                    unweighted: joint.value * scale,
+                });
+            }
+        }
         SUBPATHS.with(|cell| cell.replace(subpaths));
         camera_film
+    }
+
+    /// Traces a light subpath of at most `max_vertices` vertices into
+    /// `path` (empty), from a particle the sampler's current numbers choose.
+    fn light_subpath(
+        &self,
+        scene: &Scene,
+        time: f32,
+        max_vertices: usize,
+        sampler: &mut Sampler,
+        counts: &mut RayCounts,
+        path: &mut Subpath,
+    ) {
+        let emission = sample_particle(scene, sampler);
+        let u_lens = sampler.next_2d_for(Domain::Lens);
+        let Some(emission) = emission else {
+            return;
+        };
+        let infinite = scene.lights.is_infinite(emission.light);
+        path.push(Vertex {
+            kind: Kind::Light,
+            point: emission.point,
+            error: emission.error,
+            normal: emission.normal,
+            beta: Rgb::splat(1.0 / emission.pdf_position),
+            // From infinity the particle's origin is its direction
+            // (per solid angle; 0 for a directional light's delta).
+            pdf_fwd: if infinite {
+                origin_density(scene, emission.light, -emission.direction)
+            } else {
+                emission.pdf_position
+            },
+            delta_light: emission.normal == Vec3A::ZERO
+                || scene.lights.is_directional(emission.light),
+            infinite,
+            light: emission.light,
+            emitted: emission.emitted,
+            two_sided: emission.two_sided,
+            u_connect: u_lens,
+            ..Vertex::EMPTY
+        });
+        let ray = emission.ray().at_time(time);
+        counts.bounce += 1;
+        self.random_walk(
+            scene,
+            ray,
+            emission.throughput,
+            emission.pdf_direction,
+            Transport::Importance,
+            max_vertices,
+            sampler,
+            counts,
+            path,
+        );
+    }
+
+    /// What one light subpath's t = 1 contribution of s light vertices
+    /// counts for: 1 / n where every one of the n particles makes that
+    /// strategy, else 1.
+    #[inline]
+    fn lens_share(&self, s: usize) -> f32 {
+        if self.light_paths > 1 && s <= self.light_path_vertices {
+            1.0 / self.light_paths as f32
+        } else {
+            1.0
+        }
     }
 
     /// Extends `path` (which holds its first vertex) by tracing `ray` and

@@ -64,6 +64,9 @@ pub(super) struct Vertex {
     /// this vertex and the ones before it from the other side (see
     /// [`Bdpt::prepare_mis`]).
     pub(super) mis_prefix: f32,
+    /// On the camera subpath, the one term of `mis_prefix` that stands for
+    /// light tracing (t = 1): the product of the ratios down to z_1.
+    pub(super) mis_lens: f32,
     /// The light the point lies on (light vertices and emitting surfaces),
     /// else [`NO_LIGHT`].
     pub(super) light: u32,
@@ -94,6 +97,7 @@ impl Vertex {
         delta_light: false,
         infinite: false,
         mis_prefix: 0.0,
+        mis_lens: 0.0,
         light: NO_LIGHT,
         emitted: Rgb::ZERO,
         two_sided: false,
