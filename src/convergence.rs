@@ -102,7 +102,14 @@ impl BenchConfig {
                         _ => return Err(err(format!("strategy `{value}` (bsdf, light, mis)"))),
                     }
                 }
-                "shadow-rays" | "glossy-rays" | "strategy" => return Err(missing()),
+                "light-paths" if kind == IntegratorKind::Bdpt => {
+                    integrator.bdpt.light_paths = number()?
+                }
+                "light-path-bounces" if kind == IntegratorKind::Bdpt => {
+                    integrator.bdpt.light_path_bounces = number()?
+                }
+                "shadow-rays" | "glossy-rays" | "strategy" | "light-paths"
+                | "light-path-bounces" => return Err(missing()),
                 "light-sampling" => {
                     light_sampling = Some(match value {
                         "area" => LightSampling::Area,
@@ -143,8 +150,9 @@ pub struct Checkpoint {
     pub cpu_seconds: Option<f64>,
     pub rays_per_pixel: f64,
     pub error: ErrorMetrics,
-    /// RMSE with the reference's own noise taken out: sqrt(MSE - mean
-    /// reference variance), when the variance is known; else the RMSE.
+    /// RMSE (over the pixels [`ErrorOver`] chose) with the reference's own
+    /// noise taken out: sqrt(MSE - mean reference variance), when the
+    /// variance is known; else the RMSE.
     pub rmse: f64,
 }
 
@@ -155,6 +163,16 @@ pub struct StopAt {
     pub rmse: Option<f64>,
     /// Once a checkpoint took at least this many seconds.
     pub seconds: Option<f64>,
+}
+
+/// Which error a measurement's [`Checkpoint::rmse`] reads.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ErrorOver {
+    /// Every pixel.
+    #[default]
+    AllPixels,
+    /// Every pixel but the worst 0.1% ([`ErrorMetrics::trimmed_rmse`]).
+    Trimmed,
 }
 
 impl Checkpoint {
@@ -200,6 +218,7 @@ pub fn measure(
     reference_mse: f64,
     max_spp: u32,
     stop: StopAt,
+    over: ErrorOver,
     seed: u64,
     threads: usize,
 ) -> Result<Vec<Checkpoint>> {
@@ -256,7 +275,13 @@ pub fn measure(
             cpu_seconds,
             rays_per_pixel: stats.rays.total() as f64 / pixels,
             error,
-            rmse: (error.rmse * error.rmse - reference_mse).max(0.0).sqrt(),
+            rmse: {
+                let rmse = match over {
+                    ErrorOver::AllPixels => error.rmse,
+                    ErrorOver::Trimmed => error.trimmed_rmse,
+                };
+                (rmse * rmse - reference_mse).max(0.0).sqrt()
+            },
         });
         let last = out[out.len() - 1];
         let reached = stop.rmse.is_some_and(|e| last.rmse <= e)
@@ -353,6 +378,16 @@ mod tests {
         let c = BenchConfig::parse("path:sobol:distribute=4").unwrap();
         assert_eq!(c.distribute, Some(4));
         assert!(BenchConfig::parse("path:sobol:distribute=x").is_err());
+        let c = BenchConfig::parse("bdpt:sobol:light-paths=4:light-path-bounces=3").unwrap();
+        assert_eq!(
+            (
+                c.integrator.bdpt.light_paths,
+                c.integrator.bdpt.light_path_bounces
+            ),
+            (4, 3)
+        );
+        assert!(BenchConfig::parse("path:sobol:light-paths=4").is_err());
+        assert!(BenchConfig::parse("bdpt:sobol:light-paths=0").is_err());
         assert!(BenchConfig::parse("paht:sobol").is_err());
         assert!(BenchConfig::parse("path:sobel").is_err());
         assert!(BenchConfig::parse("path:sobol:depth=3").is_err());
@@ -375,6 +410,7 @@ mod tests {
                         rmse,
                         relative_mse: 0.0,
                         mean_relative_error: 0.0,
+                        trimmed_rmse: 0.0,
                     },
                 }
             })

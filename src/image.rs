@@ -24,7 +24,13 @@ pub struct ErrorMetrics {
     pub relative_mse: f64,
     /// mean(|a - b| / (|b| + 0.01)).
     pub mean_relative_error: f64,
+    /// The RMSE without the worst 0.1% of pixels (by their squared error
+    /// over the channels): what a handful of fireflies cannot decide.
+    pub trimmed_rmse: f64,
 }
+
+/// The share of pixels [`ErrorMetrics::trimmed_rmse`] leaves out.
+pub const TRIMMED_SHARE: f64 = 0.001;
 
 impl Image {
     /// A black image.
@@ -154,20 +160,37 @@ impl Image {
             }
         }
         let (mut se, mut rel_se, mut rel_ae) = (0.0f64, 0.0f64, 0.0f64);
+        let mut per_pixel = Vec::with_capacity(self.pixels.len());
         for (a, b) in self.pixels.iter().zip(&reference.pixels) {
+            let mut pixel_se = 0.0;
             for c in 0..3 {
                 let (a, b) = (a[c] as f64, b[c] as f64);
                 let d = a - b;
-                se += d * d;
+                pixel_se += d * d;
                 rel_se += d * d / (b * b + 0.01);
                 rel_ae += d.abs() / (b.abs() + 0.01);
             }
+            se += pixel_se;
+            // NaN counts among the worst.
+            per_pixel.push(if pixel_se.is_nan() {
+                f64::INFINITY
+            } else {
+                pixel_se
+            });
         }
         let n = (self.pixels.len() * 3).max(1) as f64;
+        let kept = per_pixel.len() - (per_pixel.len() as f64 * TRIMMED_SHARE) as usize;
+        let trimmed_se: f64 = if kept < per_pixel.len() {
+            per_pixel.select_nth_unstable_by(kept, f64::total_cmp);
+            per_pixel[..kept].iter().sum()
+        } else {
+            se
+        };
         Ok(ErrorMetrics {
             rmse: (se / n).sqrt(),
             relative_mse: rel_se / n,
             mean_relative_error: rel_ae / n,
+            trimmed_rmse: (trimmed_se / (kept * 3).max(1) as f64).sqrt(),
         })
     }
 }
@@ -266,6 +289,25 @@ pub fn write_new_file(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_trimmed_rmse_leaves_out_the_worst_thousandth() {
+        // 2 000 pixels off by 0.1, two of them by 100 (fireflies): the plain
+        // RMSE is theirs, the trimmed one leaves exactly those two out.
+        let reference = Image::new(2000, 1);
+        let mut image = Image::new(2000, 1);
+        image.pixels.fill([0.1; 3]);
+        image.pixels[7] = [100.0; 3];
+        image.pixels[1500] = [f32::NAN; 3];
+        let m = image.compare(&reference).unwrap();
+        assert!(m.rmse.is_nan());
+        assert!((m.trimmed_rmse - 0.1).abs() < 1e-6, "{}", m.trimmed_rmse);
+        image.pixels[1500] = [0.1; 3];
+        let m = image.compare(&reference).unwrap();
+        assert!(m.rmse > 2.0);
+        // One of 2 000 pixels left out: the firefly and nothing else.
+        assert!((m.trimmed_rmse - 0.1).abs() < 1e-6, "{}", m.trimmed_rmse);
+    }
 
     #[test]
     fn metrics_of_a_known_difference() {

@@ -7,7 +7,7 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use tracelab::convergence::{
-    BenchConfig, Checkpoint, StopAt, log_log_slope, mean_variance, measure, time_to_rmse,
+    BenchConfig, Checkpoint, ErrorOver, StopAt, log_log_slope, mean_variance, measure, time_to_rmse,
 };
 use tracelab::image::{Image, check_writable};
 use tracelab::plot::{PlotFormat, Series, SeriesStyle, log_log_plot};
@@ -38,7 +38,8 @@ pub struct BenchArgs {
     /// `path:stratified:max-depth=1`, `mcrt:independent:shadow-rays=5:glossy-rays=5:max-depth=3`,
     /// `light:independent`; keys: max-depth, rr-depth, rr=off, seen-emitters=sampled,
     /// shadow-rays, glossy-rays, strategy=bsdf|light|mis, light-sampling=area|solid-angle,
-    /// domains=pixel+light, distribute=N (adaptive sampling by noise after N spp). Repeatable.
+    /// domains=pixel+light, light-paths, light-path-bounces (BDPT), distribute=N (adaptive
+    /// sampling by noise after N spp). Repeatable.
     #[arg(long = "config", required = true)]
     configs: Vec<String>,
     /// Largest sample count measured (powers of two from 1).
@@ -64,6 +65,11 @@ pub struct BenchArgs {
     seed: u64,
     #[arg(long, default_value_t = 0)]
     threads: usize,
+    /// RMSE without the worst 0.1% of pixels, for the slopes, the
+    /// time-to-error table and the plots: a few fireflies (a rare path
+    /// through glass) then do not decide the figure.
+    #[arg(long)]
+    trim: bool,
     /// CSV of every checkpoint.
     #[arg(long)]
     csv: Option<PathBuf>,
@@ -125,7 +131,7 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
         None => 0.0,
     };
     let mut csv = String::from(
-        "config,spp,seconds,cpu_seconds,rays_per_pixel,rmse,rmse_without_reference_noise,relative_mse,mean_relative_error,efficiency\n",
+        "config,spp,seconds,cpu_seconds,rays_per_pixel,rmse,rmse_without_reference_noise,relative_mse,mean_relative_error,efficiency,trimmed_rmse\n",
     );
     let mut results = Vec::new();
     for config in &configs {
@@ -140,6 +146,11 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
                 rmse: args.until_rmse,
                 seconds: args.seconds,
             },
+            if args.trim {
+                ErrorOver::Trimmed
+            } else {
+                ErrorOver::AllPixels
+            },
             args.seed,
             args.threads,
         )?;
@@ -151,7 +162,11 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
             "CPU s",
             "rays/px",
             "RMSE",
-            "RMSE-ref.noise",
+            if args.trim {
+                "trimmed-noise"
+            } else {
+                "RMSE-ref.noise"
+            },
             "rel. MSE",
             "mean rel.",
             "1/(MSE t)"
@@ -170,7 +185,7 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
                 p.efficiency()
             );
             csv += &format!(
-                "{},{},{:.6},{},{:.3},{:.8},{:.8},{:.8},{:.8},{:.6e}\n",
+                "{},{},{:.6},{},{:.3},{:.8},{:.8},{:.8},{:.8},{:.6e},{:.8}\n",
                 config.label,
                 p.spp,
                 p.seconds,
@@ -180,7 +195,8 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
                 p.rmse,
                 p.error.relative_mse,
                 p.error.mean_relative_error,
-                p.efficiency()
+                p.efficiency(),
+                p.error.trimmed_rmse
             );
         }
         match log_log_slope(&points, args.slope_from) {
@@ -231,7 +247,12 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
                     Series::new(name, SeriesStyle::Line, i, &points)
                 })
                 .collect();
-            log_log_plot(path, &args.title, x_label, "RMSE", &series)?;
+            let y_label = if args.trim {
+                "RMSE without the worst 0.1% of pixels"
+            } else {
+                "RMSE"
+            };
+            log_log_plot(path, &args.title, x_label, y_label, &series)?;
             eprintln!("wrote {}", path.display());
         }
     }
