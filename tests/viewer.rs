@@ -509,3 +509,35 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
     step_until(&mut harness, "2 iterations of VCM", finished);
     assert!(harness.state().app.frame().views[0].stats.spp >= 2);
 }
+
+#[test]
+fn a_comparison_renders_the_files_depth_in_both_views() {
+    // veach-bidir asks for max_depth 7 (6 bounces): B, path tracing beside
+    // BDPT, must not keep its own default of 8.
+    let launch = Launch {
+        scene: Some(repo_path("scenes/veach-bidir/scene.xml")),
+        integrator: Some(IntegratorKind::Bdpt),
+        compare_with: Some(IntegratorKind::Path),
+        defines: vec![("resx".into(), "32".into()), ("resy".into(), "32".into())],
+        target_spp: Some(1),
+        threads: 2,
+        fresh: true,
+        export_dir: Some(temp_dir("viewer-compare-depth")),
+        ..Default::default()
+    };
+    let mut harness = Harness::builder()
+        .with_size(SIZE)
+        .build_eframe(|cc| Window::new(cc, launch));
+    step_until(&mut harness, "both views", finished);
+    let settings = &harness.state().app.settings;
+    let depths = [&settings.a, &settings.b].map(|v| (v.integrator.kind, v.integrator.max_depth()));
+    assert_eq!(
+        depths,
+        [
+            (IntegratorKind::Bdpt, Some(6)),
+            (IntegratorKind::Path, Some(6))
+        ]
+    );
+    assert_eq!(harness.state().app.frame().views.len(), 2);
+    harness.state_mut().app.shutdown();
+}

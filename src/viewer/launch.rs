@@ -138,7 +138,8 @@ pub(super) fn list_scene_files() -> Vec<String> {
 
 impl super::app::ViewerApp {
     /// What an imported file asks for (Mitsuba's integrator block): the
-    /// technique and depths of view A, said in a toast.
+    /// technique and depths of view A (the depths of view B too, when
+    /// comparing), said in a toast.
     pub(super) fn apply_hints(&mut self, hints: &crate::scene::RenderHints) {
         // A technique named on the command line wins over the file's.
         let keep_kind = self.launch.integrator.is_some();
@@ -150,6 +151,13 @@ impl super::app::ViewerApp {
             Ok(said) => said,
             Err(e) => vec![e],
         };
+        // View B keeps its technique but renders the file's depths too: a
+        // comparison of two depths would not be one of two techniques.
+        if self.settings.compare
+            && let Err(e) = self.settings.b.integrator.take_hints(&hints, true)
+        {
+            self.toast(format!("view B: {e}"));
+        }
         if !said.is_empty() {
             self.toast(format!("from the scene file: {}", said.join(", ")));
         }
