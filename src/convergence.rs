@@ -388,6 +388,7 @@ mod tests {
         );
         assert!(BenchConfig::parse("path:sobol:light-paths=4").is_err());
         assert!(BenchConfig::parse("bdpt:sobol:light-paths=0").is_err());
+        assert!(BenchConfig::parse("bdpt:sobol:light-path-bounces=33").is_err());
         assert!(BenchConfig::parse("paht:sobol").is_err());
         assert!(BenchConfig::parse("path:sobel").is_err());
         assert!(BenchConfig::parse("path:sobol:depth=3").is_err());

@@ -100,6 +100,12 @@ impl Settings for BdptSettings {
                 self.light_paths
             ));
         }
+        if self.light_path_bounces > MAX_BOUNCES {
+            return Err(format!(
+                "light path bounces {} is more than bidirectional path tracing's {MAX_BOUNCES}",
+                self.light_path_bounces
+            ));
+        }
         if self.length.max_depth > MAX_BOUNCES {
             return Err(format!(
                 "max depth {} is more than bidirectional path tracing's {MAX_BOUNCES}",
