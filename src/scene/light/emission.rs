@@ -3,6 +3,7 @@
 //! direction with its density by solid angle.
 
 use super::*;
+use crate::sampling::warp::square_to_uniform_cone;
 
 /// A particle leaving a light, for light tracing: a point with its density
 /// by area and a direction with its density by solid angle.

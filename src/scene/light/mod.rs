@@ -11,8 +11,8 @@ use crate::math::{Frame, Rgb, gamma, luminance};
 use crate::sampling::spherical_triangle;
 use crate::sampling::warp::square_to_concentric_disk;
 use crate::sampling::warp::{
-    cosine_hemisphere_pdf, square_to_cosine_hemisphere, square_to_uniform_cone,
-    square_to_uniform_sphere, square_to_uniform_triangle, uniform_cone_pdf,
+    cosine_hemisphere_pdf, sphere_cap_height, square_to_cosine_hemisphere, square_to_uniform_cap,
+    square_to_uniform_sphere, square_to_uniform_triangle, uniform_cap_pdf,
 };
 use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
@@ -313,12 +313,9 @@ impl Light {
                 let inside = dc2 <= radius * radius * (1.0 + 1e-4);
                 if sampling == LightSampling::SolidAngle && !inside {
                     let dc = dc2.sqrt();
-                    let sin2_max = (radius * radius / dc2).min(1.0);
-                    let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+                    let cap = sphere_cap_height(radius * radius / dc2);
                     let frame = Frame::from_normal(to_center / dc);
-                    let wi = frame
-                        .to_world(square_to_uniform_cone(u, cos_max))
-                        .normalize();
+                    let wi = frame.to_world(square_to_uniform_cap(u, cap)).normalize();
                     // Nearest intersection of the sampled direction with the sphere;
                     // clamping the discriminant handles directions at the silhouette.
                     let b = wi.dot(to_center);
@@ -329,7 +326,7 @@ impl Light {
                     // Re-projected onto the sphere, as intersections are.
                     let point = center + radius * normal;
                     let error = sphere_point_error(radius * normal, point);
-                    let pdf = uniform_cone_pdf(cos_max);
+                    let pdf = uniform_cap_pdf(cap);
                     if !pdf.is_finite() {
                         return None;
                     }
@@ -424,8 +421,7 @@ impl Light {
                 let dc2 = (center - reference).length_squared();
                 let inside = dc2 <= radius * radius * (1.0 + 1e-4);
                 if sampling == LightSampling::SolidAngle && !inside {
-                    let cos_max = (1.0 - (radius * radius / dc2).min(1.0)).max(0.0).sqrt();
-                    uniform_cone_pdf(cos_max)
+                    uniform_cap_pdf(sphere_cap_height(radius * radius / dc2))
                 } else {
                     dist2 / (cos_light * 4.0 * PI * radius * radius)
                 }
