@@ -384,8 +384,7 @@ impl Lights {
             } => (4.0 * PI * radius * radius, two_sided),
             Light::Point { .. } => return (pmf, 1.0 / (4.0 * PI)),
             Light::Spot { cone, .. } => {
-                let inside = cone.axis.dot(w) > cone.cutoff.cos();
-                return (pmf, if inside { cone.pdf() } else { 0.0 });
+                return (pmf, if cone.contains(w) { cone.pdf() } else { 0.0 });
             }
             Light::Directional { radius, .. } => return (pmf / (PI * radius * radius), 1.0),
         };

@@ -3,7 +3,6 @@
 //! direction with its density by solid angle.
 
 use super::*;
-use crate::sampling::warp::square_to_uniform_cone;
 
 /// A particle leaving a light, for light tracing: a point with its density
 /// by area and a direction with its density by solid angle.
@@ -151,7 +150,7 @@ impl Light {
                 cone,
             } => {
                 // Uniform within the cutoff cone.
-                let local = square_to_uniform_cone(u_direction, cone.cutoff.cos());
+                let local = square_to_uniform_cap(u_direction, cone.cap_height());
                 let direction = Frame::from_normal(cone.axis).to_world(local).normalize();
                 return Some(EmissionSample {
                     point: position,

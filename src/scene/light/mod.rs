@@ -87,22 +87,41 @@ impl SpotCone {
     /// The falloff towards unit direction `w`.
     #[inline]
     pub fn falloff(&self, w: Vec3A) -> f32 {
-        let cos = self.axis.dot(w);
-        if cos <= self.cutoff.cos() {
+        let angle = self.angle_to(w);
+        if angle >= self.cutoff {
             0.0
-        } else if cos >= self.beam_width.cos() {
+        } else if angle <= self.beam_width {
             1.0
         } else {
-            ((self.cutoff - cos.clamp(-1.0, 1.0).acos())
-                / (self.cutoff - self.beam_width).max(1e-6))
-            .clamp(0.0, 1.0)
+            ((self.cutoff - angle) / (self.cutoff - self.beam_width).max(1e-6)).clamp(0.0, 1.0)
         }
+    }
+
+    /// True when unit direction `w` is inside the cutoff cone.
+    #[inline]
+    pub fn contains(&self, w: Vec3A) -> bool {
+        self.angle_to(w) < self.cutoff
+    }
+
+    /// Angle from the axis to unit `w`, from the chord between them: the
+    /// acos of a cosine near 1 moves in steps of 3.5e-4 rad in f32, which
+    /// made a spot of 0.02° 22% too bright.
+    #[inline]
+    fn angle_to(&self, w: Vec3A) -> f32 {
+        2.0 * (0.5 * (w - self.axis).length()).min(1.0).asin()
+    }
+
+    /// Height 1 − cos(cutoff) of the cone's cap, as 2 sin²(cutoff / 2):
+    /// exact for narrow spots, where 1 − cos loses its digits.
+    #[inline]
+    pub fn cap_height(&self) -> f32 {
+        2.0 * (0.5 * self.cutoff).sin().powi(2)
     }
 
     /// Density of a uniform direction within the cutoff cone.
     #[inline]
     pub fn pdf(&self) -> f32 {
-        1.0 / (2.0 * PI * (1.0 - self.cutoff.cos()).max(1e-7))
+        uniform_cap_pdf(self.cap_height().max(f32::MIN_POSITIVE))
     }
 }
 
