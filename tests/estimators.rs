@@ -420,3 +420,50 @@ fn a_narrow_spot_gives_its_closed_form_in_every_technique() {
         }
     }
 }
+
+#[test]
+fn merging_says_when_its_radius_is_wider_than_the_view_and_meets_the_closed_form_when_not() {
+    // The 0.1° spot's footprint is 0.11 wide in a scene 283 across: the
+    // default radius (0.002 of the diagonal) spans about 320 pixels, and
+    // VCM's merges blurred 96% of the light out of view. The summary says
+    // so; at a radius of about one pixel VCM meets the closed form
+    // (tolerance as in the spot test above).
+    let (text, expected) = narrow_spot(0.1);
+    for kind in [IntegratorKind::Vcm, IntegratorKind::Sppm] {
+        let options = IntegratorOptions::of(kind);
+        let said = options
+            .build()
+            .for_scene(&load("wide-radius", &text))
+            .describe();
+        assert!(said.contains("more than an eighth of the frame"), "{said}");
+        let cornell = options
+            .build()
+            .for_scene(&crate::common::cornell_box())
+            .describe();
+        assert!(
+            cornell.contains("pixels at the median first hit"),
+            "{cornell}"
+        );
+        assert!(!cornell.contains("more than an eighth"), "{cornell}");
+    }
+    let mut options = IntegratorOptions::of(IntegratorKind::Vcm);
+    *options.max_depth_mut().expect("a depth") = 1;
+    options.vcm.radius = 2e-5;
+    let (snapshot, stats) = render_with(
+        load("narrow-radius", &text),
+        options.build(),
+        SamplerKind::Independent,
+        64,
+        1,
+        0,
+        8,
+    );
+    assert_eq!(stats.non_finite, 0);
+    let (mean, error) = crate::common::mean_and_standard_error(&snapshot);
+    let tolerance = 4.0 * error[0] + 2e-4 * expected;
+    assert!(
+        (mean[0] - expected).abs() < tolerance,
+        "mean {} against {expected} (tolerance {tolerance})",
+        mean[0]
+    );
+}

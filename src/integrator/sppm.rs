@@ -89,6 +89,11 @@ pub struct PhotonMapper {
     pub radius: f32,
     /// How fast the radius shrinks: r_i^2 = r_1^2 i^(alpha - 1).
     pub alpha: f32,
+    /// The first radius in pixels at the median first hit, once
+    /// [`Technique::for_scene`] has seen the scene (for the summary).
+    pub radius_pixels: Option<f32>,
+    /// The frame's width in pixels, with `radius_pixels`.
+    pub frame_width: u32,
 }
 
 impl Default for PhotonMapper {
@@ -98,6 +103,8 @@ impl Default for PhotonMapper {
             photons: 0,
             radius: 0.002,
             alpha: 2.0 / 3.0,
+            radius_pixels: None,
+            frame_width: 0,
         }
     }
 }
@@ -114,15 +121,18 @@ impl Technique for PhotonMapper {
             photons: settings.photons,
             radius: settings.radius,
             alpha: settings.alpha,
+            radius_pixels: None,
+            frame_width: 0,
         }
     }
 
     fn describe(&self) -> String {
         format!(
-            "photon mapping (max depth {}, {} photons per iteration, radius {:.3e}, alpha {:.2})",
+            "photon mapping (max depth {}, {} photons per iteration, radius {:.3e}{}, alpha {:.2})",
             self.max_depth,
             photon_map::describe_photons(self.photons),
             self.radius,
+            photon_map::describe_radius_in_pixels(self.frame_width, self.radius_pixels),
             self.alpha
         )
     }
@@ -130,6 +140,9 @@ impl Technique for PhotonMapper {
     fn for_scene(self, scene: &Scene) -> Self {
         PhotonMapper {
             radius: photon_map::of_diagonal(scene, self.radius),
+            radius_pixels: photon_map::pixel_footprint(scene)
+                .map(|w| photon_map::of_diagonal(scene, self.radius) / w),
+            frame_width: scene.camera.width,
             photons: photon_map::photons_per_iteration(scene, self.photons),
             ..self
         }

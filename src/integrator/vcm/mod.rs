@@ -107,6 +107,11 @@ pub struct Vcm {
     pub radius: f32,
     /// How fast the radius shrinks: r_i^2 = r_1^2 i^(alpha - 1).
     pub alpha: f32,
+    /// The first radius in pixels at the median first hit, once
+    /// [`Technique::for_scene`] has seen the scene (for the summary).
+    pub radius_pixels: Option<f32>,
+    /// The frame's width in pixels, with `radius_pixels`.
+    pub frame_width: u32,
 }
 
 impl Default for Vcm {
@@ -118,6 +123,8 @@ impl Default for Vcm {
             mis: MisHeuristic::Power,
             radius: 0.002,
             alpha: 2.0 / 3.0,
+            radius_pixels: None,
+            frame_width: 0,
         }
     }
 }
@@ -139,15 +146,18 @@ impl Technique for Vcm {
             mis: super::options::combining(settings.mis),
             radius: settings.radius,
             alpha: settings.alpha,
+            radius_pixels: None,
+            frame_width: 0,
         }
     }
 
     fn describe(&self) -> String {
         format!(
-            "vcm (max depth {}, mis {:?}, radius {:.3e}, alpha {:.2}, rr {})",
+            "vcm (max depth {}, mis {:?}, radius {:.3e}{}, alpha {:.2}, rr {})",
             super::options::depth_label(self.max_depth),
             self.mis,
             self.radius,
+            photon_map::describe_radius_in_pixels(self.frame_width, self.radius_pixels),
             self.alpha,
             if self.russian_roulette {
                 format!("from {}", self.rr_depth)
@@ -160,6 +170,9 @@ impl Technique for Vcm {
     fn for_scene(self, scene: &Scene) -> Self {
         Vcm {
             radius: photon_map::of_diagonal(scene, self.radius),
+            radius_pixels: photon_map::pixel_footprint(scene)
+                .map(|w| photon_map::of_diagonal(scene, self.radius) / w),
+            frame_width: scene.camera.width,
             ..self
         }
     }
