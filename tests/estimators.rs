@@ -388,9 +388,7 @@ fn a_narrow_spot_gives_its_closed_form_in_every_technique() {
     // The falloff's angle came from acos of a cosine near 1, in steps of
     // 3.5e-4 rad, and the cone's density from 1 − cos(cutoff): a spot of
     // 0.02° read 22% high in path tracing, 6.6% in light tracing, 10% in
-    // BDPT. Tolerance: 4 standard errors of the image mean (from the
-    // pixels' own), plus 2e-4 of the value for the pixel grid's edges
-    // across the footprint (path tracing, nearly noiseless, lands 2e-5 off).
+    // BDPT. Tolerance: see `check_spot`.
     for cutoff in [10.0, 0.1, 0.02] {
         let (text, expected) = narrow_spot(cutoff);
         for kind in [
@@ -400,25 +398,38 @@ fn a_narrow_spot_gives_its_closed_form_in_every_technique() {
         ] {
             let mut options = IntegratorOptions::of(kind);
             *options.max_depth_mut().expect("a depth") = 1;
-            let (snapshot, stats) = render_with(
-                load("narrow-spot", &text),
-                options.build(),
-                SamplerKind::Independent,
-                64,
-                1,
-                0,
-                8,
-            );
-            assert_eq!(stats.non_finite, 0);
-            let (mean, error) = crate::common::mean_and_standard_error(&snapshot);
-            let tolerance = 4.0 * error[0] + 2e-4 * expected;
-            assert!(
-                (mean[0] - expected).abs() < tolerance,
-                "{kind:?}, cutoff {cutoff}°: mean {} against {expected} (tolerance {tolerance})",
-                mean[0]
+            check_spot(
+                &text,
+                expected,
+                options,
+                &format!("{kind:?}, cutoff {cutoff}°"),
             );
         }
     }
+}
+
+/// Renders a [`narrow_spot`] scene at 64 spp and checks its mean against
+/// the closed form: within 4 standard errors of the mean (from the pixels'
+/// own) plus 2e-4 of the value for the pixel grid's edges across the
+/// footprint (path tracing, nearly noiseless, lands 2e-5 off).
+fn check_spot(text: &str, expected: f64, options: IntegratorOptions, what: &str) {
+    let (snapshot, stats) = render_with(
+        load("narrow-spot", text),
+        options.build(),
+        SamplerKind::Independent,
+        64,
+        1,
+        0,
+        8,
+    );
+    assert_eq!(stats.non_finite, 0);
+    let (mean, error) = crate::common::mean_and_standard_error(&snapshot);
+    let tolerance = 4.0 * error[0] + 2e-4 * expected;
+    assert!(
+        (mean[0] - expected).abs() < tolerance,
+        "{what}: mean {} against {expected} (tolerance {tolerance})",
+        mean[0]
+    );
 }
 
 #[test]
@@ -449,21 +460,5 @@ fn merging_says_when_its_radius_is_wider_than_the_view_and_meets_the_closed_form
     let mut options = IntegratorOptions::of(IntegratorKind::Vcm);
     *options.max_depth_mut().expect("a depth") = 1;
     options.vcm.radius = 2e-5;
-    let (snapshot, stats) = render_with(
-        load("narrow-radius", &text),
-        options.build(),
-        SamplerKind::Independent,
-        64,
-        1,
-        0,
-        8,
-    );
-    assert_eq!(stats.non_finite, 0);
-    let (mean, error) = crate::common::mean_and_standard_error(&snapshot);
-    let tolerance = 4.0 * error[0] + 2e-4 * expected;
-    assert!(
-        (mean[0] - expected).abs() < tolerance,
-        "mean {} against {expected} (tolerance {tolerance})",
-        mean[0]
-    );
+    check_spot(&text, expected, options, "VCM at a radius of 3 pixels");
 }
