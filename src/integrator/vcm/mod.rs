@@ -168,10 +168,10 @@ impl Technique for Vcm {
     }
 
     fn for_scene(self, scene: &Scene) -> Self {
+        let radius = photon_map::of_diagonal(scene, self.radius);
         Vcm {
-            radius: photon_map::of_diagonal(scene, self.radius),
-            radius_pixels: photon_map::pixel_footprint(scene)
-                .map(|w| photon_map::of_diagonal(scene, self.radius) / w),
+            radius,
+            radius_pixels: photon_map::pixel_footprint(scene).map(|w| radius / w),
             frame_width: scene.camera.width,
             ..self
         }
