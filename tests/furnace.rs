@@ -30,6 +30,7 @@ fn furnace_material() -> Material {
         textures: Default::default(),
         opacity: Default::default(),
         normal_map: None,
+        blend: None,
     }
 }
 

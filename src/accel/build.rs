@@ -247,6 +247,7 @@ impl Geometry {
             offset: self.offset,
             bvh_too_deep: self.bvh_too_deep,
             masks: self.masks.clone(),
+            blends: self.blends.clone(),
             instances: self.instances.clone(),
             ..Geometry::default()
         };

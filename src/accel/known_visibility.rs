@@ -93,6 +93,9 @@ impl Geometry {
         if let OffsetMode::Fixed(_) = self.offset {
             hit.error = self.offset.spawn_error(hit.error, hit.normal);
         }
+        if let Some(blends) = &self.blends {
+            hit.material = blends.material_at(&hit, || self.uv(&hit));
+        }
         Some(hit)
     }
 }

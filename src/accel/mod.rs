@@ -7,6 +7,7 @@
 //! Triangles are stored in flat arrays in leaf order, so a leaf's triangles
 //! are contiguous in memory and a hit's index addresses them directly.
 
+pub mod blend;
 mod block;
 mod build;
 mod instance;
@@ -19,6 +20,7 @@ pub(crate) mod triangle;
 mod wide_bvh;
 
 use crate::math::{OffsetMode, Ray, gamma};
+use blend::Blends;
 use glam::{Affine3A, Vec2, Vec3A};
 use instance::Instances;
 pub use instance::NO_INSTANCE;
@@ -209,9 +211,12 @@ pub struct Geometry {
     /// Opacity masks, where some material has one: queries then pass
     /// through the hits a mask drops.
     masks: Option<Arc<Masks>>,
+    /// Blends of two materials, where some material is one: hits then
+    /// take one of the two by a hash of their point.
+    blends: Option<Arc<Blends>>,
     /// Shared geometry placed by transforms.
     instances: Instances,
-    /// No masks, instances, moving objects or fixed offset
+    /// No masks, blends, instances, moving objects or fixed offset
     /// ([`Geometry::is_plain`]). False until settled, so that a geometry
     /// built another way is never taken for plain.
     plain: bool,
@@ -257,6 +262,7 @@ impl Geometry {
     /// Settles [`Geometry::is_plain`] after what it reads has changed.
     fn update_plain(&mut self) {
         self.plain = self.masks.is_none()
+            && self.blends.is_none()
             && self.instances.is_empty()
             && self.moving.is_empty()
             && !matches!(self.offset, OffsetMode::Fixed(_));
@@ -436,6 +442,9 @@ impl Geometry {
         if let (OffsetMode::Fixed(_), Some(h)) = (self.offset, &mut hit) {
             h.error = self.offset.spawn_error(h.error, h.normal);
         }
+        if let (Some(blends), Some(h)) = (&self.blends, &mut hit) {
+            h.material = blends.material_at(h, || self.uv(h));
+        }
         hit
     }
 
@@ -494,6 +503,13 @@ impl Geometry {
     /// through the hits their masks drop. Scenes without a mask keep none.
     pub fn set_masks(&mut self, masks: Masks) {
         self.masks = Masks::any(&masks.by_material).then(|| Arc::new(masks));
+        self.update_plain();
+    }
+
+    /// Sets the materials' blends: from now on a hit on a blend takes one
+    /// of its two materials. Scenes without a blend keep none.
+    pub fn set_blends(&mut self, blends: Blends) {
+        self.blends = Blends::any(&blends.by_material).then(|| Arc::new(blends));
         self.update_plain();
     }
 

@@ -174,8 +174,6 @@ mod tests {
         }
     }
 
-    use super::*;
-
     #[test]
     fn warps_land_in_their_domains() {
         for i in 0..32 {

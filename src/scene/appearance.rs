@@ -555,5 +555,6 @@ pub(super) fn build_material(
         textures: Default::default(),
         opacity: Default::default(),
         normal_map: None,
+        blend: None,
     })
 }

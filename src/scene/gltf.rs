@@ -5,16 +5,17 @@
 //!
 //! The mapping (say it where a user asks): transmission > 0 is a dielectric
 //! (rough where roughness > 0) of the KHR_materials_ior index, else
-//! metallic ≥ ½ a conductor whose reflectance is the base colour at every
-//! angle, else a plastic (a dielectric coat of IOR 1.5 over the base colour);
-//! GGX with α = roughness² (a roughness map read at each hit; a metallic
-//! map decides by its mean). glTF's single-sided materials are one-sided.
+//! metallic 1 a conductor whose reflectance is the base colour at every
+//! angle, metallic 0 a plastic (a dielectric coat of IOR 1.5 over the base
+//! colour), and between (or a metallic map that varies) a blend of the two
+//! weighted by metallic; GGX with α = roughness² (a roughness map read at
+//! each hit). glTF's single-sided materials are one-sided.
 //! Punctual lights' intensities are taken as radiometric (W/sr, W/m²).
 
 use super::appearance::build_material;
 use super::description::{IorDesc, MaterialDesc, MaterialKind};
 use super::environment::{Environment, Radiance};
-use super::material::{Material, MaterialTextures, NormalMap, Opacity};
+use super::material::{Blend, BlendWeight, Material, MaterialTextures, NormalMap, Opacity};
 use super::mesh::{MeshData, Orientation};
 use super::uri::read_uri;
 use super::{LoadOptions, SceneInput, in_range};
@@ -403,7 +404,7 @@ impl Importer<'_> {
         let mut metallic = pbr.metallic_factor().clamp(0.0, 1.0);
         let alpha = roughness * roughness;
         let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
-        let mut textures = MaterialTextures::default();
+        let textures = MaterialTextures::default();
         let base_texture = match pbr.base_color_texture() {
             Some(info) => Some(self.texture(&info.texture(), info.tex_coord(), false, &label)?),
             None => None,
@@ -413,6 +414,7 @@ impl Importer<'_> {
         // the model for the whole material, so a map that varies is read
         // as its mean, with a warning.
         let mut alpha_texture = None;
+        let mut metal_texture = None;
         if let Some(info) = pbr.metallic_roughness_texture() {
             let t = info.texture();
             if info.tex_coord() != 0 {
@@ -434,9 +436,7 @@ impl Importer<'_> {
             let metal = decode(2, &|b| metallic * b).map_err(|m| self.error(m))?;
             let (lo, hi, mean) = metal.first_channel_range();
             if hi > lo {
-                self.warn(format!(
-                    "{label}: metallic varies over its texture ({lo:.2} to {hi:.2}): its mean {mean:.2} decides metal or dielectric"
-                ));
+                metal_texture = Some(self.push_texture(&t, metal, &label));
             }
             metallic = mean;
         }
@@ -473,71 +473,70 @@ impl Importer<'_> {
             (Some(c), None) if base[3] < c => Opacity::Constant(0.0),
             (Some(_), None) => Opacity::Opaque,
         };
-        if metallic > 0.0 && metallic < 1.0 && transmission == 0.0 {
-            self.warn(format!(
-                "{label}: metallic {metallic} read as {}",
-                if metallic >= 0.5 {
-                    "a metal"
+        // glTF's BRDF is the dielectric's and the metal's mixed by metallic:
+        // where it lies strictly between 0 and 1 (or its map varies), the
+        // material is a blend of the two (crate::accel::blend).
+        let blended =
+            transmission == 0.0 && (metal_texture.is_some() || (metallic > 0.0 && metallic < 1.0));
+        let model = |metal: bool| {
+            let mut d = MaterialDesc {
+                twosided: Some(m.double_sided()),
+                ..Default::default()
+            };
+            let mut textures = textures;
+            if transmission > 0.0 {
+                d.twosided = None;
+                let ior = m.ior().unwrap_or(1.5);
+                // glTF's transmissive volumes are refracting solids.
+                d.kind = match alpha > 1e-4 {
+                    true => MaterialKind::RoughDielectric,
+                    false => MaterialKind::Dielectric,
+                };
+                if d.kind == MaterialKind::Dielectric {
+                    d.ior = Some(ior);
+                    d.tint = Some(base_rgb);
                 } else {
-                    "a dielectric"
+                    d.int_ior = Some(IorDesc::Value(ior));
+                    d.ext_ior = Some(IorDesc::Value(1.0));
+                    d.specular_transmittance = Some(base_rgb);
+                    d.distribution = Some(crate::bsdf::Distribution::Ggx);
+                    d.alpha = Some(alpha);
+                    (textures.alpha, textures.alpha_v) = (alpha_texture, alpha_texture);
                 }
-            ));
-        }
-        let mut d = MaterialDesc {
-            twosided: Some(m.double_sided()),
-            ..Default::default()
-        };
-        if transmission > 0.0 {
-            if transmission < 1.0 {
-                self.warn(format!("{label}: transmission {transmission} read as 1"));
-            }
-            d.twosided = None;
-            let ior = m.ior().unwrap_or(1.5);
-            // glTF's transmissive volumes are refracting solids.
-            d.kind = match alpha > 1e-4 {
-                true => MaterialKind::RoughDielectric,
-                false => MaterialKind::Dielectric,
-            };
-            if d.kind == MaterialKind::Dielectric {
-                d.ior = Some(ior);
-                d.tint = Some(base_rgb);
+            } else if metal {
+                d.kind = match alpha > 1e-4 {
+                    true => MaterialKind::RoughConductor,
+                    false => MaterialKind::Conductor,
+                };
+                // η = 0, k = 1: Fresnel 1 at every angle, tinted by the base colour.
+                d.eta = Some([0.0; 3]);
+                d.k = Some([1.0; 3]);
+                d.specular_reflectance = Some(base_rgb);
+                textures.specular = base_texture;
+                if d.kind == MaterialKind::RoughConductor {
+                    d.distribution = Some(crate::bsdf::Distribution::Ggx);
+                    d.alpha = Some(alpha);
+                    (textures.alpha, textures.alpha_v) = (alpha_texture, alpha_texture);
+                }
             } else {
-                d.int_ior = Some(IorDesc::Value(ior));
+                d.kind = match alpha > 1e-4 {
+                    true => MaterialKind::RoughPlastic,
+                    false => MaterialKind::Plastic,
+                };
+                d.int_ior = Some(IorDesc::Value(1.5));
                 d.ext_ior = Some(IorDesc::Value(1.0));
-                d.specular_transmittance = Some(base_rgb);
-                d.distribution = Some(crate::bsdf::Distribution::Ggx);
-                d.alpha = Some(alpha);
-                (textures.alpha, textures.alpha_v) = (alpha_texture, alpha_texture);
+                d.diffuse_reflectance = Some(base_rgb);
+                textures.diffuse = base_texture;
+                if d.kind == MaterialKind::RoughPlastic {
+                    d.distribution = Some(crate::bsdf::Distribution::Ggx);
+                    d.alpha = Some(alpha);
+                    (textures.alpha, textures.alpha_v) = (alpha_texture, alpha_texture);
+                }
             }
-        } else if metallic >= 0.5 {
-            d.kind = match alpha > 1e-4 {
-                true => MaterialKind::RoughConductor,
-                false => MaterialKind::Conductor,
-            };
-            // η = 0, k = 1: Fresnel 1 at every angle, tinted by the base colour.
-            d.eta = Some([0.0; 3]);
-            d.k = Some([1.0; 3]);
-            d.specular_reflectance = Some(base_rgb);
-            textures.specular = base_texture;
-            if d.kind == MaterialKind::RoughConductor {
-                d.distribution = Some(crate::bsdf::Distribution::Ggx);
-                d.alpha = Some(alpha);
-                (textures.alpha, textures.alpha_v) = (alpha_texture, alpha_texture);
-            }
-        } else {
-            d.kind = match alpha > 1e-4 {
-                true => MaterialKind::RoughPlastic,
-                false => MaterialKind::Plastic,
-            };
-            d.int_ior = Some(IorDesc::Value(1.5));
-            d.ext_ior = Some(IorDesc::Value(1.0));
-            d.diffuse_reflectance = Some(base_rgb);
-            textures.diffuse = base_texture;
-            if d.kind == MaterialKind::RoughPlastic {
-                d.distribution = Some(crate::bsdf::Distribution::Ggx);
-                d.alpha = Some(alpha);
-                (textures.alpha, textures.alpha_v) = (alpha_texture, alpha_texture);
-            }
+            (d, textures)
+        };
+        if transmission > 0.0 && transmission < 1.0 {
+            self.warn(format!("{label}: transmission {transmission} read as 1"));
         }
         let strength = m.emissive_strength().unwrap_or(1.0);
         let mut emission = Rgb::from(m.emissive_factor()) * strength;
@@ -546,15 +545,31 @@ impl Importer<'_> {
             self.warn(format!("{label}: emissive texture: its mean is used"));
             emission *= self.textures[id as usize].mean();
         }
-        if emission.max_element() > 0.0 {
-            d.emission = Some(emission.to_array());
-            d.two_sided = Some(m.double_sided());
+        let build = |metal: bool| {
+            let (mut d, textures) = model(metal);
+            if emission.max_element() > 0.0 {
+                d.emission = Some(emission.to_array());
+                d.two_sided = Some(m.double_sided());
+            }
+            let mut material = build_material(&name, &d)?;
+            material.set_textures(textures);
+            material.opacity = opacity;
+            material.normal_map = normal_map;
+            Ok::<_, String>(material)
+        };
+        let built = |metal| build(metal).map_err(|e| self.error(format!("{label}: {e}")));
+        let mut material = built(!blended && metallic >= 0.5)?;
+        if blended {
+            let metal = built(true)?;
+            material.blend = Some(Blend {
+                second: self.materials.len() as u32,
+                weight: match metal_texture {
+                    Some(t) => BlendWeight::Texture(t),
+                    None => BlendWeight::Constant(metallic),
+                },
+            });
+            self.materials.push(metal);
         }
-        let mut material =
-            build_material(&name, &d).map_err(|e| self.error(format!("{label}: {e}")))?;
-        material.set_textures(textures);
-        material.opacity = opacity;
-        material.normal_map = normal_map;
         let id = self.materials.len() as u32;
         self.materials.push(material);
         self.material_ids.insert(m.index(), id);

@@ -553,6 +553,7 @@ pub(super) fn default_material() -> Material {
         textures: Default::default(),
         opacity: Default::default(),
         normal_map: None,
+        blend: None,
     }
 }
 

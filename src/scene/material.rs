@@ -1,5 +1,6 @@
 //! Materials: a BSDF (see [`crate::bsdf`]) plus optional emission.
 
+pub use crate::accel::blend::{Blend, Weight as BlendWeight};
 pub use crate::accel::mask::Opacity;
 use crate::bsdf::Microfacet;
 pub use crate::bsdf::{Bsdf, BsdfSample, Fresnel, fresnel_dielectric};
@@ -24,6 +25,9 @@ pub struct Material {
     /// A tangent-space normal map that tilts the shading normal
     /// ([`crate::scene::Scene::shading_normal`]).
     pub normal_map: Option<NormalMap>,
+    /// A blend with a second material (Mitsuba's `blendbsdf`): hits take
+    /// it with the blend's weight ([`crate::accel::blend`]).
+    pub blend: Option<Blend>,
 }
 
 /// A texture that tilts the shading normal; `texture` indexes the scene's

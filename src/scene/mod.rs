@@ -24,6 +24,7 @@ pub use features::Features;
 pub use instances::InstancesInput;
 mod uri;
 
+use crate::accel::blend::Blends;
 use crate::accel::mask::Masks;
 use crate::accel::{AccelChoice, Geometry, NO_LIGHT, Sphere, SurfaceHit, TriangleInput};
 use crate::camera::Camera;
@@ -34,7 +35,7 @@ use crate::texture::Texture;
 use emitters::EmitterShape;
 use glam::Vec3A;
 use light::{Light, LightSampling, Lights, PlanarEmitter};
-use material::{Material, Opacity};
+use material::{BlendWeight, Material, Opacity};
 use rayon::prelude::*;
 use std::path::Path;
 use std::sync::Arc;
@@ -341,6 +342,8 @@ impl Scene {
             !m.textures.is_empty()
                 || matches!(m.opacity, Opacity::Texture(_))
                 || m.normal_map.is_some()
+                || m.blend
+                    .is_some_and(|b| matches!(b.weight, BlendWeight::Texture(_)))
         });
         let mut geometry = Geometry::build_full(triangles, spheres, AccelChoice::Auto, textured);
         // An emitter is sampled where it is, mask or not: it stays whole.
@@ -355,6 +358,10 @@ impl Scene {
         }
         geometry.set_masks(Masks {
             by_material: input.materials.iter().map(|m| m.opacity).collect(),
+            textures: input.textures.clone(),
+        });
+        geometry.set_blends(Blends {
+            by_material: input.materials.iter().map(|m| m.blend).collect(),
             textures: input.textures.clone(),
         });
         for (triangles, spheres, velocity) in moving {
@@ -508,6 +515,33 @@ impl Scene {
     /// is read as the texture's mean, which counts as dropping detail.
     pub fn diffuse_albedo(&self, m: u32) -> Option<(crate::math::Rgb, bool)> {
         let material = &self.materials[m as usize];
+        if let Some(blend) = material.blend {
+            // The two albedos mixed by the weight's mean; a specular part
+            // adds nothing diffuse.
+            let w = match blend.weight {
+                BlendWeight::Constant(w) => w.clamp(0.0, 1.0),
+                BlendWeight::Texture(t) => {
+                    crate::math::luminance(self.textures[t as usize].mean()).clamp(0.0, 1.0)
+                }
+            };
+            let first = Material {
+                blend: None,
+                ..material.clone()
+            };
+            let part = |m: &Material| match m.bsdf.diffuse_albedo() {
+                None => None,
+                Some((a, _)) => Some(match m.textures.diffuse {
+                    Some(t) => self.textures[t as usize].mean(),
+                    None => a,
+                }),
+            };
+            let (a, b) = (part(&first), part(&self.materials[blend.second as usize]));
+            if a.is_none() && b.is_none() {
+                return None;
+            }
+            let zero = crate::math::Rgb::ZERO;
+            return Some((a.unwrap_or(zero) * (1.0 - w) + b.unwrap_or(zero) * w, true));
+        }
         let (albedo, approximated) = material.bsdf.diffuse_albedo()?;
         match material.textures.diffuse {
             Some(t) => Some((self.textures[t as usize].mean(), true)),

@@ -514,6 +514,7 @@ fn convert_material(mtl_path: &Path, m: &tobj::Material) -> Result<Material> {
         textures: Default::default(),
         opacity: Default::default(),
         normal_map: None,
+        blend: None,
     })
 }
 
