@@ -498,6 +498,14 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
         )
         .set_value_accesskit(0.01);
     harness.run_steps(2);
+    // The radius in pixels under its slider, as the CLI's summary says it
+    // (the Cornell box's 256 pixels: about 3.5, no warning).
+    harness.get_by_label_contains("pixels at the median first hit");
+    assert!(
+        harness
+            .query_by_label_contains("more than an eighth of the frame")
+            .is_none()
+    );
     let options = harness.state().app.settings.a.integrator;
     assert_eq!(options.kind, IntegratorKind::Vcm);
     assert_eq!(options.vcm.mis, tracelab::integrator::MisHeuristic::Power);

@@ -9,9 +9,17 @@ Run: pip install mitsuba numpy; cargo build --release;
 python3 bench/peer/plugin_probes.py [--only disk,blend] [--techniques path,bdpt]
     [--seeds 4] [--spp 1024] [--dir /tmp/probes]
 """
-import argparse, os, subprocess, sys
+import argparse
+import os
+import subprocess
+import sys
+
 import numpy as np
-import mitsuba as mi
+
+# bench/peer/mitsuba (the Cornell box's meshes) would shadow the package.
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path = [p for p in sys.path if os.path.abspath(p or ".") != HERE]
+import mitsuba as mi  # noqa: E402
 
 mi.set_variant("scalar_rgb")
 

@@ -17,7 +17,7 @@ use tracelab::{Error, Result};
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Scene file (TOML).
+    /// Scene file (TOML, Mitsuba XML, glTF, or a bare OBJ or PLY).
     scene: PathBuf,
     /// Reference image (EXR); without it tracelab renders one (path tracing,
     /// Sobol, --reference-spp) and caches it under target/.

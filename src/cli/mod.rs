@@ -79,7 +79,7 @@ impl ValueEnum for IntegratorArg {
 #[cfg(feature = "viewer")]
 #[derive(clap::Args, Debug)]
 struct ViewArgs {
-    /// Scene file (TOML); default: the last one, or the Cornell box.
+    /// Scene file (TOML, Mitsuba XML, glTF, or a bare OBJ or PLY); default: the last one, or the Cornell box.
     scene: Option<PathBuf>,
     /// The technique and its settings, as `render` takes them; without
     /// `--integrator` the viewer's saved technique and settings are kept.

@@ -179,7 +179,7 @@ impl RadiosityFlags {
 
 #[derive(Args, Debug)]
 pub struct RadiosityArgs {
-    /// Scene file (TOML).
+    /// Scene file (TOML, Mitsuba XML, glTF, or a bare OBJ or PLY).
     scene: PathBuf,
     /// The image to measure against (EXR, the scene's resolution).
     #[arg(long)]

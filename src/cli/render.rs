@@ -23,7 +23,7 @@ use tracelab::{Error, Result};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Scene file: tracelab TOML, Mitsuba XML, or a bare OBJ or PLY mesh.
+    /// Scene file: tracelab TOML, Mitsuba XML, glTF, or a bare OBJ or PLY mesh.
     scene: PathBuf,
     #[command(flatten)]
     pub(crate) technique: TechniqueFlags,

@@ -90,6 +90,10 @@ pub struct ViewerApp {
     /// The last scene that loaded; kept when a new one fails.
     scene: Option<Arc<Scene>>,
     scene_name: String,
+    /// Pixels at the camera's median first hit per unit of a merge radius
+    /// given as a fraction of the diagonal, and the frame's width, for the
+    /// radius controls of VCM and SPPM.
+    pub merge_scale: Option<(f32, u32)>,
     /// Camera moved with the mouse; `None` uses the scene's.
     pub camera: Option<Camera>,
     reference: Option<Arc<Image>>,
@@ -150,6 +154,7 @@ impl ViewerApp {
             live,
             scene: None,
             scene_name: String::new(),
+            merge_scale: None,
             camera: None,
             reference: None,
             reference_beside: None,
@@ -196,6 +201,13 @@ impl ViewerApp {
                     self.toast(format!("{path}: {w}"));
                 }
                 self.apply_hints(&scene.hints);
+                self.merge_scale =
+                    crate::integrator::photon_map::pixel_footprint(&scene).map(|w| {
+                        (
+                            crate::integrator::photon_map::of_diagonal(&scene, 1.0) / w,
+                            scene.camera.width,
+                        )
+                    });
                 self.scene = Some(Arc::new(scene));
                 self.camera = None;
                 self.settings.scene_path = path.to_string();

@@ -18,8 +18,14 @@ use crate::radiosity::{FormFactorMethod, RadiositySolver};
 use crate::scene::UNBOUNDED_DEPTH;
 use eframe::egui::{self, RichText};
 
-/// The chosen technique's controls.
-pub fn technique(ui: &mut egui::Ui, options: &mut IntegratorOptions) {
+/// The chosen technique's controls; `merge_scale` (pixels per unit of a
+/// radius given as a fraction of the diagonal, and the frame's width)
+/// shows a merge radius in pixels.
+pub fn technique(
+    ui: &mut egui::Ui,
+    options: &mut IntegratorOptions,
+    merge_scale: Option<(f32, u32)>,
+) {
     match options.kind {
         IntegratorKind::Whitted => whitted(ui, &mut options.whitted),
         IntegratorKind::Mcrt => mcrt(ui, &mut options.mcrt),
@@ -28,8 +34,8 @@ pub fn technique(ui: &mut egui::Ui, options: &mut IntegratorOptions) {
         IntegratorKind::Light => light(ui, &mut options.light),
         IntegratorKind::Bdpt => bdpt(ui, &mut options.bdpt),
         IntegratorKind::Photon => photon(ui, &mut options.photon),
-        IntegratorKind::Sppm => sppm(ui, &mut options.sppm),
-        IntegratorKind::Vcm => vcm(ui, &mut options.vcm),
+        IntegratorKind::Sppm => sppm(ui, &mut options.sppm, merge_scale),
+        IntegratorKind::Vcm => vcm(ui, &mut options.vcm, merge_scale),
         IntegratorKind::Radiosity => radiosity(ui, &mut options.radiosity),
     }
 }
@@ -128,21 +134,21 @@ fn photon(ui: &mut egui::Ui, s: &mut PhotonSettings) {
     );
 }
 
-fn sppm(ui: &mut egui::Ui, s: &mut SppmSettings) {
+fn sppm(ui: &mut egui::Ui, s: &mut SppmSettings, merge_scale: Option<(f32, u32)>) {
     max_depth(ui, &mut s.max_depth);
     ui.add(
         slider(&mut s.photons, 0..=4_000_000)
             .logarithmic(true)
             .text("Photons per iteration (0: one per pixel)"),
     );
-    merge_radius(ui, &mut s.radius, &mut s.alpha);
+    merge_radius(ui, &mut s.radius, &mut s.alpha, merge_scale);
 }
 
-fn vcm(ui: &mut egui::Ui, s: &mut VcmSettings) {
+fn vcm(ui: &mut egui::Ui, s: &mut VcmSettings, merge_scale: Option<(f32, u32)>) {
     unbounded_max_depth(ui, &mut s.length);
     mis_heuristic(ui, &mut s.mis);
     roulette(ui, &mut s.length);
-    merge_radius(ui, &mut s.radius, &mut s.alpha);
+    merge_radius(ui, &mut s.radius, &mut s.alpha, merge_scale);
 }
 
 fn radiosity(ui: &mut egui::Ui, s: &mut Radiosity) {
@@ -322,11 +328,32 @@ fn seen_emitters(ui: &mut egui::Ui, exact: &mut bool) {
         );
 }
 
-fn merge_radius(ui: &mut egui::Ui, radius: &mut f32, alpha: &mut f32) {
+fn merge_radius(
+    ui: &mut egui::Ui,
+    radius: &mut f32,
+    alpha: &mut f32,
+    merge_scale: Option<(f32, u32)>,
+) {
     ui.add(
-        slider(radius, 1e-4..=0.05)
+        slider(radius, 1e-5..=0.05)
             .logarithmic(true)
             .text("First radius (of the scene's diagonal)"),
     );
+    // The same words as the CLI's summary; a radius wider than an eighth
+    // of the frame blurs what is in view (a narrow spot lost 96%).
+    if let Some((per_unit, width)) = merge_scale {
+        let pixels = *radius * per_unit;
+        let said = crate::integrator::photon_map::describe_radius_in_pixels(width, Some(pixels));
+        let text = said
+            .trim()
+            .trim_start_matches('(')
+            .trim_end_matches(')')
+            .replace("--radius", "radius");
+        let wide = pixels > width as f32 / 8.0;
+        ui.label(match wide {
+            true => RichText::new(text).color(ui.visuals().warn_fg_color),
+            false => RichText::new(text).weak(),
+        });
+    }
     ui.add(slider(alpha, 0.05..=1.0).text("Alpha (1: fixed radius, biased)"));
 }

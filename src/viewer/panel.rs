@@ -25,12 +25,13 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing)
         ui.separator();
         compare_section(ui, app, editing);
         ui.separator();
+        let merge_scale = app.merge_scale;
         let config = if app.settings.compare && *editing == Editing::B {
             &mut app.settings.b
         } else {
             &mut app.settings.a
         };
-        estimator_section(ui, config);
+        estimator_section(ui, config, merge_scale);
         if app.settings.a.integrator.kind == IntegratorKind::Bdpt {
             ui.checkbox(&mut app.strategy_grid.open, "Strategy images (s, t)")
                 .on_hover_text(
@@ -151,14 +152,14 @@ fn compare_section(ui: &mut egui::Ui, app: &mut ViewerApp, editing: &mut Editing
     });
 }
 
-fn estimator_section(ui: &mut egui::Ui, config: &mut Config) {
+fn estimator_section(ui: &mut egui::Ui, config: &mut Config, merge_scale: Option<(f32, u32)>) {
     ui.heading("Estimator");
     let options = &mut config.integrator;
     for &kind in IntegratorKind::ALL {
         ui.radio_value(&mut options.kind, kind, kind.label())
             .on_hover_text(kind.summary());
     }
-    super::controls::technique(ui, options);
+    super::controls::technique(ui, options, merge_scale);
     match config.fixed_sampler() {
         Some(fixed) => {
             ui.label(format!(
