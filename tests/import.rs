@@ -350,6 +350,48 @@ fn what_is_not_rendered_is_a_warning_and_strict_makes_it_an_error() {
     );
 }
 
+/// The image mean of `scene` by `options` (64 spp) and its standard error.
+type MeanAndError = ([f64; 3], [f64; 3]);
+
+fn direct_mean(scene: Scene, options: &tracelab::integrator::IntegratorOptions) -> MeanAndError {
+    let (snapshot, stats) = crate::common::render_with(
+        scene,
+        options.build(),
+        SamplerKind::Independent,
+        64,
+        1,
+        0,
+        8,
+    );
+    assert_eq!(stats.non_finite, 0);
+    crate::common::mean_and_standard_error(&snapshot)
+}
+
+/// Asserts that `blend` is (1 − w) `first` + w `second`, within 4
+/// standard errors of that difference (the three renders independent).
+fn assert_mixes(
+    w: f64,
+    first: MeanAndError,
+    second: MeanAndError,
+    blend: MeanAndError,
+    what: &str,
+) {
+    let ((a, a_error), (b, b_error), (m, m_error)) = (first, second, blend);
+    for c in 0..3 {
+        let expected = (1.0 - w) * a[c] + w * b[c];
+        let error =
+            (m_error[c].powi(2) + ((1.0 - w) * a_error[c]).powi(2) + (w * b_error[c]).powi(2))
+                .sqrt();
+        assert!(
+            (m[c] - expected).abs() < 4.0 * error,
+            "{what}, channel {c}: {} against {expected} ± {error} (first alone {}, second {})",
+            m[c],
+            a[c],
+            b[c]
+        );
+    }
+}
+
 /// A `blendbsdf` is the weighted sum of its two BSDFs. Under direct light
 /// alone every path meets the blended sphere once, so the blend's image is
 /// (1 − w) times the first BSDF's image plus w times the second's, for
@@ -396,36 +438,12 @@ fn a_blend_is_the_weighted_sum_of_its_two_bsdfs_in_every_technique() {
         *options.max_depth_mut().expect("a depth") = 1;
         let mean = |name: &str, bsdf: &str| {
             let scene = load(name, &scene(bsdf), &[], true).unwrap_or_else(|e| panic!("{e}"));
-            let (snapshot, stats) = crate::common::render_with(
-                scene,
-                options.build(),
-                SamplerKind::Independent,
-                64,
-                1,
-                0,
-                8,
-            );
-            assert_eq!(stats.non_finite, 0);
-            crate::common::mean_and_standard_error(&snapshot)
+            direct_mean(scene, &options)
         };
-        let (d, d_error) = mean("blend-diffuse", diffuse);
-        let (m, m_error) = mean("blend-metal", metal);
+        let (first, second) = (mean("blend-diffuse", diffuse), mean("blend-metal", metal));
         for (i, blend) in blends.iter().enumerate() {
-            let (b, b_error) = mean("blend", blend);
-            for c in 0..3 {
-                let expected = (1.0 - w) * d[c] + w * m[c];
-                let error = (b_error[c].powi(2)
-                    + ((1.0 - w) * d_error[c]).powi(2)
-                    + (w * m_error[c]).powi(2))
-                .sqrt();
-                assert!(
-                    (b[c] - expected).abs() < 4.0 * error,
-                    "{kind:?}, blend {i}, channel {c}: {} against {expected} ± {error} (first BSDF alone: {}, second: {})",
-                    b[c],
-                    d[c],
-                    m[c]
-                );
-            }
+            let what = format!("{kind:?}, blend {i}");
+            assert_mixes(w, first, second, mean("blend", blend), &what);
         }
     }
 }
@@ -568,35 +586,9 @@ fn gltf_metallic_between_zero_and_one_blends_the_dielectric_and_the_metal() {
         let mut scene = Scene::load(&file).unwrap_or_else(|e| panic!("{e}"));
         assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
         scene.set_resolution(48, 32);
-        let (snapshot, stats) = crate::common::render_with(
-            scene,
-            options.build(),
-            SamplerKind::Independent,
-            64,
-            1,
-            0,
-            8,
-        );
-        assert_eq!(stats.non_finite, 0);
-        crate::common::mean_and_standard_error(&snapshot)
+        direct_mean(scene, &options)
     };
-    let (d, d_error) = mean("0");
-    let (m, m_error) = mean("1");
-    let (b, b_error) = mean("0.4");
-    let w = 0.4;
-    for c in 0..3 {
-        let expected = (1.0 - w) * d[c] + w * m[c];
-        let error =
-            (b_error[c].powi(2) + ((1.0 - w) * d_error[c]).powi(2) + (w * m_error[c]).powi(2))
-                .sqrt();
-        assert!(
-            (b[c] - expected).abs() < 4.0 * error,
-            "channel {c}: {} against {expected} ± {error} (dielectric {}, metal {})",
-            b[c],
-            d[c],
-            m[c]
-        );
-    }
+    assert_mixes(0.4, mean("0"), mean("1"), mean("0.4"), "metallic 0.4");
 }
 
 #[test]

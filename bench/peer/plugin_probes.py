@@ -87,17 +87,9 @@ def write_scenes():
     mi.Bitmap(tex).write('checker.exr')
     grad=np.zeros((16,32,3),np.float32); grad[:,:,0]=np.linspace(0,10,32)[None,:]; grad[:,:,1]=np.linspace(0,5,16)[:,None]; grad[:,:,2]=2
     mi.Bitmap(grad).write('grad.exr')
-    HEAD='''<scene version="3.0.0">
-      <integrator type="path"><integer name="max_depth" value="{depth}"/></integrator>
-      <sensor type="perspective"><float name="fov" value="40"/>
-        <transform name="to_world"><lookat origin="0, -6, 3" target="0, 0, 0" up="0, 0, 1"/></transform>
-        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
-        <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="48"/><rfilter type="box"/></film>
-      </sensor>
-    '''
-    FLOOR='''  <shape type="rectangle"><transform name="to_world"><scale value="10"/></transform>
-        <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
-    '''
+    # The same head, at the oblique view of the emitter probes.
+    HEAD = HEAD.replace("{fov}", "40").replace("{origin}", OBL["origin"]).replace(
+        "{target}", OBL["target"]).replace("{up}", OBL["up"])
     TEXFLOOR='''  <shape type="rectangle"><transform name="to_world"><scale value="3"/></transform>
         <bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="checker.exr"/>{filt}
           <transform name="to_uv"><scale x="{su}" y="{sv}"/><translate x="0.1"/></transform></texture></bsdf></shape>
