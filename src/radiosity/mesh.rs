@@ -161,8 +161,8 @@ impl Mesh {
         }
         if glossy > 0 {
             mesh.notes.push(format!(
-                "{glossy} glossy, rough diffuse, plastic or textured triangles are treated as diffuse with \
-                 their diffuse reflectance"
+                "{glossy} glossy, rough diffuse, plastic, textured or blended triangles are treated as \
+                 diffuse with their (mean, blended) diffuse reflectance"
             ));
         }
         if specular > 0 {

@@ -524,10 +524,6 @@ impl Scene {
                     crate::math::luminance(self.textures[t as usize].mean()).clamp(0.0, 1.0)
                 }
             };
-            let first = Material {
-                blend: None,
-                ..material.clone()
-            };
             let part = |m: &Material| match m.bsdf.diffuse_albedo() {
                 None => None,
                 Some((a, _)) => Some(match m.textures.diffuse {
@@ -535,7 +531,7 @@ impl Scene {
                     None => a,
                 }),
             };
-            let (a, b) = (part(&first), part(&self.materials[blend.second as usize]));
+            let (a, b) = (part(material), part(&self.materials[blend.second as usize]));
             if a.is_none() && b.is_none() {
                 return None;
             }
