@@ -13,6 +13,8 @@ mod bitterli;
 mod filtered_film;
 // Mitsuba XML, PLY and serialized import: every element, every error.
 mod import;
+// Blends of two BSDFs against the weighted sum of their parts.
+mod import_blends;
 // Mitsuba sensors: the clips the importer does not apply are warnings.
 mod import_sensor;
 // What Mitsuba 3's documentation scenes use: textured roughness, references.

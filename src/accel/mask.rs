@@ -8,6 +8,7 @@
 //! Scenes without masks never reach this code: [`super::Geometry`] tests
 //! for a mask table once per query.
 
+use super::{Geometry, SurfaceHit};
 use crate::math::{Ray, offset_ray_origin};
 use crate::sampling::hash::hash_combine;
 use crate::texture::Texture;
@@ -105,5 +106,47 @@ pub fn continue_past(ray: &Ray, t: f32, point: Vec3A, error: Vec3A, normal: Vec3
         origin,
         t_max: ray.t_max - t,
         ..*ray
+    }
+}
+
+impl Geometry {
+    /// The closest hit that the masks keep: past each one they drop, the
+    /// ray goes on from it (out of line: only scenes with masks come here).
+    #[inline(never)]
+    pub(super) fn intersect_masked(&self, ray: &Ray, masks: &Masks) -> Option<SurfaceHit> {
+        let mut r = *ray;
+        let mut travelled = 0.0;
+        for pass in 1..=MAX_PASSES {
+            let hit = self.intersect_all(&r)?;
+            if pass == MAX_PASSES || masks.keeps(hit.material, &r, hit.point, || self.uv(&hit)) {
+                return Some(SurfaceHit {
+                    t: hit.t + travelled,
+                    ..hit
+                });
+            }
+            travelled += hit.t;
+            r = continue_past(&r, hit.t, hit.point, hit.error, hit.normal);
+        }
+        None
+    }
+
+    /// Occlusion where masks cut holes: one any-hit traversal that counts
+    /// only opaque triangles settles most shadow rays; a ray that met a
+    /// masked triangle, or is blocked by anything but triangles at rest, is
+    /// followed through the hits by closest-hit queries (out of line: only
+    /// scenes with masks come here).
+    #[inline(never)]
+    pub(super) fn occluded_masked(&self, ray: &Ray, masks: &Masks) -> bool {
+        let mut met_mask = false;
+        let mut opaque = |i: usize| {
+            let opaque = masks.is_opaque(self.tri_shading[i].material);
+            met_mask |= !opaque;
+            opaque
+        };
+        if self.triangle_blocks(ray, &mut opaque) {
+            return true;
+        }
+        let maybe = met_mask || self.spheres_block(ray) || self.occluded_elsewhere(ray);
+        maybe && self.intersect_masked(ray, masks).is_some()
     }
 }

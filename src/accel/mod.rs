@@ -477,28 +477,6 @@ impl Geometry {
         best
     }
 
-    /// The closest hit that the masks keep: past each one they drop, the
-    /// ray goes on from it (out of line: only scenes with masks come here).
-    #[inline(never)]
-    fn intersect_masked(&self, ray: &Ray, masks: &Masks) -> Option<SurfaceHit> {
-        let mut r = *ray;
-        let mut travelled = 0.0;
-        for pass in 1..=mask::MAX_PASSES {
-            let hit = self.intersect_all(&r)?;
-            if pass == mask::MAX_PASSES
-                || masks.keeps(hit.material, &r, hit.point, || self.uv(&hit))
-            {
-                return Some(SurfaceHit {
-                    t: hit.t + travelled,
-                    ..hit
-                });
-            }
-            travelled += hit.t;
-            r = mask::continue_past(&r, hit.t, hit.point, hit.error, hit.normal);
-        }
-        None
-    }
-
     /// Sets the materials' opacities: from now on every query passes
     /// through the hits their masks drop. Scenes without a mask keep none.
     pub fn set_masks(&mut self, masks: Masks) {
@@ -636,26 +614,6 @@ impl Geometry {
             return self.occluded_masked(ray, masks);
         }
         self.occluded_static(ray) || self.occluded_elsewhere(ray)
-    }
-
-    /// Occlusion where masks cut holes: one any-hit traversal that counts
-    /// only opaque triangles settles most shadow rays; a ray that met a
-    /// masked triangle, or is blocked by anything but triangles at rest, is
-    /// followed through the hits by closest-hit queries (out of line: only
-    /// scenes with masks come here).
-    #[inline(never)]
-    fn occluded_masked(&self, ray: &Ray, masks: &Masks) -> bool {
-        let mut met_mask = false;
-        let mut opaque = |i: usize| {
-            let opaque = masks.is_opaque(self.tri_shading[i].material);
-            met_mask |= !opaque;
-            opaque
-        };
-        if self.triangle_blocks(ray, &mut opaque) {
-            return true;
-        }
-        let maybe = met_mask || self.spheres_block(ray) || self.occluded_elsewhere(ray);
-        maybe && self.intersect_masked(ray, masks).is_some()
     }
 
     /// Occlusion by instances and moving objects.
