@@ -171,3 +171,33 @@ fn gltf_metallic_between_zero_and_one_blends_the_dielectric_and_the_metal() {
     };
     assert_mixes(0.4, mean("0"), mean("1"), mean("0.4"), "metallic 0.4");
 }
+
+/// A normal or bump map around a `blendbsdf` tilts both of its BSDFs (the
+/// second one once rendered flat: half a floor's points unmapped).
+#[test]
+fn a_map_around_a_blend_tilts_both_of_its_bsdfs() {
+    for map in [
+        r#"<bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/>"#,
+        r#"<bsdf type="bumpmap"><texture type="checkerboard"/>"#,
+    ] {
+        let xml = format!(
+            r#"<scene version="3.0.0">
+  <shape type="rectangle">
+    {map}<bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="roughconductor"/></bsdf></bsdf>
+  </shape>
+</scene>"#
+        );
+        let scene = load("map-blend", &xml, &[], false).unwrap_or_else(|e| panic!("{e}"));
+        let blended = scene
+            .materials
+            .iter()
+            .find_map(|m| m.blend)
+            .expect("a blend");
+        let first = scene.materials.iter().find(|m| m.blend.is_some()).unwrap();
+        assert!(first.normal_map.is_some(), "{map}");
+        assert_eq!(
+            scene.materials[blended.second as usize].normal_map, first.normal_map,
+            "{map}"
+        );
+    }
+}

@@ -410,9 +410,9 @@ impl Importer<'_> {
             None => None,
         };
         // Roughness in green, metallic in blue, each times its factor. The
-        // roughness map becomes an α map (α = roughness²); metallic picks
-        // the model for the whole material, so a map that varies is read
-        // as its mean, with a warning.
+        // roughness map becomes an α map (α = roughness²); a metallic map
+        // that varies weighs the blend of the plastic and the metal below
+        // (one that does not is its value).
         let mut alpha_texture = None;
         let mut metal_texture = None;
         if let Some(info) = pbr.metallic_roughness_texture() {

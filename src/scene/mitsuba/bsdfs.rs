@@ -140,6 +140,7 @@ impl<'a> Importer<'a> {
                 texture,
                 scale: 1.0,
             });
+            self.map_blend_too(&m);
             return Ok(m);
         }
         if kind == "bumpmap" {
@@ -156,6 +157,7 @@ impl<'a> Importer<'a> {
             self.warn_terminator(e, "bumpmap");
             let mut m = self.bsdf(inner, two_sided)?;
             m.normal_map = Some(NormalMap::Bump { texture, scale });
+            self.map_blend_too(&m);
             return Ok(m);
         }
         if kind == "blendbsdf" {
@@ -335,6 +337,13 @@ impl<'a> Importer<'a> {
         });
         self.materials.push(second);
         Ok(m)
+    }
+
+    /// A map around a `blendbsdf` tilts both of its BSDFs.
+    fn map_blend_too(&mut self, m: &Material) {
+        if let Some(blend) = m.blend {
+            self.materials[blend.second as usize].normal_map = m.normal_map;
+        }
     }
 
     /// Mitsuba 3's `normalmap` and `bumpmap` (not 0.6's) scale what
