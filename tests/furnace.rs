@@ -27,6 +27,7 @@ fn furnace_material() -> Material {
         bsdf: Bsdf::Diffuse { albedo: ALBEDO },
         emission: EMISSION,
         two_sided_emission: true,
+        emission_texture: None,
         textures: Default::default(),
         opacity: Default::default(),
         normal_map: None,

@@ -46,19 +46,18 @@ impl Geometry {
             return (1.0 - b1 - b2) * *t0 + b1 * *t1 + b2 * *t2;
         }
         if hit.primitive & MOVING_PRIMITIVE == 0 && i >= self.tri_vertices.len() {
-            let n = hit.normal;
-            let phi = n.y.atan2(n.x);
-            let phi = if phi < 0.0 {
-                phi + std::f32::consts::TAU
-            } else {
-                phi
-            };
-            return Vec2::new(
-                phi * (0.5 * std::f32::consts::FRAC_1_PI),
-                n.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
-            );
+            return sphere_uv(hit.normal);
         }
         hit.barycentric
+    }
+
+    /// Triangle `i`'s texture coordinates at its corners (storage order):
+    /// its own, or the barycentric corners that [`Geometry::uv`] falls back on.
+    pub fn triangle_uvs(&self, i: usize) -> [Vec2; 3] {
+        match self.tri_uvs.get(i) {
+            Some(&uvs) => uvs,
+            None => [Vec2::ZERO, Vec2::X, Vec2::Y],
+        }
     }
 
     /// dp/du and dp/dv at `hit`, where the surface has texture coordinates
@@ -104,4 +103,20 @@ impl Geometry {
         }
         None
     }
+}
+
+/// A sphere's texture coordinates at outward unit normal `n`: longitude
+/// about z over 2π, colatitude over π.
+#[inline]
+pub fn sphere_uv(n: Vec3A) -> Vec2 {
+    let phi = n.y.atan2(n.x);
+    let phi = if phi < 0.0 {
+        phi + std::f32::consts::TAU
+    } else {
+        phi
+    };
+    Vec2::new(
+        phi * (0.5 * std::f32::consts::FRAC_1_PI),
+        n.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
+    )
 }

@@ -24,6 +24,7 @@ use blend::Blends;
 use glam::{Affine3A, Vec2, Vec3A};
 use instance::Instances;
 pub use instance::NO_INSTANCE;
+pub use interpolate::sphere_uv;
 use mask::Masks;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;

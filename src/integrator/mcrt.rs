@@ -175,10 +175,9 @@ impl CameraEstimator for McRayTracer {
                 .map_or(Rgb::ZERO, |e| e.le(ray.direction));
             return seen_emission.unwrap_or(background);
         };
-        let material = &scene.materials[hit.material as usize];
         let emitted = match seen_emission {
             Some(emission) => emission,
-            None if hit.light != NO_LIGHT => material.emitted(hit.normal, -ray.direction),
+            None if hit.light != NO_LIGHT => scene.emitted(&hit, -ray.direction),
             None => Rgb::ZERO,
         };
         emitted + self.scattered(scene, &hit, -ray.direction, 0, sampler, counts)
@@ -270,9 +269,8 @@ impl McRayTracer {
                 continue;
             };
             let beta = sample.weight / n_bsdf as f32;
-            let material = &scene.materials[next.material as usize];
             if next.light != NO_LIGHT {
-                let emitted = material.emitted(next.normal, -wi_world);
+                let emitted = scene.emitted(&next, -wi_world);
                 if emitted.max_element() > 0.0 {
                     let weight = if sample.specular || n_light == 0 {
                         1.0

@@ -339,8 +339,7 @@ impl PathTracer {
             observer.vertex(bounces, &hit, beta);
             let wo_world = -ray.direction;
             if hit.light != NO_LIGHT && !(seen_known && bounces == 0) {
-                let material = &scene.materials[hit.material as usize];
-                let emitted = material.emitted(hit.normal, wo_world);
+                let emitted = scene.emitted(&hit, wo_world);
                 if emitted.max_element() > 0.0 {
                     let weight = self.found_light_weight(specular_bounce, prev_bsdf_pdf, || {
                         scene

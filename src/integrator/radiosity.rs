@@ -360,7 +360,6 @@ impl Radiosity {
             if depth > 0 {
                 counts.bounce += 1;
             }
-            let material = &scene.materials[hit.material as usize];
             let bsdf = scene.bsdf_at(&hit);
             match bsdf.diffuse_albedo() {
                 None => {
@@ -378,7 +377,7 @@ impl Radiosity {
                         facing_surface(scene, state, &hit, ray.direction)
                     else {
                         // Spheres are not patches: their own emission only.
-                        return weight * material.emitted(hit.normal, -ray.direction);
+                        return weight * scene.emitted(&hit, -ray.direction);
                     };
                     let e = &surface.element;
                     if self.wireframe {

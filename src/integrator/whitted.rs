@@ -160,9 +160,8 @@ impl WhittedTracer {
                 .map_or(Rgb::ZERO, |e| e.le(ray.direction));
         };
         let wo_world = -ray.direction;
-        let material = &scene.materials[hit.material as usize];
         let mut radiance = if hit.light != NO_LIGHT {
-            material.emitted(hit.normal, wo_world)
+            scene.emitted(&hit, wo_world)
         } else {
             Rgb::ZERO
         };

@@ -191,13 +191,13 @@ impl Hierarchy {
         let mut roots = Vec::with_capacity(geometry.triangles().len());
         let mut specular = 0;
         for (i, v) in geometry.triangles().iter().enumerate() {
-            let material = &scene.materials[geometry.triangle_material(i) as usize];
             let Some((reflectance, _)) = scene.diffuse_albedo(geometry.triangle_material(i)) else {
                 specular += 1;
                 roots.push(NONE);
                 continue;
             };
-            let element = Element::new(i as u32, *v, reflectance, material.emission);
+            let emission = scene.triangle_emission(i);
+            let element = Element::new(i as u32, *v, reflectance, emission);
             if !(element.area > 0.0) || hidden.get(i).copied().unwrap_or(false) {
                 roots.push(NONE);
                 continue;
@@ -208,7 +208,7 @@ impl Hierarchy {
                 depth: 0,
                 children: NONE,
                 gathered: Rgb::ZERO,
-                radiance: material.emission,
+                radiance: emission,
                 exposure: f32::NAN,
                 links: Vec::new(),
             });
@@ -286,9 +286,7 @@ impl Hierarchy {
                  patches, and camera rays are traced through them (caustics are missing)"
             ));
         }
-        if let Some(note) = super::mesh::unpatched_lights(scene) {
-            h.notes.push(note);
-        }
+        h.notes.extend(super::mesh::light_notes(scene));
         // One self-link of the whole scene, refined by the oracle.
         h.measure_exposure(geometry);
         // The clusters' radiance (the lights) for the oracle's first round.

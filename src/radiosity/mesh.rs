@@ -123,7 +123,6 @@ impl Mesh {
                 mesh.roots.push(NONE);
                 continue;
             };
-            let material = &scene.materials[geometry.triangle_material(i) as usize];
             let reflectance = scene
                 .diffuse_albedo(geometry.triangle_material(i))
                 .map_or(Rgb::ZERO, |(a, _)| a);
@@ -133,7 +132,7 @@ impl Mesh {
                 normal: Vec3A::ZERO,
                 area: 0.0,
                 reflectance,
-                emission: material.emission,
+                emission: scene.triangle_emission(i),
             };
             if hidden.get(i).copied().unwrap_or(false) {
                 mesh.roots.push(NONE);
@@ -171,9 +170,7 @@ impl Mesh {
                  patches, and camera rays are traced through them (caustics are missing)"
             ));
         }
-        if let Some(note) = unpatched_lights(scene) {
-            mesh.notes.push(note);
-        }
+        mesh.notes.extend(light_notes(scene));
         if !mesh.elements.iter().any(|e| e.emission.max_element() > 0.0) {
             return Err(
                 "radiosity needs an emissive diffuse surface: the scene has none \
@@ -436,16 +433,30 @@ pub fn child_at(b: &mut [f32; 3]) -> usize {
     child
 }
 
-/// A note naming the lights radiosity cannot see: only emissive patches
-/// emit in it.
-pub(crate) fn unpatched_lights(scene: &Scene) -> Option<String> {
-    let points = scene.features.point_lights;
-    let environment = scene.lights.environment().is_some();
-    (points || environment).then(|| {
-        "point, spot and directional lights and the environment are not patches: \
-         radiosity ignores them"
-            .to_string()
-    })
+/// Notes on the lights radiosity cannot see as they are (only emissive
+/// patches emit in it, each uniformly).
+pub(crate) fn light_notes(scene: &Scene) -> Vec<String> {
+    let mut notes = Vec::new();
+    if scene.features.point_lights || scene.lights.environment().is_some() {
+        notes.push(
+            "point, spot and directional lights and the environment are not patches: \
+             radiosity ignores them"
+                .to_string(),
+        );
+    }
+    let textured = (0..scene.geometry.triangle_count())
+        .filter(|&i| {
+            let m = &scene.materials[scene.geometry.triangle_material(i) as usize];
+            m.is_emissive() && m.emission_texture.is_some()
+        })
+        .count();
+    if textured > 0 {
+        notes.push(format!(
+            "{textured} triangles with textured emission emit their texture's mean over each \
+             triangle, uniformly"
+        ));
+    }
+    notes
 }
 
 #[cfg(test)]

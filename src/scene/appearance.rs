@@ -552,6 +552,7 @@ pub(super) fn build_material(
         bsdf,
         emission: colour("emission", d.emission, Rgb::ZERO, f32::MAX)?,
         two_sided_emission: d.two_sided.unwrap_or(false),
+        emission_texture: None,
         textures: Default::default(),
         opacity: Default::default(),
         normal_map: None,

@@ -335,6 +335,9 @@ pub struct MaterialDesc {
     pub bump_scale: Option<f32>,
     /// Emitted radiance (any type).
     pub emission: Option<[f32; 3]>,
+    /// A texture (a name in `[textures]`) that multiplies `emission`
+    /// (which is then 1 unless given).
+    pub emission_texture: Option<String>,
     /// Emit from both sides (any type).
     pub two_sided: Option<bool>,
 }

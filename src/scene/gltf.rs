@@ -539,12 +539,11 @@ impl Importer<'_> {
             self.warn(format!("{label}: transmission {transmission} read as 1"));
         }
         let strength = m.emissive_strength().unwrap_or(1.0);
-        let mut emission = Rgb::from(m.emissive_factor()) * strength;
-        if let Some(info) = m.emissive_texture() {
-            let id = self.texture(&info.texture(), info.tex_coord(), false, &label)?;
-            self.warn(format!("{label}: emissive texture: its mean is used"));
-            emission *= self.textures[id as usize].mean();
-        }
+        let emission = Rgb::from(m.emissive_factor()) * strength;
+        let emission_texture = match m.emissive_texture() {
+            Some(info) => Some(self.texture(&info.texture(), info.tex_coord(), false, &label)?),
+            None => None,
+        };
         let build = |metal: bool| {
             let (mut d, textures) = model(metal);
             if emission.max_element() > 0.0 {
@@ -552,6 +551,7 @@ impl Importer<'_> {
                 d.two_sided = Some(m.double_sided());
             }
             let mut material = build_material(&name, &d)?;
+            material.emission_texture = emission_texture;
             material.set_textures(textures);
             material.opacity = opacity;
             material.normal_map = normal_map;

@@ -2,9 +2,10 @@
 //! and the environment, for next-event estimation and for light paths.
 
 use super::environment::Environment;
-use super::light::{EmissionSample, Light, LightSample, LightSampling};
+use super::light::{EmissionSample, EmissionTexture, Light, LightSample, LightSampling};
 use crate::math::{OffsetMode, Rgb};
 use crate::sampling::AliasTable;
+use crate::texture::Texture;
 use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
 use std::sync::Arc;
@@ -25,6 +26,13 @@ pub struct Lights {
     aimed: bool,
     /// How shadow rays stop short of sampled light points.
     offset: OffsetMode,
+    /// Per light id, the texture that multiplies its radiance; empty
+    /// where no light is textured, so that other scenes pay one length
+    /// test per sample.
+    textured: Vec<Option<EmissionTexture>>,
+    /// The scene's textures, which `textured` indexes (their images are
+    /// shared, not copied).
+    textures: Vec<Texture>,
 }
 
 impl Lights {
@@ -50,7 +58,53 @@ impl Lights {
             direct,
             aimed: false,
             offset: OffsetMode::Robust,
+            textured: Vec::new(),
+            textures: Vec::new(),
         }
+    }
+
+    /// The same lights, those named in `textured` (by light id) with their
+    /// radiance multiplied by a texture of `textures`, and chosen by their
+    /// radiance averaged over the texture.
+    pub fn with_textured_emission(
+        self,
+        textured: Vec<Option<EmissionTexture>>,
+        textures: Vec<Texture>,
+    ) -> Lights {
+        if textured.iter().all(Option::is_none) {
+            return self;
+        }
+        let mut averaged = self.lights.clone();
+        for (light, t) in averaged.iter_mut().zip(&textured) {
+            let Some(t) = t else { continue };
+            let weight = t.choice_weight(&textures);
+            match light {
+                Light::Triangle(p) | Light::Parallelogram(p) => p.radiance *= weight,
+                Light::Sphere { radiance, .. } => *radiance *= weight,
+                Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => {}
+            }
+        }
+        let mut powers: Vec<f32> = averaged.iter().map(Light::power).collect();
+        if let Some(env) = &self.environment {
+            powers.push(env.power());
+        }
+        let selection = AliasTable::new(&powers);
+        Lights {
+            direct: selection.clone(),
+            selection,
+            aimed: false,
+            textured,
+            textures,
+            ..self
+        }
+    }
+
+    /// The texture factor of light `index`'s emission at `point`, if it
+    /// is textured.
+    #[inline(always)]
+    fn texture_at(&self, index: usize, point: Vec3A, normal: Vec3A) -> Option<Rgb> {
+        let t = self.textured.get(index)?.as_ref()?;
+        Some(t.at(&self.lights[index], point, normal, &self.textures))
     }
 
     /// True for the lights at infinity: the environment and directional
@@ -229,6 +283,8 @@ impl Lights {
             direct: self.direct.clone(),
             aimed: self.aimed,
             offset: self.offset,
+            textured: self.textured.clone(),
+            textures: self.textures.clone(),
         }
     }
 
@@ -291,6 +347,9 @@ impl Lights {
             Some(light) => light.sample(reference, u)?,
             None => self.environment.as_ref()?.sample_from(reference, u)?,
         };
+        if let Some(texture) = self.texture_at(index, s.point, s.normal) {
+            s.radiance *= texture;
+        }
         s.pdf *= pmf;
         s.light = index as u32;
         s.error = self.offset.spawn_error(s.error, s.normal);
@@ -333,6 +392,10 @@ impl Lights {
                 .as_ref()?
                 .emission(u_position, u_direction)?,
         };
+        if let Some(texture) = self.texture_at(index, s.point, s.normal) {
+            s.emitted *= texture;
+            s.throughput *= texture;
+        }
         s.throughput /= pmf;
         s.error = self.offset.spawn_error(s.error, s.normal);
         s.pdf_position *= pmf;

@@ -95,6 +95,17 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
             material_opacity(name, desc.get_ref(), &texture_ids).map_err(|m| at(desc.span(), m))?;
         m.normal_map =
             normal_map(name, desc.get_ref(), &texture_ids).map_err(|m| at(desc.span(), m))?;
+        if let Some(t) = &desc.get_ref().emission_texture {
+            m.emission_texture = Some(*texture_ids.get(t).ok_or_else(|| {
+                at(
+                    desc.span(),
+                    format!("material `{name}`: unknown texture `{t}` for `emission_texture`"),
+                )
+            })?);
+            if desc.get_ref().emission.is_none() {
+                m.emission = crate::math::Rgb::ONE;
+            }
+        }
         by_name.insert(name.clone(), materials.len() as u32);
         materials.push(m);
     }
@@ -550,6 +561,7 @@ pub(super) fn default_material() -> Material {
         },
         emission: Rgb::ZERO,
         two_sided_emission: false,
+        emission_texture: None,
         textures: Default::default(),
         opacity: Default::default(),
         normal_map: None,

@@ -17,6 +17,11 @@ pub struct Material {
     pub emission: Rgb,
     /// Emit on both sides; by default only along the geometric normal.
     pub two_sided_emission: bool,
+    /// A texture (index into the scene's) that multiplies `emission` at
+    /// each point (Mitsuba's textured `radiance`, glTF's
+    /// `emissiveTexture`); lights read it where they are sampled
+    /// ([`crate::scene::light::EmissionTexture`]).
+    pub emission_texture: Option<u32>,
     /// Parameters read from textures at each hit.
     pub textures: MaterialTextures,
     /// How much of the surface is there (Mitsuba's `mask`); queries pass
@@ -164,7 +169,17 @@ impl Material {
         self.emission.max_element() > 0.0
     }
 
-    /// Radiance emitted from a surface with geometric normal `n` towards `w`.
+    /// The emission averaged over the texture (where one multiplies it),
+    /// for what reads one value per surface: radiosity's elements.
+    pub fn mean_emission(&self, textures: &[Texture]) -> Rgb {
+        match self.emission_texture {
+            Some(t) => self.emission * textures[t as usize].mean(),
+            None => self.emission,
+        }
+    }
+
+    /// Radiance emitted from a surface with geometric normal `n` towards
+    /// `w`, before its texture ([`crate::scene::Scene::emitted`] reads it).
     #[inline]
     pub fn emitted(&self, n: Vec3A, w: Vec3A) -> Rgb {
         if self.two_sided_emission || n.dot(w) > 0.0 {

@@ -34,7 +34,7 @@ use crate::shortcuts::{NotApplied, PrimaryCandidates, Shortcuts, ShortcutsUsed};
 use crate::texture::Texture;
 use emitters::EmitterShape;
 use glam::Vec3A;
-use light::{Light, LightSampling, Lights, PlanarEmitter};
+use light::{EmissionTexture, Light, LightSampling, Lights, PlanarEmitter};
 use material::{BlendWeight, Material, Opacity};
 use rayon::prelude::*;
 use std::path::Path;
@@ -340,6 +340,7 @@ impl Scene {
         // when some material reads a texture.
         let textured = input.materials.iter().any(|m| {
             !m.textures.is_empty()
+                || m.emission_texture.is_some()
                 || matches!(m.opacity, Opacity::Texture(_))
                 || m.normal_map.is_some()
                 || m.blend
@@ -387,9 +388,20 @@ impl Scene {
             .into_par_iter()
             .filter(|&i| input.materials[geometry.triangle_material(i) as usize].is_emissive())
             .collect();
-        let shapes = emitters::group_emitters(geometry.triangles(), &emissive, |i| {
+        // Textured lights stay triangles: a parallelogram's point has no
+        // barycentrics in one triangle to read the texture by.
+        let textured_at = |i: usize| {
+            input.materials[geometry.triangle_material(i) as usize]
+                .emission_texture
+                .is_some()
+        };
+        let (textured, plain): (Vec<usize>, Vec<usize>) =
+            emissive.iter().partition(|&&i| textured_at(i));
+        let mut shapes = emitters::group_emitters(geometry.triangles(), &plain, |i| {
             geometry.triangle_material(i)
         });
+        shapes.extend(textured.into_iter().map(EmitterShape::Triangle));
+        let mut emission_textures = Vec::new();
         for shape in &shapes {
             // The triangles the light is made of, its corner and edges, and
             // its area as a fraction of |e1 x e2|.
@@ -424,6 +436,10 @@ impl Scene {
                 EmitterShape::Triangle(_) => Light::Triangle(emitter),
                 EmitterShape::Parallelogram { .. } => Light::Parallelogram(emitter),
             });
+            emission_textures.push(material.emission_texture.map(|texture| EmissionTexture {
+                texture,
+                corners: Some(geometry.triangle_uvs(members[0])),
+            }));
         }
         for i in 0..geometry.spheres().len() {
             let s = geometry.spheres()[i];
@@ -437,6 +453,12 @@ impl Scene {
                     two_sided: material.two_sided_emission,
                     sampling: input.sphere_sampling,
                 });
+                emission_textures.push(material.emission_texture.map(|texture| {
+                    EmissionTexture {
+                        texture,
+                        corners: None,
+                    }
+                }));
             }
         }
         let (center, radius) = bounding_sphere(&geometry);
@@ -455,7 +477,8 @@ impl Scene {
             env.bound(center, radius);
             env
         });
-        let lights = Lights::with_environment(lights, environment);
+        let lights = Lights::with_environment(lights, environment)
+            .with_textured_emission(emission_textures, input.textures.clone());
         if lights.is_empty() {
             warnings.push("the scene has no light source: the image will be black".into());
         }
@@ -555,6 +578,36 @@ impl Scene {
         self.textured_bsdf_at(material, hit)
     }
 
+    /// Radiance that the surface at `hit` emits towards `w`: its
+    /// material's emission, times its texture where it has one.
+    #[inline]
+    pub fn emitted(&self, hit: &SurfaceHit, w: Vec3A) -> crate::math::Rgb {
+        let material = &self.materials[hit.material as usize];
+        let emitted = material.emitted(hit.normal, w);
+        match material.emission_texture {
+            Some(t) if emitted.max_element() > 0.0 => {
+                emitted * self.textures[t as usize].eval(self.geometry.uv(hit))
+            }
+            _ => emitted,
+        }
+    }
+
+    /// What triangle `i` emits, averaged over it where its emission is
+    /// textured: for what reads one value per surface (radiosity).
+    pub fn triangle_emission(&self, i: usize) -> crate::math::Rgb {
+        let material = &self.materials[self.geometry.triangle_material(i) as usize];
+        match material.emission_texture {
+            Some(texture) => {
+                let t = EmissionTexture {
+                    texture,
+                    corners: Some(self.geometry.triangle_uvs(i)),
+                };
+                material.emission * t.mean(&self.textures)
+            }
+            None => material.emission,
+        }
+    }
+
     /// [`Scene::bsdf_at`] where a texture is read, out of line: with it
     /// inlined LLVM kept the whole lookup out of the integrators' loops,
     /// a call and a copy of the model at every hit of untextured scenes.
@@ -599,8 +652,14 @@ impl Scene {
     pub fn try_primary_candidates(&self) -> std::result::Result<&PrimaryCandidates, NotApplied> {
         let geometry = &self.geometry;
         let (materials, camera) = (&self.materials, &self.camera);
+        let textured_emission = materials
+            .iter()
+            .any(|m| m.is_emissive() && m.emission_texture.is_some());
         self.shortcuts.primary_candidates(geometry, camera, |i| {
-            if geometry.triangle_light(i) == NO_LIGHT {
+            // A textured light is not constant over its triangle, and a
+            // pixel counted as known skips every emitter it sees: with one,
+            // no pixel is known.
+            if textured_emission || geometry.triangle_light(i) == NO_LIGHT {
                 return None;
             }
             // One side of a flat emitter faces the eye everywhere on it.

@@ -511,6 +511,7 @@ fn convert_material(mtl_path: &Path, m: &tobj::Material) -> Result<Material> {
         bsdf,
         emission,
         two_sided_emission: false,
+        emission_texture: None,
         textures: Default::default(),
         opacity: Default::default(),
         normal_map: None,

@@ -131,7 +131,6 @@ impl Bdpt {
                 }
                 break;
             };
-            let material = &scene.materials[hit.material as usize];
             let wo_world = -ray.direction;
             let index = path.len();
             let previous = path.vertices[index - 1];
@@ -146,7 +145,7 @@ impl Bdpt {
             }
             if hit.light != NO_LIGHT {
                 vertex.light = hit.light;
-                vertex.emitted = material.emitted(hit.normal, wo_world);
+                vertex.emitted = scene.emitted(&hit, wo_world);
             }
             vertex.u_select = u_select;
             vertex.u_connect = u_connect;

@@ -299,10 +299,9 @@ pub fn camera_to_diffuse(
             }
             break;
         };
-        let material = &scene.materials[hit.material as usize];
         let wo_world = -ray.direction;
         if hit.light != NO_LIGHT {
-            emitted += beta * material.emitted(hit.normal, wo_world);
+            emitted += beta * scene.emitted(&hit, wo_world);
         }
         let bsdf = scene.bsdf_at(&hit);
         if bsdf.is_black() {

@@ -568,9 +568,8 @@ impl MultiPassEstimator for Vcm {
             // arrive while the light sample and the connections trace.
             iteration.map.prefetch_buckets(hit.point);
             let wo_world = -ray.direction;
-            let material = &scene.materials[hit.material as usize];
             if hit.light != NO_LIGHT {
-                let emitted = material.emitted(hit.normal, wo_world);
+                let emitted = scene.emitted(&hit, wo_world);
                 if emitted.max_element() > 0.0 {
                     // Against light sampling and every longer light subpath;
                     // seen directly, against the light point's splat.

@@ -18,7 +18,9 @@ use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
 
 mod emission;
+mod textured;
 pub use emission::EmissionSample;
+pub use textured::EmissionTexture;
 
 /// How points on area lights are chosen for next-event estimation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]

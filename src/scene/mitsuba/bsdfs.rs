@@ -2,7 +2,7 @@
 //! of [`crate::bsdf`] take Mitsuba's parameter names, so a plugin becomes a
 //! [`MaterialDesc`] and goes through the same checks as a TOML material.
 
-use super::Importer;
+use super::{Emission, Importer};
 use super::props::{Colour, Props};
 use super::xml::Element;
 use crate::bsdf::Distribution;
@@ -21,7 +21,7 @@ impl<'a> Importer<'a> {
     pub(super) fn material(
         &mut self,
         bsdf: Option<&'a Element>,
-        emission: Option<Rgb>,
+        emission: Option<Emission>,
     ) -> Result<u32> {
         let key = bsdf.map_or(std::ptr::null(), |b| b as *const Element);
         if emission.is_none()
@@ -52,12 +52,12 @@ impl<'a> Importer<'a> {
             )?,
         };
         if let Some(e) = emission {
-            material.emission = e;
+            (material.emission, material.emission_texture) = (e.radiance, e.texture);
             material.name = format!("{} (emitter)", material.name);
             // A blend's second material emits too, from a copy of its own.
             if let Some(blend) = material.blend.as_mut() {
                 let mut second = self.materials[blend.second as usize].clone();
-                second.emission = e;
+                (second.emission, second.emission_texture) = (e.radiance, e.texture);
                 second.name = format!("{} (emitter)", second.name);
                 blend.second = self.materials.len() as u32;
                 self.materials.push(second);

@@ -115,6 +115,14 @@ fn collect_ids<'a>(e: &'a Element, ids: &mut HashMap<String, &'a Element>) -> Re
     Ok(())
 }
 
+/// What a shape's `area` emitter emits: a radiance, times a texture
+/// (an index into the importer's) where it is textured.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Emission {
+    radiance: crate::math::Rgb,
+    texture: Option<u32>,
+}
+
 pub(super) struct Importer<'a> {
     doc: &'a Document,
     ids: &'a HashMap<String, &'a Element>,

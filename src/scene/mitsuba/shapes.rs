@@ -2,7 +2,7 @@
 //! shapes (rectangle, cube, sphere, disk, cylinder) and instances of shape
 //! groups, with their BSDFs and area emitters.
 
-use super::Importer;
+use super::{Emission, Importer};
 use super::meshes::MeshFile;
 use super::props::{Colour, Props};
 use super::xml::Element;
@@ -294,8 +294,9 @@ impl<'a> Importer<'a> {
         Ok(())
     }
 
-    /// The radiance of a shape's `area` emitter, if it has one.
-    fn area_emitter(&mut self, p: &Props<'a>) -> Result<Option<crate::math::Rgb>> {
+    /// The radiance of a shape's `area` emitter, if it has one, and the
+    /// texture that multiplies it where it is textured.
+    fn area_emitter(&mut self, p: &Props<'a>) -> Result<Option<Emission>> {
         let emitters = p.objects("emitter")?;
         let Some(&e) = emitters.first() else {
             return Ok(None);
@@ -307,22 +308,15 @@ impl<'a> Importer<'a> {
             )));
         }
         let ep = Props::new(e, self.ids);
-        let radiance = match ep.colour("radiance", true)? {
-            None => crate::math::Rgb::ONE,
-            Some(Colour::Value(c)) => c,
-            Some(Colour::Texture(t)) => {
-                let id = self.texture(t)?;
-                self.warn(
-                    &t.loc,
-                    "textured emission: the texture's mean radiance is used",
-                );
-                self.textures[id as usize].mean()
-            }
+        let (radiance, texture) = match ep.colour("radiance", true)? {
+            None => (crate::math::Rgb::ONE, None),
+            Some(Colour::Value(c)) => (c, None),
+            Some(Colour::Texture(t)) => (crate::math::Rgb::ONE, Some(self.texture(t)?)),
         };
         ep.unused(&mut self.warnings);
         if !(radiance.min_element() >= 0.0) {
             return Err(e.loc.error("radiance must be >= 0"));
         }
-        Ok(Some(radiance))
+        Ok(Some(Emission { radiance, texture }))
     }
 }
