@@ -210,8 +210,10 @@ impl WhittedTracer {
         counts: &mut RayCounts,
     ) -> Rgb {
         let mut sum = Rgb::ZERO;
-        for light in scene.lights.as_slice() {
+        for (i, light) in scene.lights.as_slice().iter().enumerate() {
             let (position, shadow_target, intensity) = point_equivalent(light, hit.point);
+            // A textured light shines with its texture's mean.
+            let intensity = intensity * scene.lights.texture_mean(i);
             let to_light = position - hit.point;
             let dist2 = to_light.length_squared();
             if intensity.max_element() <= 0.0 || dist2 <= 0.0 {

@@ -33,6 +33,9 @@ pub struct Lights {
     /// The scene's textures, which `textured` indexes (their images are
     /// shared, not copied).
     textures: Vec<Texture>,
+    /// Per textured light, its texture averaged over it (for what treats
+    /// a light as one value: Whitted's point lights).
+    texture_means: Vec<Rgb>,
 }
 
 impl Lights {
@@ -60,6 +63,7 @@ impl Lights {
             offset: OffsetMode::Robust,
             textured: Vec::new(),
             textures: Vec::new(),
+            texture_means: Vec::new(),
         }
     }
 
@@ -74,6 +78,10 @@ impl Lights {
         if textured.iter().all(Option::is_none) {
             return self;
         }
+        let texture_means: Vec<Rgb> = textured
+            .iter()
+            .map(|t| t.map_or(Rgb::ONE, |t| t.mean(&textures)))
+            .collect();
         let mut averaged = self.lights.clone();
         for (light, t) in averaged.iter_mut().zip(&textured) {
             let Some(t) = t else { continue };
@@ -95,14 +103,20 @@ impl Lights {
             aimed: false,
             textured,
             textures,
+            texture_means,
             ..self
         }
     }
 
-    /// The texture factor of light `index`'s emission at `point`, if it
-    /// is textured.
+    /// Light `light`'s texture averaged over it; 1 where it has none.
+    pub fn texture_mean(&self, light: usize) -> Rgb {
+        self.texture_means.get(light).copied().unwrap_or(Rgb::ONE)
+    }
+
+    /// The factor by which light `index`'s texture multiplies its
+    /// radiance at `point` (normal `normal`) on it, if it is textured.
     #[inline(always)]
-    fn texture_at(&self, index: usize, point: Vec3A, normal: Vec3A) -> Option<Rgb> {
+    pub fn texture_at(&self, index: usize, point: Vec3A, normal: Vec3A) -> Option<Rgb> {
         let t = self.textured.get(index)?.as_ref()?;
         Some(t.at(&self.lights[index], point, normal, &self.textures))
     }
@@ -285,6 +299,7 @@ impl Lights {
             offset: self.offset,
             textured: self.textured.clone(),
             textures: self.textures.clone(),
+            texture_means: self.texture_means.clone(),
         }
     }
 

@@ -493,7 +493,7 @@ impl Bdpt {
             }
             let (pdf_position, pdf_emission) =
                 scene.lights.emission_pdf(ls.light, ls.normal, -ls.wi);
-            let (emitted, two_sided) = emission_of(scene, ls.light);
+            let (emitted, two_sided) = emission_of(scene, ls.light, ls.point, ls.normal);
             let infinite = scene.lights.is_infinite(ls.light);
             let sampled = Vertex {
                 kind: Kind::Light,

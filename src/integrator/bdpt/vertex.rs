@@ -264,18 +264,25 @@ impl Subpath {
     }
 }
 
-/// A light's emitted radiance (or intensity) and sidedness.
-pub(super) fn emission_of(scene: &Scene, light: u32) -> (Rgb, bool) {
+/// A light's emitted radiance (or intensity) at `point` (normal `normal`)
+/// on it, and its sidedness.
+pub(super) fn emission_of(scene: &Scene, light: u32, point: Vec3A, normal: Vec3A) -> (Rgb, bool) {
     let Some(&emitter) = scene.lights.as_slice().get(light as usize) else {
         return (Rgb::ZERO, false); // the environment, whose radiance is per direction
     };
+    let texture = || {
+        scene
+            .lights
+            .texture_at(light as usize, point, normal)
+            .unwrap_or(Rgb::ONE)
+    };
     match emitter {
-        Light::Triangle(p) | Light::Parallelogram(p) => (p.radiance, p.two_sided),
+        Light::Triangle(p) | Light::Parallelogram(p) => (p.radiance * texture(), p.two_sided),
         Light::Sphere {
             radiance,
             two_sided,
             ..
-        } => (radiance, two_sided),
+        } => (radiance * texture(), two_sided),
         Light::Point { intensity, .. } | Light::Spot { intensity, .. } => (intensity, true),
         Light::Directional { .. } => (Rgb::ZERO, false),
     }
