@@ -72,13 +72,26 @@ fn assert_regions_agree(got: &[(f64, f64)], want: &[(f64, f64)], what: &str) {
 
 /// The regions' means of `scene` rendered by `kind` under direct light
 /// (one bounce), 64 spp.
-fn direct_regions(scene: Scene, kind: IntegratorKind, columns: usize, rows: usize) -> Vec<(f64, f64)> {
+fn direct_regions(
+    scene: Scene,
+    kind: IntegratorKind,
+    columns: usize,
+    rows: usize,
+) -> Vec<(f64, f64)> {
     let mut options = IntegratorOptions::of(kind);
     if let Some(depth) = options.max_depth_mut() {
         *depth = 1;
     }
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
-    let (snapshot, stats) = render_with(scene, options.build(), SamplerKind::Independent, 64, 1, 0, 8);
+    let (snapshot, stats) = render_with(
+        scene,
+        options.build(),
+        SamplerKind::Independent,
+        64,
+        1,
+        0,
+        8,
+    );
     assert_eq!(stats.non_finite, 0);
     region_means(&snapshot, columns, rows)
 }
@@ -111,7 +124,12 @@ fn a_half_black_light_lights_the_room_as_a_light_of_half_its_size_in_every_techn
     let halves = |name: &str, light: &str, kind| {
         let file = dir.join(format!("{name}.xml"));
         std::fs::write(&file, room(light)).unwrap();
-        direct_regions(Scene::load(&file).unwrap_or_else(|e| panic!("{e}")), kind, 2, 1)
+        direct_regions(
+            Scene::load(&file).unwrap_or_else(|e| panic!("{e}")),
+            kind,
+            2,
+            1,
+        )
     };
     for kind in [
         IntegratorKind::Path,
@@ -120,7 +138,10 @@ fn a_half_black_light_lights_the_room_as_a_light_of_half_its_size_in_every_techn
         IntegratorKind::Vcm,
         IntegratorKind::Mcrt,
     ] {
-        let (got, want) = (halves("textured", &textured, kind), halves("half", &half, kind));
+        let (got, want) = (
+            halves("textured", &textured, kind),
+            halves("half", &half, kind),
+        );
         assert!(
             want[1].0 > 2.0 * want[0].0,
             "{kind:?}: the lit half should stand out: {want:?}"
@@ -178,7 +199,10 @@ material = "lamp"
     // A name that no texture has is an error naming it.
     let file = temp_dir("sphere-lamp-typo").join("scene.toml");
     std::fs::write(&file, text.replace("= \"quadrant\"", "= \"quadrnat\"")).unwrap();
-    let error = Scene::load(&file).err().expect("an unknown texture").to_string();
+    let error = Scene::load(&file)
+        .err()
+        .expect("an unknown texture")
+        .to_string();
     assert!(
         error.contains("unknown texture `quadrnat` for `emission_texture`"),
         "{error}"
@@ -208,7 +232,10 @@ fn gltf_emissive_textures_are_read_where_the_light_is_hit_or_sampled() {
             r#""buffers":"#,
             r#""images": [{"uri": "half.png"}], "textures": [{"source": 0}], "buffers":"#,
         );
-    assert!(json.contains("emissiveTexture") && json.contains(r#""TEXCOORD_0": 2}, "indices": 3, "material": 1"#));
+    assert!(
+        json.contains("emissiveTexture")
+            && json.contains(r#""TEXCOORD_0": 2}, "indices": 3, "material": 1"#)
+    );
     let file = dir.join("lamp.gltf");
     std::fs::write(&file, json).unwrap();
     let scene = Scene::load(&file).unwrap_or_else(|e| panic!("{e}"));

@@ -26,7 +26,7 @@ mod uri;
 
 use crate::accel::blend::Blends;
 use crate::accel::mask::Masks;
-use crate::accel::{AccelChoice, Geometry, NO_LIGHT, Sphere, SurfaceHit, TriangleInput};
+use crate::accel::{AccelChoice, Geometry, NO_LIGHT, Sphere, TriangleInput};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::math::OffsetMode;
@@ -453,11 +453,9 @@ impl Scene {
                     two_sided: material.two_sided_emission,
                     sampling: input.sphere_sampling,
                 });
-                emission_textures.push(material.emission_texture.map(|texture| {
-                    EmissionTexture {
-                        texture,
-                        corners: None,
-                    }
+                emission_textures.push(material.emission_texture.map(|texture| EmissionTexture {
+                    texture,
+                    corners: None,
                 }));
             }
         }
@@ -566,54 +564,6 @@ impl Scene {
             Some(t) => Some((self.textures[t as usize].mean(), true)),
             None => Some((albedo, approximated)),
         }
-    }
-
-    /// The BSDF at `hit`, its textures read.
-    #[inline(always)]
-    pub fn bsdf_at(&self, hit: &SurfaceHit) -> crate::bsdf::Bsdf {
-        let material = &self.materials[hit.material as usize];
-        if material.textures.is_empty() {
-            return material.bsdf;
-        }
-        self.textured_bsdf_at(material, hit)
-    }
-
-    /// Radiance that the surface at `hit` emits towards `w`: its
-    /// material's emission, times its texture where it has one.
-    #[inline]
-    pub fn emitted(&self, hit: &SurfaceHit, w: Vec3A) -> crate::math::Rgb {
-        let material = &self.materials[hit.material as usize];
-        let emitted = material.emitted(hit.normal, w);
-        match material.emission_texture {
-            Some(t) if emitted.max_element() > 0.0 => {
-                emitted * self.textures[t as usize].eval(self.geometry.uv(hit))
-            }
-            _ => emitted,
-        }
-    }
-
-    /// What triangle `i` emits, averaged over it where its emission is
-    /// textured: for what reads one value per surface (radiosity).
-    pub fn triangle_emission(&self, i: usize) -> crate::math::Rgb {
-        let material = &self.materials[self.geometry.triangle_material(i) as usize];
-        match material.emission_texture {
-            Some(texture) => {
-                let t = EmissionTexture {
-                    texture,
-                    corners: Some(self.geometry.triangle_uvs(i)),
-                };
-                material.emission * t.mean(&self.textures)
-            }
-            None => material.emission,
-        }
-    }
-
-    /// [`Scene::bsdf_at`] where a texture is read, out of line: with it
-    /// inlined LLVM kept the whole lookup out of the integrators' loops,
-    /// a call and a copy of the model at every hit of untextured scenes.
-    #[inline(never)]
-    fn textured_bsdf_at(&self, material: &Material, hit: &SurfaceHit) -> crate::bsdf::Bsdf {
-        material.bsdf_at(&self.textures, self.geometry.uv(hit))
     }
 
     /// Samples every area light by `mode` (the CLI's `--light-sampling`).

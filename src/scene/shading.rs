@@ -1,13 +1,63 @@
-//! The shading normal of a hit: interpolated vertex normals, tilted by a
-//! material's normal or bump map. Every technique asks here.
+//! What a surface is at a hit: its BSDF with its textures read, what it
+//! emits, and its shading normal (interpolated vertex normals, tilted by
+//! a material's normal or bump map). Every technique asks here.
 
 use super::Scene;
-use super::material::NormalMap;
+use super::light::EmissionTexture;
+use super::material::{Material, NormalMap};
 use crate::accel::SurfaceHit;
 use crate::math::Frame;
 use glam::Vec3A;
 
 impl Scene {
+    /// The BSDF at `hit`, its textures read.
+    #[inline(always)]
+    pub fn bsdf_at(&self, hit: &SurfaceHit) -> crate::bsdf::Bsdf {
+        let material = &self.materials[hit.material as usize];
+        if material.textures.is_empty() {
+            return material.bsdf;
+        }
+        self.textured_bsdf_at(material, hit)
+    }
+
+    /// Radiance that the surface at `hit` emits towards `w`: its
+    /// material's emission, times its texture where it has one.
+    #[inline]
+    pub fn emitted(&self, hit: &SurfaceHit, w: Vec3A) -> crate::math::Rgb {
+        let material = &self.materials[hit.material as usize];
+        let emitted = material.emitted(hit.normal, w);
+        match material.emission_texture {
+            Some(t) if emitted.max_element() > 0.0 => {
+                emitted * self.textures[t as usize].eval(self.geometry.uv(hit))
+            }
+            _ => emitted,
+        }
+    }
+
+    /// What triangle `i` emits, averaged over it where its emission is
+    /// textured: for what reads one value per surface (radiosity).
+    pub fn triangle_emission(&self, i: usize) -> crate::math::Rgb {
+        let material = &self.materials[self.geometry.triangle_material(i) as usize];
+        match material.emission_texture {
+            Some(texture) => {
+                let t = EmissionTexture {
+                    texture,
+                    corners: Some(self.geometry.triangle_uvs(i)),
+                };
+                material.emission * t.mean(&self.textures)
+            }
+            None => material.emission,
+        }
+    }
+
+    /// [`Scene::bsdf_at`] where a texture is read, out of line: with it
+    /// inlined LLVM kept the whole lookup out of the integrators' loops,
+    /// a call and a copy of the model at every hit of untextured scenes.
+    #[inline(never)]
+    fn textured_bsdf_at(&self, material: &Material, hit: &SurfaceHit) -> crate::bsdf::Bsdf {
+        material.bsdf_at(&self.textures, self.geometry.uv(hit))
+    }
+
     /// The shading normal at `hit`: the interpolated vertex normal (the
     /// geometric one without), tilted by the material's normal map. BSDFs
     /// act in its frame; offsets, emission and densities keep the geometric

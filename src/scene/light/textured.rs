@@ -75,7 +75,10 @@ impl EmissionTexture {
     /// light whose grid points all fall on black texels can still be
     /// chosen, so that choosing lights by it stays unbiased.
     pub fn choice_weight(&self, textures: &[Texture]) -> Rgb {
-        let (mean, floor) = (self.mean(textures), 0.01 * textures[self.texture as usize].mean());
+        let (mean, floor) = (
+            self.mean(textures),
+            0.01 * textures[self.texture as usize].mean(),
+        );
         if luminance(mean) < luminance(floor) {
             floor
         } else {

@@ -2,9 +2,9 @@
 //! of [`crate::bsdf`] take Mitsuba's parameter names, so a plugin becomes a
 //! [`MaterialDesc`] and goes through the same checks as a TOML material.
 
-use super::{Emission, Importer};
 use super::props::{Colour, Props};
 use super::xml::Element;
+use super::{Emission, Importer};
 use crate::bsdf::Distribution;
 use crate::error::Result;
 use crate::math::Rgb;

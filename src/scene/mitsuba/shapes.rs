@@ -2,10 +2,10 @@
 //! shapes (rectangle, cube, sphere, disk, cylinder) and instances of shape
 //! groups, with their BSDFs and area emitters.
 
-use super::{Emission, Importer};
 use super::meshes::MeshFile;
 use super::props::{Colour, Props};
 use super::xml::Element;
+use super::{Emission, Importer};
 use crate::accel::{NO_LIGHT, Sphere};
 use crate::error::Result;
 use crate::scene::mesh::{MeshData, Orientation, Placement};
