@@ -33,8 +33,9 @@ pub struct Lights {
     /// The scene's textures, which `textured` indexes (their images are
     /// shared, not copied).
     textures: Vec<Texture>,
-    /// Per textured light, its texture averaged over it (for what treats
-    /// a light as one value: Whitted's point lights).
+    /// Per light id (where any is textured), its texture averaged over
+    /// it, 1 for an untextured light: for what treats a light as one
+    /// value (Whitted's point lights).
     texture_means: Vec<Rgb>,
 }
 
