@@ -22,7 +22,7 @@ use tracelab::scene::material::{Bsdf, fresnel_dielectric};
 
 /// Number of `assert_fits` calls here and in `chi2_rough.rs` (the
 /// significance is split over them).
-const TESTS_IN_FILE: f64 = 65.0;
+const TESTS_IN_FILE: f64 = 70.0;
 pub(crate) const SAMPLES: u64 = 500_000;
 
 /// Uniform numbers for test `seed`, sample `i`.

@@ -5,8 +5,8 @@
 use crate::chi2::{SAMPLES, assert_fits, check_bsdf_events, check_directions, uniform};
 use glam::{Vec2, Vec3A};
 use tracelab::bsdf::{
-    Distribution, Microfacet, Plastic, RoughConductor, RoughDielectric, RoughDiffuse, RoughPlastic,
-    ThinDielectric,
+    Distribution, Microfacet, Plastic, Principled, RoughConductor, RoughDielectric, RoughDiffuse,
+    RoughPlastic, ThinDielectric,
 };
 use tracelab::lab::stats::ChiSquare;
 use tracelab::lab::warps::Histogram;
@@ -132,6 +132,20 @@ fn rough_bsdfs() -> Vec<(&'static str, Bsdf)> {
             },
         ),
         (
+            "principled, every reflecting lobe, anisotropic",
+            Bsdf::Principled {
+                lobe: principled(0.35, 0.6, 0.0),
+                two_sided: false,
+            },
+        ),
+        (
+            "principled, transmitting",
+            Bsdf::Principled {
+                lobe: principled(0.3, 0.0, 0.7),
+                two_sided: false,
+            },
+        ),
+        (
             "plastic (diffuse events)",
             Bsdf::Plastic {
                 lobe: Plastic::new(1.5, Rgb::splat(0.5), Rgb::ONE, false),
@@ -139,6 +153,26 @@ fn rough_bsdfs() -> Vec<(&'static str, Bsdf)> {
             },
         ),
     ]
+}
+
+/// A `principled` with every lobe: sheen, clearcoat and fake subsurface
+/// on, metal and transmission as given.
+fn principled(roughness: f32, anisotropic: f32, spec_trans: f32) -> Principled {
+    Principled {
+        base_color: Rgb::new(0.8, 0.4, 0.2),
+        microfacet: Principled::microfacet_of(roughness, anisotropic),
+        roughness,
+        anisotropic,
+        metallic: 0.3,
+        spec_trans,
+        eta: 1.45,
+        spec_tint: 0.4,
+        sheen: 0.6,
+        sheen_tint: 0.5,
+        flatness: 0.3,
+        clearcoat: 0.8,
+        clearcoat_alpha: 0.05,
+    }
 }
 
 /// Every rough model's sampling (reflection and transmission together for

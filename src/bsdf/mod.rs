@@ -22,6 +22,7 @@ pub mod mirror;
 pub mod phong;
 pub mod plastic;
 pub mod presets;
+pub mod principled;
 pub mod rough_conductor;
 pub mod rough_dielectric;
 pub mod rough_diffuse;
@@ -33,6 +34,7 @@ pub use fresnel::{Fresnel, fresnel_conductor, fresnel_dielectric};
 pub use microfacet::{Distribution, Microfacet};
 pub use phong::Phong;
 pub use plastic::Plastic;
+pub use principled::Principled;
 pub use rough_conductor::RoughConductor;
 pub use rough_dielectric::RoughDielectric;
 pub use rough_diffuse::RoughDiffuse;
@@ -77,6 +79,9 @@ pub enum Bsdf {
     ThinDielectric(ThinDielectric),
     /// Microfacet dielectric boundary.
     RoughDielectric(RoughDielectric),
+    /// Mitsuba 3's `principled` (Burley's BSDF). With transmission it is
+    /// a boundary, both sides scattering, and `two_sided` is not read.
+    Principled { lobe: Principled, two_sided: bool },
 }
 
 /// A sampled direction with its Monte Carlo weight.
@@ -151,7 +156,7 @@ impl Bsdf {
         matches!(
             self,
             Bsdf::Dielectric { .. } | Bsdf::ThinDielectric(_) | Bsdf::RoughDielectric(_)
-        )
+        ) || matches!(self, Bsdf::Principled { lobe, .. } if lobe.transmits())
     }
 
     /// True when the surface scatters nothing (paths end here).
@@ -159,6 +164,7 @@ impl Bsdf {
     pub fn is_black(&self) -> bool {
         match *self {
             Bsdf::Dielectric { .. } | Bsdf::RoughDielectric(_) => false,
+            Bsdf::Principled { lobe, .. } if lobe.transmits() => false,
             _ => self.max_reflectance() <= 0.0,
         }
     }
@@ -189,6 +195,10 @@ impl Bsdf {
                 orient(two_sided, wo, wi).map_or(Rgb::ZERO, |(wo, wi)| lobe.eval(wo, wi))
             }
             Bsdf::RoughDielectric(lobe) => lobe.eval(wo, wi),
+            Bsdf::Principled { lobe, two_sided } => match lobe.transmits() {
+                true => lobe.eval(wo, wi),
+                false => orient(two_sided, wo, wi).map_or(Rgb::ZERO, |(wo, wi)| lobe.eval(wo, wi)),
+            },
         }
     }
 
@@ -244,6 +254,10 @@ impl Bsdf {
                 orient(two_sided, wo, wi).map_or(0.0, |(wo, wi)| lobe.pdf(wo, wi))
             }
             Bsdf::RoughDielectric(lobe) => lobe.pdf(wo, wi),
+            Bsdf::Principled { lobe, two_sided } => match lobe.transmits() {
+                true => lobe.pdf(wo, wi),
+                false => orient(two_sided, wo, wi).map_or(0.0, |(wo, wi)| lobe.pdf(wo, wi)),
+            },
         }
     }
 
@@ -276,6 +290,10 @@ impl Bsdf {
             }
             Bsdf::ThinDielectric(lobe) => lobe.sample(wo, u_lobe),
             Bsdf::RoughDielectric(lobe) => lobe.sample(wo, u_lobe, u),
+            Bsdf::Principled { lobe, two_sided } => match lobe.transmits() {
+                true => lobe.sample(wo, u_lobe, u),
+                false => sample_oriented(two_sided, wo, |wo| lobe.sample(wo, u_lobe, u)),
+            },
         }
     }
 
@@ -290,6 +308,7 @@ impl Bsdf {
         match *self {
             Bsdf::Dielectric { eta, .. } => dielectric::refraction_scale(eta, wo, wi),
             Bsdf::RoughDielectric(lobe) => lobe.refraction_scale(wo, wi),
+            Bsdf::Principled { lobe, .. } if lobe.transmits() => lobe.refraction_scale(wo, wi),
             _ => 1.0,
         }
     }
@@ -310,6 +329,7 @@ impl Bsdf {
             Bsdf::RoughPlastic { lobe, .. } => lobe.albedo_hint(),
             Bsdf::ThinDielectric(lobe) => lobe.albedo_hint(),
             Bsdf::RoughDielectric(lobe) => lobe.albedo_hint(),
+            Bsdf::Principled { lobe, .. } => lobe.albedo_hint(),
         }
     }
 
@@ -324,6 +344,7 @@ impl Bsdf {
             Bsdf::RoughDiffuse { lobe, .. } => Some((lobe.albedo, true)),
             Bsdf::Plastic { lobe, .. } => Some((lobe.diffuse, true)),
             Bsdf::RoughPlastic { lobe, .. } => Some((lobe.diffuse, true)),
+            Bsdf::Principled { lobe, .. } => Some((lobe.diffuse_colour(), true)),
             _ => None,
         }
     }
@@ -379,6 +400,16 @@ impl Bsdf {
             }
             Bsdf::Plastic { lobe, two_sided } => coating(lobe.eta, lobe.specular, two_sided),
             Bsdf::RoughPlastic { lobe, two_sided } => coating(lobe.eta, lobe.specular, two_sided),
+            Bsdf::Principled { lobe, two_sided } => {
+                if lobe.transmits() {
+                    let [(r, _), t] = refract(lobe.eta, lobe.transmission_tint());
+                    [(r, lobe.ideal_reflectance(wo.z)), t]
+                } else if wo.z > 0.0 || two_sided {
+                    [(mirror, lobe.ideal_reflectance(wo.z.abs())), none]
+                } else {
+                    [none, none]
+                }
+            }
             Bsdf::Diffuse { .. } | Bsdf::Glossy { .. } | Bsdf::RoughDiffuse { .. } => [none, none],
         }
     }
@@ -387,7 +418,10 @@ impl Bsdf {
     pub fn is_rough(&self) -> bool {
         matches!(
             self,
-            Bsdf::RoughConductor { .. } | Bsdf::RoughPlastic { .. } | Bsdf::RoughDielectric(_)
+            Bsdf::RoughConductor { .. }
+                | Bsdf::RoughPlastic { .. }
+                | Bsdf::RoughDielectric(_)
+                | Bsdf::Principled { .. }
         )
     }
 
@@ -428,6 +462,7 @@ impl Bsdf {
             Bsdf::RoughPlastic { .. } => "roughplastic",
             Bsdf::ThinDielectric(_) => "thindielectric",
             Bsdf::RoughDielectric(_) => "roughdielectric",
+            Bsdf::Principled { .. } => "principled",
         }
     }
 }

@@ -220,6 +220,7 @@ pub(super) fn material_textures(
         specular,
         alpha,
         alpha_v: alpha,
+        metallic: None,
         coating: None,
     })
 }

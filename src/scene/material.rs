@@ -65,6 +65,9 @@ pub struct MaterialTextures {
     /// `alpha_v`: the roughness along v. An isotropic textured roughness
     /// names the same texture in both.
     pub alpha_v: Option<u32>,
+    /// `metallic` of a `principled` (its roughness takes `alpha`, its
+    /// base colour `diffuse`).
+    pub metallic: Option<u32>,
     /// A rough plastic's coating tables by roughness, where `alpha` is
     /// textured (glTF's roughness maps).
     pub coating: Option<&'static crate::bsdf::rough_plastic::CoatingLevels>,
@@ -78,6 +81,7 @@ impl MaterialTextures {
             && self.specular.is_none()
             && self.alpha.is_none()
             && self.alpha_v.is_none()
+            && self.metallic.is_none()
     }
 }
 
@@ -148,6 +152,15 @@ impl Material {
                 rough(&mut lobe.microfacet);
             }
             Bsdf::ThinDielectric(lobe) => lobe.reflectance = specular.unwrap_or(lobe.reflectance),
+            Bsdf::Principled { lobe, .. } => {
+                lobe.base_color = diffuse.unwrap_or(lobe.base_color);
+                if let Some(r) = alpha_u {
+                    lobe.set_roughness(r.clamp(0.0, 1.0));
+                }
+                if let Some(m) = read_1(t.metallic) {
+                    lobe.metallic = m.clamp(0.0, 1.0);
+                }
+            }
             Bsdf::Glossy { .. } | Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } => {}
         }
         bsdf
@@ -159,6 +172,7 @@ impl Material {
         let microfacet = match &self.bsdf {
             Bsdf::RoughConductor { lobe, .. } => lobe.microfacet,
             Bsdf::RoughDielectric(lobe) => lobe.microfacet,
+            Bsdf::Principled { lobe, .. } => lobe.microfacet,
             _ => return false,
         };
         microfacet.alpha_u != microfacet.alpha_v || self.textures.alpha != self.textures.alpha_v

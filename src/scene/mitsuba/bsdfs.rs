@@ -71,7 +71,7 @@ impl<'a> Importer<'a> {
         Ok(id)
     }
 
-    fn built(
+    pub(super) fn built(
         &mut self,
         name: &str,
         desc: MaterialDesc,
@@ -162,6 +162,9 @@ impl<'a> Importer<'a> {
         }
         if kind == "blendbsdf" {
             return self.blend(e, &p, two_sided);
+        }
+        if kind == "principled" {
+            return self.principled(e, &p, &name, two_sided);
         }
         let mut d = MaterialDesc {
             twosided: Some(two_sided),

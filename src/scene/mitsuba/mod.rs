@@ -8,6 +8,7 @@ mod bsdfs;
 mod cie;
 mod meshes;
 mod prefetch;
+mod principled;
 mod props;
 mod shapes;
 mod spectrum;
