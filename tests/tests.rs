@@ -15,6 +15,8 @@ mod filtered_film;
 mod import;
 // Blends of two BSDFs against the weighted sum of their parts.
 mod import_blends;
+// Mitsuba 3's principled BSDF against its own eval.
+mod principled;
 // Textured lights: sampled and hit where their texture says, in every technique.
 mod emission_textures;
 // Mitsuba sensors: the clips the importer does not apply are warnings.

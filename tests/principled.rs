@@ -1,0 +1,64 @@
+//! Mitsuba 3's `principled` as the XML importer reads it, against Mitsuba
+//! 3's own `eval` at fixed direction pairs, front and back
+//! (`tests/data/principled_mitsuba.txt`, made by
+//! `bench/peer/principled_eval.py` with Mitsuba 3.9 `scalar_rgb`). Both
+//! evaluate the same closed form in f32, so they must agree to rounding.
+
+use crate::import::load;
+use glam::Vec3A;
+use tracelab::bsdf::Bsdf;
+
+/// The parameter sets of `principled_eval.py`, as XML properties.
+const SETS: [&str; 4] = [
+    "",
+    r#"<rgb name="base_color" value="0.8, 0.3, 0.2"/> <float name="roughness" value="0.3"/>
+       <float name="metallic" value="0.6"/> <float name="spec_tint" value="0.5"/>
+       <float name="sheen" value="0.7"/> <float name="sheen_tint" value="0.4"/>
+       <float name="clearcoat" value="0.8"/> <float name="clearcoat_gloss" value="0.6"/>
+       <float name="specular" value="0.7"/>"#,
+    r#"<rgb name="base_color" value="0.2, 0.6, 0.9"/> <float name="roughness" value="0.4"/>
+       <float name="anisotropic" value="0.6"/> <float name="flatness" value="0.5"/>"#,
+    r#"<rgb name="base_color" value="0.9, 0.9, 0.6"/> <float name="roughness" value="0.3"/>
+       <float name="spec_trans" value="0.7"/> <float name="eta" value="1.45"/>
+       <float name="metallic" value="0.2"/>"#,
+];
+
+fn principled(index: usize) -> Bsdf {
+    let xml = format!(
+        r#"<scene version="3.0.0">
+             <shape type="rectangle"><bsdf type="principled">{}</bsdf></shape>
+             <emitter type="constant"/>
+           </scene>"#,
+        SETS[index]
+    );
+    let scene = load(&format!("principled-{index}"), &xml, &[], false).unwrap();
+    // The only warning is the missing sensor: every property was read.
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    scene.materials[0].bsdf
+}
+
+#[test]
+fn principled_evaluates_as_mitsuba_3s() {
+    let bsdfs: Vec<Bsdf> = (0..SETS.len()).map(principled).collect();
+    let text = include_str!("data/principled_mitsuba.txt");
+    let (mut worst, mut nonzero) = (0.0f32, 0);
+    for line in text.lines() {
+        let v: Vec<f32> = line.split_whitespace().map(|x| x.parse().unwrap()).collect();
+        let wo = Vec3A::new(v[1], v[2], v[3]);
+        let wi = Vec3A::new(v[4], v[5], v[6]);
+        let expected = Vec3A::new(v[7], v[8], v[9]);
+        let f = bsdfs[v[0] as usize].eval(wo, wi);
+        // Relative to the value, with a floor for values near zero.
+        let error = ((f - expected).abs() / expected.abs().max(Vec3A::splat(1e-3))).max_element();
+        assert!(
+            error < 1e-3,
+            "set {}: wo {wo}, wi {wi}: tracelab {f}, Mitsuba {expected}",
+            v[0]
+        );
+        worst = worst.max(error);
+        nonzero += usize::from(expected.max_element() > 0.0);
+    }
+    // Most pairs see some lobe: the comparison is not of zeros.
+    assert!(nonzero > 120, "only {nonzero} pairs non-zero");
+    println!("worst relative difference {worst:.2e}");
+}
