@@ -119,6 +119,12 @@ def write_scenes():
         <bsdf type="normalmap"><texture type="bitmap" name="normalmap"><string name="filename" value="checker.exr"/><boolean name="raw" value="true"/></texture><bsdf type="roughconductor"><float name="alpha" value="0.3"/></bsdf></bsdf></shape>''',
      'principled': HEAD.format(depth=3)+FLOOR+SUN+'''  <shape type="sphere"><float name="radius" value="0.7"/><point name="center" x="0" y="0" z="0.7"/>
         <bsdf type="principled"><rgb name="base_color" value="0.7,0.3,0.2"/><float name="metallic" value="0.3"/><float name="roughness" value="0.4"/></bsdf></shape>''',
+     'principled_lobes': HEAD.format(depth=3)+FLOOR+SUN+'''  <shape type="sphere"><float name="radius" value="0.7"/><point name="center" x="0" y="0" z="0.7"/>
+        <bsdf type="principled"><rgb name="base_color" value="0.2,0.5,0.8"/><float name="roughness" value="0.3"/><float name="anisotropic" value="0.5"/>
+        <float name="spec_tint" value="0.5"/><float name="sheen" value="0.8"/><float name="sheen_tint" value="0.5"/><float name="flatness" value="0.4"/>
+        <float name="clearcoat" value="1"/><float name="clearcoat_gloss" value="0.7"/><float name="specular" value="0.6"/></bsdf></shape>''',
+     'principled_glass': HEAD.format(depth=6)+FLOOR+SUN+'''  <shape type="sphere"><float name="radius" value="0.7"/><point name="center" x="0" y="0" z="0.7"/>
+        <bsdf type="principled"><rgb name="base_color" value="0.9,0.8,0.6"/><float name="roughness" value="0.2"/><float name="spec_trans" value="0.9"/><float name="eta" value="1.5"/></bsdf></shape>''',
     }
     for n,b in S.items(): open(n+'.xml','w').write(b+'\n</scene>\n')
 
