@@ -159,8 +159,8 @@ fn rough_bsdfs() -> Vec<(&'static str, Bsdf)> {
 /// on, metal and transmission as given.
 fn principled(roughness: f32, anisotropic: f32, spec_trans: f32) -> Principled {
     Principled {
-        base_color: Rgb::new(0.8, 0.4, 0.2),
-        microfacet: Principled::microfacet_of(roughness, anisotropic),
+        base: [0.8, 0.4, 0.2],
+        alpha: Principled::alphas(roughness, anisotropic),
         roughness,
         anisotropic,
         metallic: 0.3,

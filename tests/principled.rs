@@ -43,7 +43,10 @@ fn principled_evaluates_as_mitsuba_3s() {
     let text = include_str!("data/principled_mitsuba.txt");
     let (mut worst, mut nonzero) = (0.0f32, 0);
     for line in text.lines() {
-        let v: Vec<f32> = line.split_whitespace().map(|x| x.parse().unwrap()).collect();
+        let v: Vec<f32> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
         let wo = Vec3A::new(v[1], v[2], v[3]);
         let wi = Vec3A::new(v[4], v[5], v[6]);
         let expected = Vec3A::new(v[7], v[8], v[9]);

@@ -19,11 +19,14 @@ use glam::{Vec2, Vec3A};
 use std::f32::consts::{FRAC_1_PI, PI};
 
 /// The parameters of Mitsuba's `principled`, each in [0, 1] but `eta`.
+/// Plain floats (64 bytes), so that a [`super::Bsdf`] stays as small as
+/// the rough plastic makes it: vertices of bidirectional methods hold one.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Principled {
-    pub base_color: Rgb,
-    /// GGX of α = max(0.001, roughness²), stretched by `anisotropic`.
-    pub microfacet: Microfacet,
+    pub base: [f32; 3],
+    /// GGX's α along u and v: max(0.001, roughness²), stretched by
+    /// `anisotropic` ([`Principled::alphas`]).
+    pub alpha: [f32; 2],
     pub roughness: f32,
     pub anisotropic: f32,
     pub metallic: f32,
@@ -127,6 +130,17 @@ fn half_vector(eta: f32, wo: Vec3A, wi: Vec3A) -> Option<(Vec3A, f32)> {
 }
 
 impl Principled {
+    #[inline]
+    fn base_color(&self) -> Rgb {
+        Rgb::from(self.base)
+    }
+
+    /// The specular lobes' GGX.
+    #[inline]
+    pub fn microfacet(&self) -> Microfacet {
+        Microfacet::new(Distribution::Ggx, self.alpha[0], self.alpha[1])
+    }
+
     /// The weight of the diffuse lobes (Mitsuba's `brdf`) and of
     /// transmission (its `bsdf`).
     #[inline]
@@ -152,10 +166,10 @@ impl Principled {
         if !front {
             return Rgb::splat(transmission * f);
         }
-        let metal = self.metallic * schlick(self.base_color, cos, self.eta);
-        let lum = luminance(self.base_color);
+        let metal = self.metallic * schlick(self.base_color(), cos, self.eta);
+        let lum = luminance(self.base_color());
         let tint = if lum > 0.0 {
-            self.base_color / lum
+            self.base_color() / lum
         } else {
             Rgb::ONE
         };
@@ -176,8 +190,8 @@ impl Principled {
         let (diffuse_weight, transmission) = self.weights();
         let front = wo.z > 0.0;
         let f = fresnel_dielectric(wo.dot(m), self.eta).reflectance;
-        let d = self.microfacet.d(m);
-        let g = self.microfacet.g(wo, wi, m);
+        let d = self.microfacet().d(m);
+        let g = self.microfacet().g(wo, wi, m);
         if wo.z * wi.z < 0.0 {
             if transmission <= 0.0 || f >= 1.0 {
                 return Rgb::ZERO;
@@ -186,7 +200,7 @@ impl Principled {
             let denom = wo.dot(m) + etap * wi.dot(m);
             let t =
                 (1.0 - f) * d * g * (wo.dot(m) * wi.dot(m)).abs() / (cos_o * cos_i * denom * denom);
-            return sqrt_rgb(self.base_color) * (transmission * t);
+            return sqrt_rgb(self.base_color()) * (transmission * t);
         }
         let mut value = Rgb::ZERO;
         if f > 0.0 {
@@ -214,11 +228,11 @@ impl Principled {
                 let ss = 1.25 * (fss * (1.0 / (cos_o + cos_i) - 0.5) + 0.5);
                 diffuse += (ss - diffuse) * self.flatness;
             }
-            value += self.base_color * (diffuse_weight * diffuse * FRAC_1_PI);
+            value += self.base_color() * (diffuse_weight * diffuse * FRAC_1_PI);
             if self.sheen > 0.0 && self.metallic < 1.0 {
-                let lum = luminance(self.base_color);
+                let lum = luminance(self.base_color());
                 let tint = if lum > 0.0 {
-                    self.base_color / lum
+                    self.base_color() / lum
                 } else {
                     Rgb::ONE
                 };
@@ -267,7 +281,7 @@ impl Principled {
         }
         let [diffuse, clearcoat, specular] = self.lobe_probabilities(wo);
         let wo_up = if wo.z < 0.0 { -wo } else { wo };
-        let visible = self.microfacet.pdf_visible(wo_up, m);
+        let visible = self.microfacet().pdf_visible(wo_up, m);
         let f = fresnel_dielectric(wo.dot(m), self.eta).reflectance;
         let refract = self.refraction_probability(f, wo.z > 0.0);
         if wo.z * wi.z < 0.0 {
@@ -301,7 +315,7 @@ impl Principled {
             // Reused for the choice of event, rescaled to [0, 1).
             let u_event = (u_lobe - diffuse - clearcoat) / (1.0 - diffuse - clearcoat);
             let wo_up = if wo.z < 0.0 { -wo } else { wo };
-            let m = self.microfacet.sample_visible(wo_up, u);
+            let m = self.microfacet().sample_visible(wo_up, u);
             let cos = wo.dot(m);
             let fr = fresnel_dielectric(cos, self.eta);
             if u_event < self.refraction_probability(fr.reflectance, wo.z > 0.0) {
@@ -343,28 +357,28 @@ impl Principled {
     pub fn albedo_hint(&self) -> f32 {
         let (diffuse, transmission) = self.weights();
         let r0 = schlick_r0(self.eta);
-        let specular = self.metallic * self.base_color + Rgb::splat((1.0 - self.metallic) * r0);
-        let through = sqrt_rgb(self.base_color) * transmission;
-        (self.base_color * diffuse + specular + through)
+        let specular = self.metallic * self.base_color() + Rgb::splat((1.0 - self.metallic) * r0);
+        let through = sqrt_rgb(self.base_color()) * transmission;
+        (self.base_color() * diffuse + specular + through)
             .max_element()
             .min(1.0)
     }
 
     /// The transmission lobe's colour, √base times its weight.
     pub fn transmission_tint(&self) -> Rgb {
-        sqrt_rgb(self.base_color) * self.weights().1
+        sqrt_rgb(self.base_color()) * self.weights().1
     }
 
     /// Sets the roughness (a texture's value at a hit) and the GGX it gives.
     #[inline]
     pub fn set_roughness(&mut self, roughness: f32) {
         self.roughness = roughness;
-        self.microfacet = Principled::microfacet_of(roughness, self.anisotropic);
+        self.alpha = Principled::alphas(roughness, self.anisotropic);
     }
 
     /// The diffuse lobe's colour (what radiosity keeps).
     pub fn diffuse_colour(&self) -> Rgb {
-        self.base_color * self.weights().0
+        self.base_color() * self.weights().0
     }
 
     /// The reflectance of the smooth limit at `wo` (Whitted's mirror).
@@ -373,15 +387,11 @@ impl Principled {
         self.fresnel(f, cos.abs(), cos > 0.0)
     }
 
-    /// GGX from Mitsuba's roughness and anisotropy.
-    pub fn microfacet_of(roughness: f32, anisotropic: f32) -> Microfacet {
+    /// GGX's α along u and v from Mitsuba's roughness and anisotropy.
+    pub fn alphas(roughness: f32, anisotropic: f32) -> [f32; 2] {
         let r2 = roughness * roughness;
         let aspect = (1.0 - 0.9 * anisotropic).sqrt();
-        Microfacet::new(
-            Distribution::Ggx,
-            (r2 / aspect).max(0.001),
-            (r2 * aspect).max(0.001),
-        )
+        [(r2 / aspect).max(0.001), (r2 * aspect).max(0.001)]
     }
 }
 

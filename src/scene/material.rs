@@ -153,7 +153,9 @@ impl Material {
             }
             Bsdf::ThinDielectric(lobe) => lobe.reflectance = specular.unwrap_or(lobe.reflectance),
             Bsdf::Principled { lobe, .. } => {
-                lobe.base_color = diffuse.unwrap_or(lobe.base_color);
+                if let Some(base) = diffuse {
+                    lobe.base = base.to_array();
+                }
                 if let Some(r) = alpha_u {
                     lobe.set_roughness(r.clamp(0.0, 1.0));
                 }
@@ -172,7 +174,7 @@ impl Material {
         let microfacet = match &self.bsdf {
             Bsdf::RoughConductor { lobe, .. } => lobe.microfacet,
             Bsdf::RoughDielectric(lobe) => lobe.microfacet,
-            Bsdf::Principled { lobe, .. } => lobe.microfacet,
+            Bsdf::Principled { lobe, .. } => lobe.microfacet(),
             _ => return false,
         };
         microfacet.alpha_u != microfacet.alpha_v || self.textures.alpha != self.textures.alpha_v

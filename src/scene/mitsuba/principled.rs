@@ -94,8 +94,8 @@ impl<'a> Importer<'a> {
         }
         p.unused(&mut self.warnings);
         let lobe = Principled {
-            base_color,
-            microfacet: Principled::microfacet_of(roughness, anisotropic),
+            base: base_color.to_array(),
+            alpha: Principled::alphas(roughness, anisotropic),
             roughness,
             anisotropic,
             metallic,
