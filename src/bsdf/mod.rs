@@ -130,6 +130,23 @@ fn sample_oriented(
     Some(s)
 }
 
+/// The sample of direction `wi` of density `pdf`, weighed by f (given by
+/// `f`) · |cos| / pdf; None where the density is zero or a value is not
+/// finite (the sample carries no energy).
+#[inline]
+fn weighed(wi: Vec3A, pdf: f32, f: impl FnOnce() -> Rgb) -> Option<BsdfSample> {
+    if !(pdf > 0.0) || !pdf.is_finite() {
+        return None;
+    }
+    let weight = f() * (wi.z.abs() / pdf);
+    weight.is_finite().then_some(BsdfSample {
+        wi,
+        weight,
+        pdf,
+        specular: false,
+    })
+}
+
 impl Bsdf {
     /// True when every scattering event is a Dirac delta (no light sampling helps).
     #[inline]

@@ -122,20 +122,7 @@ impl RoughDielectric {
             }
             wi.normalize()
         };
-        let pdf = self.pdf(wo, wi);
-        if !(pdf > 0.0) || !pdf.is_finite() {
-            return None;
-        }
-        let weight = self.eval(wo, wi) * (wi.z.abs() / pdf);
-        if !weight.is_finite() {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            weight,
-            pdf,
-            specular: false,
-        })
+        super::weighed(wi, self.pdf(wo, wi), || self.eval(wo, wi))
     }
 
     /// (η_i / η_t)² that radiance picks up crossing from wi's side to wo's.
