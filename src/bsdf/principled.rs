@@ -390,3 +390,55 @@ fn sqrt_rgb(c: Rgb) -> Rgb {
         c.z.max(0.0).sqrt(),
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::RoughConductor;
+
+    /// Metallic 1 with a white base is Schlick's Fresnel of 1: the rough
+    /// conductor of Fresnel 1 (η 0, k 1) at α = roughness², in value and
+    /// in density, at every pair of directions tried.
+    #[test]
+    fn a_white_metal_is_the_rough_conductor_of_fresnel_one() {
+        let principled = Principled {
+            base: [1.0; 3],
+            alpha: Principled::alphas(0.3, 0.0),
+            roughness: 0.3,
+            anisotropic: 0.0,
+            metallic: 1.0,
+            spec_trans: 0.0,
+            eta: 1.5,
+            spec_tint: 0.0,
+            sheen: 0.0,
+            sheen_tint: 0.0,
+            flatness: 0.0,
+            clearcoat: 0.0,
+            clearcoat_alpha: 0.1,
+        };
+        let conductor = RoughConductor {
+            microfacet: Microfacet::isotropic(Distribution::Ggx, 0.09),
+            eta: Rgb::ZERO,
+            k: Rgb::ONE,
+            tint: Rgb::ONE,
+        };
+        for i in 0..200 {
+            let angle = |k: u32| ((i * 7919 + k * 104_729) % 1000) as f32 / 1000.0;
+            let direction = |a: f32, b: f32| {
+                let z = 0.05 + 0.95 * a;
+                let s = (1.0 - z * z).sqrt();
+                let phi = 2.0 * PI * b;
+                Vec3A::new(s * phi.cos(), s * phi.sin(), z)
+            };
+            let wo = direction(angle(1), angle(2));
+            let wi = direction(angle(3), angle(4));
+            let (f, g) = (principled.eval(wo, wi), conductor.eval(wo, wi));
+            assert!(
+                (f - g).abs().max_element() <= 1e-5 * g.max_element().max(1.0),
+                "{f} {g}"
+            );
+            let (p, q) = (principled.pdf(wo, wi), conductor.pdf(wo, wi));
+            assert!((p - q).abs() <= 1e-5 * q.max(1.0), "{p} {q}");
+        }
+    }
+}
