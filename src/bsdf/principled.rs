@@ -135,6 +135,18 @@ impl Principled {
         Rgb::from(self.base)
     }
 
+    /// The base colour over its luminance (white where it is black): the
+    /// hue that `spec_tint` and `sheen_tint` lend.
+    #[inline]
+    fn tint(&self) -> Rgb {
+        let lum = luminance(self.base_color());
+        if lum > 0.0 {
+            self.base_color() / lum
+        } else {
+            Rgb::ONE
+        }
+    }
+
     /// The specular lobes' GGX.
     #[inline]
     pub fn microfacet(&self) -> Microfacet {
@@ -167,14 +179,8 @@ impl Principled {
             return Rgb::splat(transmission * f);
         }
         let metal = self.metallic * schlick(self.base_color(), cos, self.eta);
-        let lum = luminance(self.base_color());
-        let tint = if lum > 0.0 {
-            self.base_color() / lum
-        } else {
-            Rgb::ONE
-        };
         let eta_it = if cos >= 0.0 { self.eta } else { 1.0 / self.eta };
-        let tinted = schlick(tint * schlick_r0(eta_it), cos, self.eta);
+        let tinted = schlick(self.tint() * schlick_r0(eta_it), cos, self.eta);
         let dielectric = 1.0 - self.metallic;
         Rgb::splat(dielectric * (1.0 - self.spec_tint) * f)
             + metal
@@ -190,8 +196,8 @@ impl Principled {
         let (diffuse_weight, transmission) = self.weights();
         let front = wo.z > 0.0;
         let f = fresnel_dielectric(wo.dot(m), self.eta).reflectance;
-        let d = self.microfacet().d(m);
-        let g = self.microfacet().g(wo, wi, m);
+        let microfacet = self.microfacet();
+        let (d, g) = (microfacet.d(m), microfacet.g(wo, wi, m));
         if wo.z * wi.z < 0.0 {
             if transmission <= 0.0 || f >= 1.0 {
                 return Rgb::ZERO;
@@ -230,13 +236,7 @@ impl Principled {
             }
             value += self.base_color() * (diffuse_weight * diffuse * FRAC_1_PI);
             if self.sheen > 0.0 && self.metallic < 1.0 {
-                let lum = luminance(self.base_color());
-                let tint = if lum > 0.0 {
-                    self.base_color() / lum
-                } else {
-                    Rgb::ONE
-                };
-                let colour = Rgb::ONE + (tint - Rgb::ONE) * self.sheen_tint;
+                let colour = Rgb::ONE + (self.tint() - Rgb::ONE) * self.sheen_tint;
                 let weight = self.sheen * (1.0 - self.metallic) * schlick_weight(cos_d.abs());
                 value += colour * weight;
             }
