@@ -128,6 +128,28 @@ impl Geometry {
         choice: AccelChoice,
         keep_uvs: bool,
     ) -> Self {
+        Self::build_keeping(triangles, spheres, choice, keep_uvs, false)
+    }
+
+    /// [`Geometry::build_full`] without the degenerate triangles
+    /// ([`TriangleInput::is_degenerate`]), left out as the triangles are
+    /// packed: a scene's loader counts them, and filtering them first
+    /// copied a million triangles on one core.
+    pub fn build_without_degenerate(
+        triangles: Vec<TriangleInput>,
+        spheres: Vec<Sphere>,
+        keep_uvs: bool,
+    ) -> Self {
+        Self::build_keeping(triangles, spheres, AccelChoice::Auto, keep_uvs, true)
+    }
+
+    fn build_keeping(
+        triangles: Vec<TriangleInput>,
+        spheres: Vec<Sphere>,
+        choice: AccelChoice,
+        keep_uvs: bool,
+        drop_degenerate: bool,
+    ) -> Self {
         let mut geometry = Geometry {
             keep_uvs,
             keep_normals: triangles.par_iter().any(|t| t.normals.is_some()),
@@ -139,7 +161,7 @@ impl Geometry {
             AccelChoice::Bvh => false,
             AccelChoice::Soup => true,
         };
-        geometry.store_triangles(triangles, use_soup);
+        geometry.store_triangles(triangles, use_soup, drop_degenerate);
         if spheres.len() <= SPHERE_LIST_MAX {
             geometry.spheres = spheres;
         } else {
@@ -171,12 +193,18 @@ impl Geometry {
     }
 
     /// Stores the triangles as a soup or under a BVH; returns per stored
-    /// triangle its index in `triangles`.
-    fn store_triangles(&mut self, triangles: Vec<TriangleInput>, use_soup: bool) -> Vec<usize> {
-        if triangles.is_empty() {
+    /// triangle its index in `triangles` (without the degenerate ones when
+    /// `drop_degenerate`).
+    fn store_triangles(
+        &mut self,
+        triangles: Vec<TriangleInput>,
+        use_soup: bool,
+        drop_degenerate: bool,
+    ) -> Vec<usize> {
+        let packed = Packed::new(triangles, self.keep_uvs, self.keep_normals, drop_degenerate);
+        if packed.corners.is_empty() {
             return Vec::new();
         }
-        let packed = Packed::new(triangles, self.keep_uvs, self.keep_normals);
         if !use_soup {
             let built = build_wide_bvh_with(&packed.corners, &|i| packed.corners[i].get());
             if let Some((bvh, order)) = built {
@@ -253,7 +281,7 @@ impl Geometry {
         };
         geometry.update_plain();
         let use_soup = inputs.len() <= SOUP_MAX_TRIANGLES;
-        let order = geometry.store_triangles(inputs, use_soup);
+        let order = geometry.store_triangles(inputs, use_soup, false);
         let from: Vec<u32> = order.iter().map(|&k| origin[k]).collect();
         for (slot, &old) in from.iter().enumerate() {
             geometry.tri_shading[slot].light = self.tri_shading[old as usize].light;
@@ -335,7 +363,7 @@ impl Geometry {
         };
         geometry.update_plain();
         let use_soup = inputs.len() <= SOUP_MAX_TRIANGLES;
-        let order = geometry.store_triangles(inputs, use_soup);
+        let order = geometry.store_triangles(inputs, use_soup, false);
         geometry.bvh_too_deep |= self.bvh_too_deep;
         for (slot, &k) in order.iter().enumerate() {
             geometry.tri_shading[slot].light = lights[k];
@@ -414,8 +442,14 @@ struct Packed {
 impl Packed {
     /// Moves `triangles` in from the back a block at a time, the list
     /// shrinking behind (glibc shrinks a large block's mapping in place),
-    /// so that the two are never held whole together.
-    fn new(mut triangles: Vec<TriangleInput>, keep_uvs: bool, keep_normals: bool) -> Packed {
+    /// so that the two are never held whole together; leaves the
+    /// degenerate ones out when `drop_degenerate`.
+    fn new(
+        mut triangles: Vec<TriangleInput>,
+        keep_uvs: bool,
+        keep_normals: bool,
+        drop_degenerate: bool,
+    ) -> Packed {
         let count = triangles.len();
         let kept = |keep: bool| if keep { count } else { 0 };
         let mut packed = Packed {
@@ -427,9 +461,19 @@ impl Packed {
         const BLOCK: usize = 1 << 16;
         while !triangles.is_empty() {
             let rest = triangles.len().saturating_sub(BLOCK);
+            let here = &triangles[rest..];
+            // The block's triangles to keep, back to front.
+            let kept: Vec<u32> = match drop_degenerate {
+                true => (0..here.len() as u32)
+                    .into_par_iter()
+                    .rev()
+                    .filter(|&k| !here[k as usize].is_degenerate())
+                    .collect(),
+                false => (0..here.len() as u32).rev().collect(),
+            };
             // On every core: the new arrays' first touch (page faults) was
             // most of the packing's time.
-            let block = || triangles[rest..].par_iter().rev().with_min_len(1 << 10);
+            let block = || (kept.par_iter().with_min_len(1 << 10)).map(|&k| &here[k as usize]);
             packed
                 .corners
                 .par_extend(block().map(|t| Corners(t.vertices.map(Vec3::from))));

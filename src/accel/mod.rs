@@ -58,6 +58,14 @@ pub struct TriangleInput {
 }
 
 impl TriangleInput {
+    /// Whether it has no representable area or normal: no hits, no
+    /// emission, and nothing a renderer can do with it.
+    pub fn is_degenerate(&self) -> bool {
+        let [a, b, c] = self.vertices;
+        let n = (b - a).cross(c - a);
+        !(n.length_squared() > 0.0 && n.is_finite() && n.normalize().is_finite())
+    }
+
     /// The parallelogram `corner + a u + b v`, a, b in [0, 1], as two
     /// triangles wound like (u, v): the quads of scene files and test scenes.
     pub fn quad(corner: Vec3A, u: Vec3A, v: Vec3A, material: u32) -> [TriangleInput; 2] {

@@ -179,14 +179,7 @@ impl Dropped {
     /// has no normal, no hits and emits nothing.
     fn triangles(&mut self, all: Vec<TriangleInput>) -> Vec<TriangleInput> {
         let total = all.len();
-        let kept: Vec<TriangleInput> = all
-            .into_iter()
-            .filter(|t| {
-                let [a, b, c] = t.vertices;
-                let n = (b - a).cross(c - a);
-                n.length_squared() > 0.0 && n.is_finite() && n.normalize().is_finite()
-            })
-            .collect();
+        let kept: Vec<TriangleInput> = all.into_iter().filter(|t| !t.is_degenerate()).collect();
         self.triangle_total += total;
         self.triangles += total - kept.len();
         kept
@@ -197,6 +190,41 @@ impl Dropped {
         let kept: Vec<Sphere> = all.into_iter().filter(|s| s.radius > 0.0).collect();
         self.spheres += total - kept.len();
         kept
+    }
+}
+
+/// What one pass over a scene's triangles finds: a million of them were
+/// read once for each of these, the degenerate ones copied out on one core.
+#[derive(Default)]
+struct Survey {
+    degenerate: usize,
+    /// Whether a triangle with an area reaches out of range.
+    out_of_range: bool,
+    /// A material index beyond the scene's materials.
+    bad_material: Option<u32>,
+}
+
+impl Survey {
+    fn of(triangles: &[TriangleInput], materials: usize) -> Survey {
+        let add = |mut s: Survey, t: &TriangleInput| {
+            if t.is_degenerate() {
+                s.degenerate += 1;
+            } else {
+                s.out_of_range |= !t.vertices.iter().all(|&v| in_range(v));
+                if t.material as usize >= materials {
+                    s.bad_material = Some(t.material);
+                }
+            }
+            s
+        };
+        let merge = |a: Survey, b: Survey| Survey {
+            degenerate: a.degenerate + b.degenerate,
+            out_of_range: a.out_of_range || b.out_of_range,
+            bad_material: a.bad_material.or(b.bad_material),
+        };
+        (triangles.par_iter().with_min_len(1 << 12))
+            .fold(Survey::default, add)
+            .reduce(Survey::default, merge)
     }
 }
 
@@ -282,7 +310,9 @@ impl Scene {
         let mut warnings = input.warnings;
         let hints = input.hints;
         let mut dropped = Dropped::default();
-        let mut triangles = dropped.triangles(input.triangles);
+        // Its degenerate triangles are counted here and left out by the
+        // geometry as it packs them.
+        let mut triangles = input.triangles;
         let spheres = dropped.spheres(input.spheres);
         let (prototypes, placements) = instances::checked(
             input.instances,
@@ -301,6 +331,9 @@ impl Scene {
                 )
             })
             .collect();
+        let survey = Survey::of(&triangles, input.materials.len());
+        dropped.triangle_total += triangles.len();
+        dropped.triangles += survey.degenerate;
         if dropped.triangles > 0 {
             let emitters_hint = "(zero-area emitters among them emit nothing)";
             warnings.push(format!(
@@ -313,7 +346,7 @@ impl Scene {
         }
         let triangle_out_of_range = |t: &TriangleInput| !t.vertices.iter().all(|&v| in_range(v));
         let sphere_out_of_range = |s: &Sphere| !in_range(s.center) || !(s.radius <= MAX_COORDINATE);
-        let out_of_range = triangles.par_iter().any(triangle_out_of_range)
+        let out_of_range = survey.out_of_range
             || spheres.iter().any(sphere_out_of_range)
             || moving.iter().any(|(t, s, v)| {
                 t.iter().any(triangle_out_of_range)
@@ -326,13 +359,9 @@ impl Scene {
                 "the scene has coordinates beyond ±{MAX_COORDINATE:e} (or not finite): areas and distances would overflow"
             )));
         }
-        if let Some(bad) = triangles
-            .par_iter()
-            .find_any(|t| t.material as usize >= input.materials.len())
-        {
+        if let Some(bad) = survey.bad_material {
             return Err(Error::new(format!(
-                "internal: triangle refers to material {}",
-                bad.material
+                "internal: triangle refers to material {bad}"
             )));
         }
 
@@ -346,7 +375,7 @@ impl Scene {
                 || m.blend
                     .is_some_and(|b| matches!(b.weight, BlendWeight::Texture(_)))
         });
-        let mut geometry = Geometry::build_full(triangles, spheres, AccelChoice::Auto, textured);
+        let mut geometry = Geometry::build_without_degenerate(triangles, spheres, textured);
         // An emitter is sampled where it is, mask or not: it stays whole.
         for m in input.materials.iter_mut() {
             if m.opacity != Opacity::Opaque && m.is_emissive() {

@@ -12,6 +12,7 @@ use crate::scene::mesh::{MeshData, Orientation, Placement};
 use crate::scene::{MAX_COORDINATE, in_range};
 use glam::{Mat4, Vec3A};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// A mesh waiting to be placed (see [`Importer::place_pending`]).
 pub(super) struct Pending<'a> {
@@ -277,14 +278,19 @@ impl<'a> Importer<'a> {
         }
         let mesh_of = |k: usize| starts.partition_point(|&s| s <= k) - 1;
         let base = self.triangles.len();
+        // The first triangle out of range, checked as it is made (a second
+        // pass read the million triangles again).
+        let outside = AtomicUsize::new(usize::MAX);
         self.triangles
             .par_extend((0..total).into_par_iter().with_min_len(1 << 12).map(|k| {
                 let i = mesh_of(k);
-                pending[i].mesh.triangle(&pending[i].at, k - starts[i])
+                let t = pending[i].mesh.triangle(&pending[i].at, k - starts[i]);
+                if !t.vertices.iter().all(|&v| in_range(v)) {
+                    outside.fetch_min(k, Ordering::Relaxed);
+                }
+                t
             }));
-        let outside = self.triangles[base..]
-            .par_iter()
-            .position_first(|t| !t.vertices.iter().all(|&v| in_range(v)));
+        let outside = Some(outside.into_inner()).filter(|&k| k != usize::MAX);
         if let Some(k) = outside {
             self.triangles.truncate(base);
             return Err(pending[mesh_of(k)].e.loc.error(format!(
