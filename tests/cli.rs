@@ -136,9 +136,14 @@ fn renders_the_cornell_box_and_compares_images() {
 
     let o = tracelab(&["compare", exr.to_str().unwrap(), exr.to_str().unwrap()]);
     assert!(o.status.success());
+    let out = String::from_utf8_lossy(&o.stdout);
     assert!(
-        String::from_utf8_lossy(&o.stdout)
-            .starts_with("RMSE 0.000000 | relative MSE 0.000000 | mean relative error 0.000000")
+        out.starts_with("RMSE 0.000000 | relative MSE 0.000000 | mean relative error 0.000000"),
+        "{out}"
+    );
+    assert!(
+        out.contains("| RMSE without the worst 0.1% of pixels 0.000000"),
+        "{out}"
     );
     // Different sizes and missing files are errors, not panics.
     let reference = repo_path("tests/data/cornell_box_path_ref.exr");

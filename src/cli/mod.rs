@@ -46,7 +46,7 @@ enum Command {
     /// Radiosity step by step against a reference: elements, links, rays,
     /// seconds, residual and RMSE per row; CSV and a plot.
     Radiosity(radiosity::RadiosityArgs),
-    /// Compare two images: RMSE, relative MSE and mean relative error (as tev computes them).
+    /// Compare two images: RMSE, relative MSE and mean relative error (as tev computes them), and the RMSE without the worst 0.1% of pixels.
     Compare {
         /// The image to measure.
         image: PathBuf,
@@ -270,8 +270,12 @@ fn compare(image: &Path, reference: &Path) -> Result<()> {
     }
     let (ma, mb) = (a.mean(), b.mean());
     println!(
-        "RMSE {:.6} | relative MSE {:.6} | mean relative error {:.6}",
-        m.rmse, m.relative_mse, m.mean_relative_error
+        "RMSE {:.6} | relative MSE {:.6} | mean relative error {:.6} | RMSE without the worst {}% of pixels {:.6}",
+        m.rmse,
+        m.relative_mse,
+        m.mean_relative_error,
+        100.0 * tracelab::image::TRIMMED_SHARE,
+        m.trimmed_rmse
     );
     println!(
         "mean RGB {:.6} {:.6} {:.6} vs {:.6} {:.6} {:.6} (ratio {:.4} {:.4} {:.4})",
