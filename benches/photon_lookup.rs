@@ -14,7 +14,7 @@ use std::num::NonZero;
 use std::path::Path;
 use std::sync::LazyLock;
 use tracelab::integrator::RayCounts;
-use tracelab::integrator::photon_map::{self, MAX_K, Photon, PhotonMap};
+use tracelab::integrator::photon_map::{self, MAX_K, Photon, PhotonMap, Side};
 use tracelab::math::Rgb;
 use tracelab::scene::Scene;
 
@@ -83,7 +83,7 @@ fn radius_hash_grid(bencher: Bencher, scale: f32) {
         .bench(|| {
             let mut flux = Rgb::ZERO;
             for q in &setup.queries {
-                map.for_each_near(q.point, q.normal, |p| flux += p.power);
+                map.for_each_near(q.point, Side::Facing(q.normal), |p| flux += p.power);
             }
             flux
         });
@@ -126,7 +126,9 @@ fn nearest_hash_grid(bencher: Bencher) {
         .bench_local(|| {
             let mut area = 0.0f32;
             for q in &setup.queries {
-                area += map.nearest(q.point, q.normal, K, &mut nearest).1;
+                area += map
+                    .nearest(q.point, Side::Facing(q.normal), K, &mut nearest)
+                    .1;
             }
             area
         });

@@ -387,3 +387,78 @@ fn bidirectional_agrees_with_path_tracing_under_a_gaussian_filter() {
     assert!(z.abs() < 4.5, "the means differ by {z:.2} standard errors");
     assert_agree("Gaussian filter, bdpt / path", &bdpt, &path);
 }
+
+/// A rough glass ball (α 0.3) alone under a uniform white sky, seen whole.
+const ROUGH_GLASS_BALL: &str = r#"<scene version="3.0.0">
+  <sensor type="perspective">
+    <float name="fov" value="30"/>
+    <transform name="to_world"><lookat origin="0, -5, 0" target="0, 0, 0" up="0, 0, 1"/></transform>
+    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="24"/><rfilter type="box"/></film>
+  </sensor>
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <shape type="sphere"><float name="radius" value="1"/>
+    <bsdf type="roughdielectric"><float name="alpha" value="0.3"/><float name="int_ior" value="1.5"/></bsdf>
+  </shape>
+</scene>
+"#;
+
+/// What leaves the ball towards the camera is mostly sky that entered it
+/// elsewhere: photons on the inner side of the surface seen, which a lookup
+/// that kept only the photons on the camera's side left out (SPPM read
+/// 0.61 of path tracing's mean here, Jensen's map 0.69; VCM, whose other
+/// strategies carry that light, was within its noise). A photon mapper's
+/// pixels share each pass's photons, so the image mean's spread is not the
+/// pixels' standard errors summed: it was measured over eight seeds at
+/// these settings (standard deviations 1.5%, 0.23% and 0.09% of the mean).
+/// Each mean agrees with path tracing's within 4 of those, plus 2% for the
+/// density estimates' bias (Jensen's map reads +1.3% here over the seeds,
+/// SPPM +0.4%, VCM −0.03%).
+#[test]
+fn photon_mappers_gather_the_light_that_passes_through_rough_glass() {
+    let dir = crate::common::temp_dir("rough_glass_ball");
+    let path = dir.join("ball.xml");
+    std::fs::write(&path, ROUGH_GLASS_BALL).expect("scene written");
+    let ball = || Scene::load(&path).expect("the ball loads");
+    let (reference, _) = render_with(
+        ball(),
+        Integrator::from(PathTracer::default()),
+        SamplerKind::Independent,
+        1024,
+        7,
+        0,
+        64,
+    );
+    let expected = reference.image.mean()[1];
+    let sppm = PhotonMapper {
+        photons: 20_000,
+        radius: 0.01,
+        ..PhotonMapper::default()
+    };
+    let jensen = PhotonMap2Pass {
+        photons: 50_000,
+        ..PhotonMap2Pass::default()
+    };
+    let vcm = Vcm {
+        radius: 0.01,
+        ..Vcm::default()
+    };
+    let techniques = [
+        ("SPPM", MultiPassIntegrator::Sppm(sppm), 0.015),
+        ("Jensen's map", MultiPassIntegrator::Photon(jensen), 0.0023),
+        ("VCM", MultiPassIntegrator::Vcm(vcm), 0.0009),
+    ];
+    for (name, technique, spread) in techniques {
+        let session = multi_pass_session(ball(), technique, 11);
+        assert!(session.render_pass(128));
+        assert_eq!(session.stats().non_finite, 0);
+        let mean = session.snapshot().image.mean()[1];
+        let tolerance = (4.0 * spread + 0.02) * expected;
+        eprintln!(
+            "{name}: mean {mean:.5} against path tracing's {expected:.5} (tolerance {tolerance:.5})"
+        );
+        assert!(
+            (mean - expected).abs() < tolerance,
+            "{name}: mean {mean} against path tracing's {expected} (tolerance {tolerance})"
+        );
+    }
+}

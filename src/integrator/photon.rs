@@ -21,7 +21,7 @@
 
 use super::light::photon_shading_factor;
 use super::options::check_fraction;
-use super::photon_map::{self, MAX_K, PhotonMap};
+use super::photon_map::{self, MAX_K, PhotonMap, Side};
 use super::{MultiPassEstimator, RayCounts, Settings, Technique};
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::hash::hash_combine;
@@ -177,7 +177,8 @@ impl PhotonMap2Pass {
         wo: Vec3A,
     ) -> Rgb {
         let mut nearest = [(0.0f32, 0u32); MAX_K];
-        let (found, r2) = map.nearest(point, facing, self.k as usize, &mut nearest);
+        let side = Side::of(facing, bsdf.is_transmissive());
+        let (found, r2) = map.nearest(point, side, self.k as usize, &mut nearest);
         if found == 0 || !(r2 > 0.0) {
             return Rgb::ZERO;
         }

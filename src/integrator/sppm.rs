@@ -20,7 +20,7 @@
 
 use super::light::photon_shading_factor;
 use super::options::check_fraction;
-use super::photon_map::{self, PhotonMap};
+use super::photon_map::{self, PhotonMap, Side};
 use super::{MultiPassEstimator, RayCounts, Settings, Technique};
 use crate::math::{Ray, Rgb};
 use crate::sampling::Sampler;
@@ -213,7 +213,8 @@ impl MultiPassEstimator for PhotonMapper {
         // Everything after a bounce: the density estimate.
         let mut sum = Rgb::ZERO;
         let ng = x.frame.to_local(x.hit.normal);
-        iteration.map.for_each_near(x.hit.point, x.facing, |p| {
+        let side = Side::of(x.facing, x.bsdf.is_transmissive());
+        iteration.map.for_each_near(x.hit.point, side, |p| {
             let wi = x.frame.to_local(p.wi);
             sum += x.bsdf.eval(x.wo, wi) * p.power * photon_shading_factor(wi, ng);
         });

@@ -20,6 +20,29 @@ pub trait Stored {
     fn facing(&self) -> Vec3A;
 }
 
+/// The side of a surface from which a lookup gathers.
+#[derive(Clone, Copy, Debug)]
+pub enum Side {
+    /// Only points reached from the side that the normal faces: light on
+    /// the far side of a wall does not reach its near side.
+    Facing(Vec3A),
+    /// Both sides, where light passes through the surface (glass): what
+    /// arrives from behind is its transmission.
+    Both,
+}
+
+impl Side {
+    /// The side `normal` faces, or both where the surface `transmits`.
+    #[inline]
+    pub fn of(normal: Vec3A, transmits: bool) -> Side {
+        if transmits {
+            Side::Both
+        } else {
+            Side::Facing(normal)
+        }
+    }
+}
+
 /// Photons found within a lookup's radius before they are visited.
 const NEAR_BATCH: usize = 32;
 
@@ -160,15 +183,15 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
     }
 
     /// Calls `visit` with every photon within the map's radius of `point`
-    /// on the side of the surface that `normal` faces.
+    /// on `side` of the surface.
     #[inline]
-    pub fn for_each_near(&self, point: Vec3A, normal: Vec3A, mut visit: impl FnMut(&P)) {
-        self.visit_near(point, normal, |_, p| visit(p));
+    pub fn for_each_near(&self, point: Vec3A, side: Side, mut visit: impl FnMut(&P)) {
+        self.visit_near(point, side, |_, p| visit(p));
     }
 
     /// [`PhotonMap::for_each_near`] with each photon's index.
     #[inline]
-    fn visit_near(&self, point: Vec3A, normal: Vec3A, mut visit: impl FnMut(u32, &P)) {
+    fn visit_near(&self, point: Vec3A, side: Side, mut visit: impl FnMut(u32, &P)) {
         if self.photons.is_empty() {
             return;
         }
@@ -194,24 +217,24 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
                         near[found] = i as u32;
                         found += 1;
                         if found == NEAR_BATCH {
-                            self.visit_facing(&near, normal, &mut visit);
+                            self.visit_on(&near, side, &mut visit);
                             found = 0;
                         }
                     }
                 }
             }
         }
-        self.visit_facing(&near[..found], normal, &mut visit);
+        self.visit_on(&near[..found], side, &mut visit);
     }
 
-    /// Calls `visit` with each of the photons `near` on the side of the
-    /// surface that `normal` faces.
+    /// Calls `visit` with each of the photons `near` on `side`.
     #[inline(always)]
-    fn visit_facing(&self, near: &[u32], normal: Vec3A, visit: &mut impl FnMut(u32, &P)) {
+    fn visit_on(&self, near: &[u32], side: Side, visit: &mut impl FnMut(u32, &P)) {
         for &i in near {
             let p = &self.photons[i as usize];
-            if p.facing().dot(normal) > 0.0 {
-                visit(i, p);
+            match side {
+                Side::Facing(normal) if p.facing().dot(normal) <= 0.0 => {}
+                _ => visit(i, p),
             }
         }
     }
@@ -257,13 +280,13 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
     pub fn nearest(
         &self,
         point: Vec3A,
-        normal: Vec3A,
+        side: Side,
         k: usize,
         nearest: &mut [(f32, u32); MAX_K],
     ) -> (usize, f32) {
         let k = k.clamp(1, MAX_K);
         let mut found = 0usize;
-        self.visit_near(point, normal, |index, p| {
+        self.visit_near(point, side, |index, p| {
             let d2 = (p.position() - point).length_squared();
             if found == k && d2 >= nearest[k - 1].0 {
                 return;
@@ -325,7 +348,7 @@ mod tests {
             .map(|p| p.point + Vec3A::splat(0.01))
         {
             let mut found = 0;
-            map.for_each_near(q, Vec3A::Z, |_| found += 1);
+            map.for_each_near(q, Side::Facing(Vec3A::Z), |_| found += 1);
             let expected = photons
                 .iter()
                 .filter(|p| (p.point - q).length_squared() <= radius * radius)
@@ -355,7 +378,7 @@ mod tests {
         let map = PhotonMap::build(photons.clone(), 0.3);
         let mut nearest = [(0.0f32, 0u32); MAX_K];
         for q in photons.iter().step_by(97).map(|p| p.point) {
-            let (found, r2) = map.nearest(q, Vec3A::Z, 10, &mut nearest);
+            let (found, r2) = map.nearest(q, Side::Facing(Vec3A::Z), 10, &mut nearest);
             let mut d: Vec<f32> = photons
                 .iter()
                 .map(|p| (p.point - q).length_squared())

@@ -4,7 +4,7 @@
 
 mod grid;
 
-pub use grid::{MAX_K, PhotonMap, Stored};
+pub use grid::{MAX_K, PhotonMap, Side, Stored};
 
 use super::RayCounts;
 use super::light::importance_weight;

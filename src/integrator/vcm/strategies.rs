@@ -9,6 +9,7 @@ use super::{Iteration, LightVertex, Vcm, Walk};
 use crate::camera::CameraConnection;
 use crate::film::splats::PendingSplats;
 use crate::integrator::RayCounts;
+use crate::integrator::photon_map::Side;
 use crate::math::{Frame, Rgb, ray_between};
 use crate::sampling::{Domain, Sampler};
 use crate::scene::Scene;
@@ -243,18 +244,19 @@ impl Vcm {
         value / (1.0 + w_light + w_camera)
     }
 
-    /// Merges: every light vertex within the radius on the same side, its
-    /// flux reflected by the camera vertex's BSDF, each weighed against the
-    /// connections that could have made its path (not yet divided by
-    /// pi r^2 N).
+    /// Merges: every light vertex within the radius on the same side (on
+    /// both where the surface transmits), its flux reflected by the camera
+    /// vertex's BSDF, each weighed against the connections that could have
+    /// made its path (not yet divided by pi r^2 N).
     pub(super) fn merge(&self, iteration: &Iteration, at: &CameraVertex, walk: &Walk) -> Rgb {
         let facing = if at.normal.dot(at.frame.to_world(at.wo)) >= 0.0 {
             at.normal
         } else {
             -at.normal
         };
+        let side = Side::of(facing, at.bsdf.is_transmissive());
         let mut sum = Rgb::ZERO;
-        iteration.map.for_each_near(at.point, facing, |light| {
+        iteration.map.for_each_near(at.point, side, |light| {
             if light.segments + at.segments > self.max_depth + 1 {
                 return;
             }
