@@ -176,6 +176,29 @@ impl Bsdf {
         ) || matches!(self, Bsdf::Principled { lobe, .. } if lobe.transmits())
     }
 
+    /// True where a photon mapper estimates light from its photons: the
+    /// surface has a diffuse part. Through the others (mirrors and glass,
+    /// but also rough metals and rough glass, whose narrow lobes read a
+    /// photon map with much noise and blur) its camera paths go on by
+    /// sampling them, as pbrt's SPPM does.
+    #[inline]
+    pub fn gathers_photons(&self) -> bool {
+        match *self {
+            Bsdf::Diffuse { .. }
+            | Bsdf::RoughDiffuse { .. }
+            | Bsdf::Plastic { .. }
+            | Bsdf::RoughPlastic { .. } => true,
+            Bsdf::Glossy { diffuse, .. } => diffuse.max_element() > 0.0,
+            Bsdf::Principled { lobe, .. } => lobe.has_diffuse(),
+            Bsdf::Mirror { .. }
+            | Bsdf::Dielectric { .. }
+            | Bsdf::Conductor { .. }
+            | Bsdf::RoughConductor { .. }
+            | Bsdf::ThinDielectric(_)
+            | Bsdf::RoughDielectric(_) => false,
+        }
+    }
+
     /// True when the surface scatters nothing (paths end here).
     #[inline]
     pub fn is_black(&self) -> bool {

@@ -164,6 +164,12 @@ impl Principled {
         )
     }
 
+    /// True when the diffuse lobe (with sheen) has a weight.
+    #[inline]
+    pub fn has_diffuse(&self) -> bool {
+        self.weights().0 > 0.0
+    }
+
     /// True when light passes through (the back side then scatters too).
     #[inline]
     pub fn transmits(&self) -> bool {

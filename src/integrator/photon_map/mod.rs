@@ -8,6 +8,7 @@ pub use grid::{MAX_K, PhotonMap, Side, Stored};
 
 use super::RayCounts;
 use super::light::importance_weight;
+use super::mis::MisHeuristic;
 use crate::accel::{NO_LIGHT, SurfaceHit};
 use crate::math::{Frame, Ray, Rgb, ray_between};
 use crate::sampling::hash::hash_combine;
@@ -261,11 +262,12 @@ fn trace_photon(
     }
 }
 
-/// Where a camera ray of a photon mapper is estimated: its first diffuse
-/// or glossy hit, reached through mirrors and glass.
+/// Where a camera ray of a photon mapper is estimated: its first hit on a
+/// surface with a diffuse part ([`Bsdf::gathers_photons`]).
 pub struct DiffuseHit {
     pub hit: SurfaceHit,
-    /// The weight of the chain of mirrors and glass before it.
+    /// The weight of the chain of mirrors, glass and glossy surfaces
+    /// before it.
     pub beta: Rgb,
     pub bsdf: Bsdf,
     pub frame: Frame,
@@ -278,9 +280,12 @@ pub struct DiffuseHit {
     pub u_bsdf: Vec2,
 }
 
-/// Follows a camera ray through mirrors and glass (a chain of at most
-/// `max_depth` bounces) to its first diffuse or glossy hit; returns the
-/// emission seen on the way and the hit, if the ray got there.
+/// Follows a camera ray by sampling the surfaces that do not gather
+/// photons (a chain of at most `max_depth` bounces) to its first one that
+/// does; returns the light found on the way and the hit, if the ray got
+/// there. On a glossy surface of the chain direct light is a light sample
+/// and the light its BSDF sample finds, weighed against each other by the
+/// power heuristic, as in path tracing.
 pub fn camera_to_diffuse(
     scene: &Scene,
     mut ray: Ray,
@@ -290,18 +295,24 @@ pub fn camera_to_diffuse(
 ) -> (Rgb, Option<DiffuseHit>) {
     let mut beta = Rgb::ONE;
     let mut emitted = Rgb::ZERO;
-    for _ in 0..=max_depth {
+    // The density and origin of the glossy sample that led here; None
+    // after the camera or a Dirac bounce, where no light sample competes.
+    let mut glossy: Option<(f32, Vec3A)> = None;
+    for bounces in 0..=max_depth {
         let Some(hit) = scene.geometry.intersect(&ray) else {
-            // Seen directly or through Dirac surfaces only: no photon
-            // stands for it.
             if let Some(env) = scene.lights.environment() {
-                emitted += beta * env.le(ray.direction);
+                let d = ray.direction;
+                let weight = found_light_weight(glossy, |_| scene.lights.environment_pdf(d));
+                emitted += beta * env.le(d) * weight;
             }
             break;
         };
         let wo_world = -ray.direction;
         if hit.light != NO_LIGHT {
-            emitted += beta * scene.emitted(&hit, wo_world);
+            let weight = found_light_weight(glossy, |from| {
+                (scene.lights).pdf(hit.light, from, hit.point, hit.normal)
+            });
+            emitted += beta * scene.emitted(&hit, wo_world) * weight;
         }
         let bsdf = scene.bsdf_at(&hit);
         if bsdf.is_black() {
@@ -311,7 +322,7 @@ pub fn camera_to_diffuse(
         let wo = frame.to_local(wo_world);
         let u_lobe = sampler.next_1d_for(Domain::Bsdf);
         let u_bsdf = sampler.next_2d_for(Domain::Bsdf);
-        if !bsdf.is_specular() {
+        if bsdf.gathers_photons() {
             let facing = if hit.normal.dot(wo_world) > 0.0 {
                 hit.normal
             } else {
@@ -329,14 +340,66 @@ pub fn camera_to_diffuse(
             };
             return (emitted, Some(diffuse));
         }
+        if bounces == max_depth {
+            break;
+        }
+        if !bsdf.is_specular() {
+            emitted += beta * glossy_light_sample(scene, &hit, &frame, &bsdf, wo, sampler, counts);
+        }
         let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
             break;
         };
         beta *= sample.weight;
+        glossy = (!sample.specular).then_some((sample.pdf, hit.point));
         ray = hit.spawn_ray(frame.to_world(sample.wi));
         counts.bounce += 1;
     }
     (emitted, None)
+}
+
+/// The weight of light that a camera chain found, against the light sample
+/// at the glossy vertex `glossy` (its BSDF sample's density and point) that
+/// could have found it with the density `light_pdf` gives from there.
+#[inline(always)]
+fn found_light_weight(glossy: Option<(f32, Vec3A)>, light_pdf: impl FnOnce(Vec3A) -> f32) -> f32 {
+    glossy.map_or(1.0, |(pdf, from)| {
+        MisHeuristic::Power.weight(pdf, light_pdf(from))
+    })
+}
+
+/// A light sample at a glossy vertex of a camera chain, weighed against
+/// the BSDF sample that could have found the same light.
+fn glossy_light_sample(
+    scene: &Scene,
+    hit: &SurfaceHit,
+    frame: &Frame,
+    bsdf: &Bsdf,
+    wo: Vec3A,
+    sampler: &mut Sampler,
+    counts: &mut RayCounts,
+) -> Rgb {
+    let u_select = sampler.next_1d_for(Domain::Light);
+    let u_light = sampler.next_2d_for(Domain::Light);
+    let Some(ls) = scene.lights.sample(hit.point, u_select, u_light) else {
+        return Rgb::ZERO;
+    };
+    let wi = frame.to_local(ls.wi);
+    let f = bsdf.eval(wo, wi);
+    if !(f.max_element() > 0.0) {
+        return Rgb::ZERO;
+    }
+    counts.shadow += 1;
+    if scene
+        .geometry
+        .occluded(&ls.shadow_ray_from(hit).at_time(hit.time))
+    {
+        return Rgb::ZERO;
+    }
+    let weight = match ls.delta {
+        true => 1.0,
+        false => MisHeuristic::Power.weight(ls.pdf, bsdf.pdf(wo, wi)),
+    };
+    f * ls.radiance * (wi.z.abs() * weight / ls.pdf)
 }
 
 impl DiffuseHit {
