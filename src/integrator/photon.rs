@@ -4,8 +4,9 @@
 //! - The **global map** holds every photon that lands on a diffuse or
 //!   glossy surface; the **caustic map** those that got there through
 //!   mirrors and glass alone (L S+ D).
-//! - Camera rays follow mirrors and glass to the first diffuse or glossy
-//!   point x. There: emission; direct light by light sampling; caustics by
+//! - Camera rays follow mirrors and glass, and sample rough metals and
+//!   rough glass (their direct light by MIS, as in path tracing), to the
+//!   first point x whose surface has a diffuse part. There: emission; direct light by light sampling; caustics by
 //!   density estimation in the caustic map,
 //!     L_c = sum_{k nearest} f(wo, wi_p) Phi_p / (pi r_k^2 N);
 //!   and indirect light by a final gather: a BSDF-sampled ray (through

@@ -6,8 +6,10 @@
 //! so bias and variance both go to zero (alpha = 2/3 balances them), and
 //! no per-pixel statistics have to survive between iterations.
 //!
-//! Camera rays follow mirrors and glass to the first diffuse or glossy
-//! surface. There, direct light is sampled from the lights (next-event
+//! Camera rays follow mirrors and glass, and sample rough metals and rough
+//! glass (their direct light by MIS, as in path tracing), to the first
+//! surface with a diffuse part, as pbrt's SPPM: a narrow lobe reads a
+//! photon map with much noise. There, direct light is sampled from the lights (next-event
 //! estimation) and everything that arrived after at least one bounce is the
 //! density estimate
 //!   L = sum_p f(wo, wi_p) Phi_p / (pi r^2 N)
