@@ -199,6 +199,19 @@ impl Bsdf {
         }
     }
 
+    /// The probability that [`Bsdf::sample`] picks a Dirac lobe at `wo`,
+    /// for a model with a Dirac lobe over a diffuse one (a smooth plastic's
+    /// coating); 0 for the others.
+    #[inline]
+    pub fn delta_probability(&self, wo: Vec3A) -> f32 {
+        match *self {
+            Bsdf::Plastic { lobe, two_sided } => {
+                orient(two_sided, wo, wo).map_or(0.0, |(wo, _)| lobe.delta_probability(wo))
+            }
+            _ => 0.0,
+        }
+    }
+
     /// True when the surface scatters nothing (paths end here).
     #[inline]
     pub fn is_black(&self) -> bool {

@@ -110,6 +110,15 @@ impl Plastic {
         })
     }
 
+    /// The probability that [`Plastic::sample`] picks the coating's
+    /// mirror reflection at `wo`.
+    pub fn delta_probability(&self, wo: Vec3A) -> f32 {
+        if wo.z <= 0.0 {
+            return 0.0;
+        }
+        self.specular_probability(fresnel_dielectric(wo.z, self.eta).reflectance)
+    }
+
     pub fn albedo_hint(&self) -> f32 {
         self.diffuse.max_element().max(self.specular.max_element())
     }

@@ -22,7 +22,7 @@
 
 use super::light::photon_shading_factor;
 use super::options::check_fraction;
-use super::photon_map::{self, MAX_K, PhotonMap, Side};
+use super::photon_map::{self, MAX_K, Photon, PhotonMap, Side};
 use super::{MultiPassEstimator, RayCounts, Settings, Technique};
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::hash::hash_combine;
@@ -165,8 +165,10 @@ pub struct Maps {
 
 impl PhotonMap2Pass {
     /// Reflected radiance at a diffuse or glossy point towards `wo` (local)
-    /// from the `k` photons of `map` nearest it.
+    /// from the `k` photons of `map` nearest it that have at most `most`
+    /// bounces (the paths the depth allows).
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     fn density_estimate(
         &self,
         map: &PhotonMap,
@@ -176,10 +178,12 @@ impl PhotonMap2Pass {
         ng: Vec3A,
         bsdf: &Bsdf,
         wo: Vec3A,
+        most: u32,
     ) -> Rgb {
         let mut nearest = [(0.0f32, 0u32); MAX_K];
         let side = Side::of(facing, bsdf.is_transmissive());
-        let (found, r2) = map.nearest(point, side, self.k as usize, &mut nearest);
+        let keep = |p: &Photon| p.bounces <= most;
+        let (found, r2) = map.nearest(point, side, self.k as usize, keep, &mut nearest);
         if found == 0 || !(r2 > 0.0) {
             return Rgb::ZERO;
         }
@@ -192,27 +196,32 @@ impl PhotonMap2Pass {
         sum / (PI * r2)
     }
 
-    /// Follows `ray` through mirrors and glass to a diffuse or glossy
-    /// point; returns its hit, the direction the ray arrived in and the
-    /// weight of the chain, or `None` where the ray escapes or dies. A
-    /// light it reaches adds nothing: direct light is sampled at x.
+    /// Follows `ray` through at most `max_bounces` mirrors and glass to a
+    /// diffuse or glossy point; returns its hit, the direction the ray
+    /// arrived in, the weight of the chain and its bounces, or `None` where
+    /// the ray escapes or dies. A light it reaches adds nothing: direct
+    /// light is sampled at x.
     #[inline]
     fn through_specular(
         &self,
         scene: &Scene,
         mut ray: Ray,
+        max_bounces: u32,
         sampler: &mut Sampler,
         counts: &mut RayCounts,
-    ) -> Option<(crate::accel::SurfaceHit, Vec3A, Rgb)> {
+    ) -> Option<(crate::accel::SurfaceHit, Vec3A, Rgb, u32)> {
         let mut beta = Rgb::ONE;
-        for _ in 0..self.max_depth {
+        for bounces in 0..=max_bounces {
             let hit = scene.geometry.intersect(&ray)?;
             let bsdf = scene.bsdf_at(&hit);
             if bsdf.is_black() {
                 return None;
             }
             if !bsdf.is_specular() {
-                return Some((hit, ray.direction, beta));
+                return Some((hit, ray.direction, beta, bounces));
+            }
+            if bounces == max_bounces {
+                return None;
             }
             let frame = scene.shading_frame(&hit);
             let wo = frame.to_local(-ray.direction);
@@ -272,9 +281,11 @@ impl MultiPassEstimator for PhotonMap2Pass {
         let Some(x) = at else {
             return emitted;
         };
-        if self.max_depth == 0 {
+        if x.bounces >= self.max_depth {
             return emitted;
         }
+        // Bounces that paths of the depth leave after x and the chain.
+        let left = self.max_depth - 1 - x.bounces;
         let mut radiance = emitted + x.direct_light(scene, sampler, counts);
         // Caustics: the caustic map at x.
         radiance += x.beta
@@ -286,17 +297,18 @@ impl MultiPassEstimator for PhotonMap2Pass {
                 x.frame.to_local(x.hit.normal),
                 &x.bsdf,
                 x.wo,
+                left,
             )
             * maps.per_photon;
         // Indirect light: a final gather ray reads the global map at x'.
-        if self.max_depth > 1
+        if left > 0
             && let Some(sample) = x.bsdf.sample(x.wo, x.u_lobe, x.u_bsdf)
             && !sample.specular
         {
             counts.bounce += 1;
             let gather = x.hit.spawn_ray(x.frame.to_world(sample.wi));
-            if let Some((y, arrived, chain)) = self.through_specular(scene, gather, sampler, counts)
-            {
+            let found = self.through_specular(scene, gather, left - 1, sampler, counts);
+            if let Some((y, arrived, chain, bounces)) = found {
                 let bsdf_y = scene.bsdf_at(&y);
                 let frame_y = scene.shading_frame(&y);
                 let wo_y = frame_y.to_local(-arrived);
@@ -314,6 +326,7 @@ impl MultiPassEstimator for PhotonMap2Pass {
                     ng_y,
                     &bsdf_y,
                     wo_y,
+                    left - 1 - bounces,
                 );
                 radiance += x.beta * sample.weight * chain * reflected * maps.per_photon;
             }

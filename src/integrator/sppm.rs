@@ -209,16 +209,20 @@ impl MultiPassEstimator for PhotonMapper {
         let Some(x) = at else {
             return emitted;
         };
-        if self.max_depth == 0 {
+        if x.bounces >= self.max_depth {
             return emitted;
         }
-        // Everything after a bounce: the density estimate.
+        // Everything after a bounce: the density estimate, over the photons
+        // whose paths, with x and the chain before it, stay within the depth.
+        let most = self.max_depth - 1 - x.bounces;
         let mut sum = Rgb::ZERO;
         let ng = x.frame.to_local(x.hit.normal);
         let side = Side::of(x.facing, x.bsdf.is_transmissive());
         iteration.map.for_each_near(x.hit.point, side, |p| {
-            let wi = x.frame.to_local(p.wi);
-            sum += x.bsdf.eval(x.wo, wi) * p.power * photon_shading_factor(wi, ng);
+            if p.bounces <= most {
+                let wi = x.frame.to_local(p.wi);
+                sum += x.bsdf.eval(x.wo, wi) * p.power * photon_shading_factor(wi, ng);
+            }
         });
         emitted + x.direct_light(scene, sampler, counts) + x.beta * sum * iteration.normalisation
     }

@@ -274,7 +274,7 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
     }
 
     /// The `k` photons nearest `point` within the map's radius (Jensen's
-    /// lookup), in `nearest`, sorted by distance; returns how many were
+    /// lookup) among those it may `keep`, in `nearest`, sorted by distance; returns how many were
     /// found and the squared radius of the disc that holds them (the map's
     /// radius when fewer than `k` were found).
     pub fn nearest(
@@ -282,11 +282,15 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
         point: Vec3A,
         side: Side,
         k: usize,
+        keep: impl Fn(&P) -> bool,
         nearest: &mut [(f32, u32); MAX_K],
     ) -> (usize, f32) {
         let k = k.clamp(1, MAX_K);
         let mut found = 0usize;
         self.visit_near(point, side, |index, p| {
+            if !keep(p) {
+                return;
+            }
             let d2 = (p.position() - point).length_squared();
             if found == k && d2 >= nearest[k - 1].0 {
                 return;
@@ -331,8 +335,9 @@ mod tests {
             .map(|_| Photon {
                 point: Vec3A::new(next(), next(), next()) * 3.0 - Vec3A::ONE,
                 wi: Vec3A::Z,
-                normal: Vec3A::Z,
                 power: Rgb::ONE,
+                normal: Vec3A::Z,
+                bounces: 1,
             })
             .collect()
     }
@@ -378,7 +383,7 @@ mod tests {
         let map = PhotonMap::build(photons.clone(), 0.3);
         let mut nearest = [(0.0f32, 0u32); MAX_K];
         for q in photons.iter().step_by(97).map(|p| p.point) {
-            let (found, r2) = map.nearest(q, Side::Facing(Vec3A::Z), 10, &mut nearest);
+            let (found, r2) = map.nearest(q, Side::Facing(Vec3A::Z), 10, |_| true, &mut nearest);
             let mut d: Vec<f32> = photons
                 .iter()
                 .map(|p| (p.point - q).length_squared())
