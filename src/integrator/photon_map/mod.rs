@@ -10,7 +10,7 @@ use super::RayCounts;
 use super::light::importance_weight;
 use super::mis::MisHeuristic;
 use crate::accel::{NO_LIGHT, SurfaceHit};
-use crate::math::{Frame, Ray, Rgb, ray_between};
+use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Sampler, SamplerKind};
 use crate::scene::Scene;
@@ -360,7 +360,7 @@ pub fn camera_to_diffuse(
             break;
         }
         if !bsdf.is_specular() && !bsdf.gathers_photons() {
-            emitted += beta * glossy_light_sample(scene, &hit, &frame, &bsdf, wo, sampler, counts);
+            emitted += beta * light_sample(scene, &hit, &frame, &bsdf, wo, true, sampler, counts);
         }
         let Some(sample) = bsdf.sample(wo, u_lobe, u_bsdf) else {
             break;
@@ -383,14 +383,17 @@ fn found_light_weight(glossy: Option<(f32, Vec3A)>, light_pdf: impl FnOnce(Vec3A
     })
 }
 
-/// A light sample at a glossy vertex of a camera chain, weighed against
-/// the BSDF sample that could have found the same light.
-fn glossy_light_sample(
+/// One light sample's light reflected at `hit` towards `wo`; `weighed`
+/// against the BSDF sample that could have found the same light (at a
+/// glossy vertex of a camera chain), or alone (where the chain ends).
+#[allow(clippy::too_many_arguments)]
+fn light_sample(
     scene: &Scene,
     hit: &SurfaceHit,
     frame: &Frame,
     bsdf: &Bsdf,
     wo: Vec3A,
+    weighed: bool,
     sampler: &mut Sampler,
     counts: &mut RayCounts,
 ) -> Rgb {
@@ -411,9 +414,9 @@ fn glossy_light_sample(
     {
         return Rgb::ZERO;
     }
-    let weight = match ls.delta {
-        true => 1.0,
-        false => MisHeuristic::Power.weight(ls.pdf, bsdf.pdf(wo, wi)),
+    let weight = match weighed && !ls.delta {
+        true => MisHeuristic::Power.weight(ls.pdf, bsdf.pdf(wo, wi)),
+        false => 1.0,
     };
     f * ls.radiance * (wi.z.abs() * weight / ls.pdf)
 }
@@ -427,26 +430,8 @@ impl DiffuseHit {
         sampler: &mut Sampler,
         counts: &mut RayCounts,
     ) -> Rgb {
-        let u_select = sampler.next_1d_for(Domain::Light);
-        let u_light = sampler.next_2d_for(Domain::Light);
-        let hit = &self.hit;
-        let Some(ls) = scene.lights.sample(hit.point, u_select, u_light) else {
-            return Rgb::ZERO;
-        };
-        let wi = self.frame.to_local(ls.wi);
-        let f = self.bsdf.eval(self.wo, wi);
-        if !(f.max_element() > 0.0) {
-            return Rgb::ZERO;
-        }
-        counts.shadow += 1;
-        let shadow = ray_between(
-            hit.point, hit.error, hit.normal, ls.point, ls.error, ls.normal,
-        )
-        .at_time(hit.time);
-        if scene.geometry.occluded(&shadow) {
-            return Rgb::ZERO;
-        }
-        self.beta * f * ls.radiance * (wi.z.abs() / ls.pdf)
+        let (hit, frame, bsdf) = (&self.hit, &self.frame, &self.bsdf);
+        self.beta * light_sample(scene, hit, frame, bsdf, self.wo, false, sampler, counts)
     }
 }
 
