@@ -405,6 +405,29 @@ impl Bitmap {
         }
     }
 
+    /// Asks the cache for texels (`x`, `y`) and (`x` + 1, `y`), the row of a
+    /// bilinear lookup (nothing past the row's end).
+    #[inline(always)]
+    pub fn prefetch(&self, x: usize, y: usize) {
+        let x1 = (x + 1).min(self.width - 1);
+        match &self.texels {
+            Texels::Bytes { bytes, .. } => {
+                for x in [x, x1] {
+                    if let Some(b) = bytes.get(3 * self.tiled_index(x, y)) {
+                        crate::math::prefetch(b);
+                    }
+                }
+            }
+            Texels::Floats(texels) => {
+                for x in [x, x1] {
+                    if let Some(t) = texels.get(y * self.width + x) {
+                        crate::math::prefetch(t);
+                    }
+                }
+            }
+        }
+    }
+
     /// Bytes the texels take.
     pub fn memory_bytes(&self) -> usize {
         match &self.texels {

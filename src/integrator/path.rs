@@ -68,6 +68,9 @@ impl PathObserver for NoObserver {
 struct PendingShadow {
     ray: Ray,
     added: Rgb,
+    /// Where `added` is still to be multiplied by the environment's
+    /// radiance, its map coordinates ([`Lights::sample_deferred`]).
+    environment_uv: Option<Vec2>,
     /// The light the ray ends on.
     light: u32,
 }
@@ -95,8 +98,17 @@ impl PendingShadow {
         counts: &mut RayCounts,
     ) -> Rgb {
         match pending {
-            Some(shadow) if shadow.visible::<PLAIN>(scene, counts) => shadow.added,
+            Some(shadow) if shadow.visible::<PLAIN>(scene, counts) => shadow.added(scene),
             _ => Rgb::ZERO,
+        }
+    }
+
+    /// What the light adds where the shadow ray is clear.
+    #[inline(always)]
+    fn added(&self, scene: &Scene) -> Rgb {
+        match (self.environment_uv, scene.lights.environment()) {
+            (Some(uv), Some(environment)) => self.added * environment.le_at(uv),
+            _ => self.added,
         }
     }
 }
@@ -367,10 +379,19 @@ impl PathTracer {
             if self.nee && !(!DIFFUSE_ONLY && bsdf.is_specular()) {
                 let light =
                     self.sample_light::<DIFFUSE_ONLY>(scene, &hit, &frame, &bsdf, wo, beta, &u);
-                if let Some((shadow, ls, f, weight)) = light {
+                if let Some((shadow, mut ls, f, weight)) = light {
                     if O::IN_ORDER {
                         let visible = shadow.visible::<PLAIN>(scene, counts);
-                        let added = if visible { shadow.added } else { Rgb::ZERO };
+                        let added = if visible {
+                            shadow.added(scene)
+                        } else {
+                            Rgb::ZERO
+                        };
+                        if let (Some(uv), Some(e)) =
+                            (shadow.environment_uv, scene.lights.environment())
+                        {
+                            ls.radiance = e.le_at(uv);
+                        }
                         observer.light_sample(&ls, f, weight, visible, added);
                         radiance += added;
                     } else {
@@ -445,7 +466,9 @@ impl PathTracer {
         beta: Rgb,
         u: &VertexNumbers,
     ) -> Option<(PendingShadow, LightSample, Rgb, f32)> {
-        let ls = scene.lights.sample(hit.point, u.light_select, u.light)?;
+        let (ls, deferred) = scene
+            .lights
+            .sample_deferred(hit.point, u.light_select, u.light)?;
         let wi = frame.to_local(ls.wi);
         let f = eval::<DIFFUSE_ONLY>(bsdf, wo, wi);
         if f.max_element() <= 0.0 {
@@ -459,6 +482,7 @@ impl PathTracer {
         let shadow = PendingShadow {
             ray: ls.shadow_ray_from(hit),
             added: beta * f * ls.radiance * (wi.z.abs() * weight / ls.pdf),
+            environment_uv: deferred,
             light: ls.light,
         };
         Some((shadow, ls, f, weight))

@@ -110,9 +110,10 @@ impl Environment {
         }
     }
 
-    /// Radiance at map coordinates `uv`.
+    /// Radiance at map coordinates `uv` (as [`Environment::sample_direction`]
+    /// gives them).
     #[inline]
-    fn le_at(&self, uv: Vec2) -> Rgb {
+    pub fn le_at(&self, uv: Vec2) -> Rgb {
         match &self.radiance {
             Radiance::Constant(c) => *c * self.scale,
             Radiance::Map(map) => lookup(map, uv) * self.scale,
@@ -122,9 +123,17 @@ impl Environment {
     /// A direction with its radiance and density in solid angle.
     #[inline]
     pub fn sample(&self, u: Vec2) -> Option<(Vec3A, Rgb, f32)> {
+        let (d, uv, pdf) = self.sample_direction(u)?;
+        Some((d, self.le_at(uv), pdf))
+    }
+
+    /// A direction, its map coordinates (for [`Environment::le_at`]) and
+    /// its density in solid angle.
+    #[inline]
+    pub fn sample_direction(&self, u: Vec2) -> Option<(Vec3A, Vec2, f32)> {
         let Some(distribution) = &self.distribution else {
             let d = square_to_uniform_sphere(u);
-            return Some((d, self.le(d), 1.0 / (4.0 * PI)));
+            return Some((d, direction_to_uv(self.to_local * d), 1.0 / (4.0 * PI)));
         };
         let (uv, pdf_uv) = distribution.sample(u);
         let local = uv_to_direction(uv);
@@ -138,7 +147,19 @@ impl Environment {
         // The radiance from the same coordinates (one atan2 and acos).
         let uv = direction_to_uv(self.to_local * d);
         let pdf = pdf_at(distribution, uv);
-        (pdf > 0.0).then(|| (d, self.le_at(uv), pdf))
+        (pdf > 0.0).then_some((d, uv, pdf))
+    }
+
+    /// Asks the cache for the texels that [`Environment::le_at`] reads at
+    /// `uv`: a caller that looks the radiance up only once its shadow ray
+    /// is found clear fetches them meanwhile.
+    #[inline(always)]
+    pub fn prefetch_le(&self, uv: Vec2) {
+        if let Radiance::Map(map) = &self.radiance {
+            let (x, y) = texel_corner(map, uv);
+            map.prefetch(x, y);
+            map.prefetch(x, (y + 1).min(map.height - 1));
+        }
     }
 
     /// Asks the cache for the table entry that [`Environment::sample`]
@@ -240,6 +261,21 @@ fn lookup(map: &Bitmap, uv: Vec2) -> Rgb {
     let t = |x: usize, y: usize| map.at(x, y);
     (t(x0, y0) * (1.0 - fx) + t(x1, y0) * fx) * (1.0 - fy)
         + (t(x0, y1) * (1.0 - fx) + t(x1, y1) * fx) * fy
+}
+
+/// The texel at the top left of [`lookup`]'s 2 × 2 at `uv` (in range).
+#[inline(always)]
+fn texel_corner(map: &Bitmap, uv: Vec2) -> (usize, usize) {
+    let (w, h) = (map.width, map.height);
+    let x = (uv.x * w as f32 - 0.5).floor();
+    let y = (uv.y * (h.max(2) - 1) as f32)
+        .floor()
+        .clamp(0.0, (h.max(2) - 2) as f32);
+    // Casts saturate: a non-finite uv lands on a corner, harmlessly.
+    (
+        (x as i64).rem_euclid(w as i64) as usize,
+        (y as usize).min(h - 1),
+    )
 }
 
 /// Mitsuba's lat-long coordinates of a local direction.
