@@ -121,6 +121,25 @@ impl Piecewise1D {
         }
     }
 
+    /// Asks the cache for the cells that [`Piecewise1D::sample`] reads
+    /// after the guide entry for `u`, which must be cached by now (a
+    /// [`Piecewise1D::prefetch`] some time before): where one cell holds
+    /// much of the mass, the guide points far from its own entry.
+    #[inline(always)]
+    pub fn prefetch_guided(&self, u: f32) {
+        let n = self.len();
+        let k = ((u * n as f32) as usize).min(n.saturating_sub(1));
+        if let Some(cell) = self.cells.get(k) {
+            let i = cell.guide as usize;
+            if let Some(first) = self.cells.get(i) {
+                crate::math::prefetch(first);
+            }
+            if let Some(next) = self.cells.get(i + 1) {
+                crate::math::prefetch(next);
+            }
+        }
+    }
+
     /// The density at x.
     #[inline]
     pub fn pdf(&self, x: f32) -> f32 {
@@ -174,6 +193,14 @@ impl Piecewise2D {
     pub fn prefetch(&self, u: Vec2) {
         let (_, _, row) = self.marginal.sample(u.y);
         self.rows[row].prefetch(u.x);
+    }
+
+    /// The second step of [`Piecewise2D::prefetch`], some time after it:
+    /// the cells its row's guide entry points at.
+    #[inline(always)]
+    pub fn prefetch_guided(&self, u: Vec2) {
+        let (_, _, row) = self.marginal.sample(u.y);
+        self.rows[row].prefetch_guided(u.x);
     }
 
     /// The density at `p`.

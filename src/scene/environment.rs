@@ -172,6 +172,15 @@ impl Environment {
         }
     }
 
+    /// The second step of [`Environment::prefetch_sample`], once its entry
+    /// has arrived: the cells that entry points at.
+    #[inline(always)]
+    pub fn prefetch_sample_guided(&self, u: Vec2) {
+        if let Some(distribution) = &self.distribution {
+            distribution.prefetch_guided(u);
+        }
+    }
+
     /// Density of [`Environment::sample`] at direction `d`.
     #[inline]
     pub fn pdf(&self, d: Vec3A) -> f32 {

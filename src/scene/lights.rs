@@ -423,6 +423,24 @@ impl Lights {
         }
     }
 
+    /// The second step of [`Lights::prefetch_sample`] with the same numbers,
+    /// some time after it (the path tracer: once the ray it traced meanwhile
+    /// has hit): the table cells that the first step's entry points at.
+    #[inline(always)]
+    pub fn prefetch_sample_guided(&self, u_select: f32, u: Vec2) {
+        let (Some(environment), Some(table)) = (&self.environment, &self.direct) else {
+            return;
+        };
+        let index = if self.has_choice() {
+            table.sample(u_select).0
+        } else {
+            0
+        };
+        if index >= self.lights.len() {
+            environment.prefetch_sample_guided(u);
+        }
+    }
+
     /// Chooses a light by power and samples a particle leaving it (light tracing).
     #[inline]
     pub fn sample_emission(
