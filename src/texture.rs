@@ -405,6 +405,26 @@ impl Bitmap {
         }
     }
 
+    /// Texels (x0, y0), (x1, y0), (x0, y1) and (x1, y1): a bilinear
+    /// lookup's, with one match on how they are kept.
+    #[inline(always)]
+    fn quad(&self, [x0, x1]: [usize; 2], [y0, y1]: [usize; 2]) -> [Rgb; 4] {
+        let corners = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)];
+        match &self.texels {
+            Texels::Bytes { bytes, decode } => corners.map(|(x, y)| {
+                let i = 3 * self.tiled_index(x, y);
+                Rgb::new(
+                    decode[bytes[i] as usize],
+                    decode[bytes[i + 1] as usize],
+                    decode[bytes[i + 2] as usize],
+                )
+            }),
+            Texels::Floats(texels) => {
+                corners.map(|(x, y)| Rgb::from_array(texels[y * self.width + x]))
+            }
+        }
+    }
+
     /// Asks the cache for texels (`x`, `y`) and (`x` + 1, `y`), the row of a
     /// bilinear lookup (nothing past the row's end).
     #[inline(always)]
@@ -438,19 +458,7 @@ impl Bitmap {
 
     #[inline]
     fn texel(&self, x: i64, y: i64, wrap: Wrap) -> Rgb {
-        let map = |i: i64, n: usize| -> usize {
-            let n = n as i64;
-            let i = match wrap {
-                Wrap::Repeat => i.rem_euclid(n),
-                Wrap::Clamp => i.clamp(0, n - 1),
-                Wrap::Mirror => {
-                    let m = i.rem_euclid(2 * n);
-                    if m < n { m } else { 2 * n - 1 - m }
-                }
-            };
-            i as usize
-        };
-        self.at(map(x, self.width), map(y, self.height))
+        self.at(wrapped(x, self.width, wrap), wrapped(y, self.height, wrap))
     }
 
     /// The bitmap at texture coordinates `uv` (texel centres at
@@ -467,13 +475,40 @@ impl Bitmap {
             Filter::Bilinear => {
                 let (x0, y0) = (x.floor(), y.floor());
                 let (fx, fy) = (x - x0, y - y0);
-                let (x0, y0) = (x0 as i64, y0 as i64);
-                let top = self.texel(x0, y0, wrap) * (1.0 - fx) + self.texel(x0 + 1, y0, wrap) * fx;
-                let bottom = self.texel(x0, y0 + 1, wrap) * (1.0 - fx)
-                    + self.texel(x0 + 1, y0 + 1, wrap) * fx;
+                let [x0, x1] = wrapped_pair(x0 as i64, self.width, wrap);
+                let [y0, y1] = wrapped_pair(y0 as i64, self.height, wrap);
+                let [a, b, c, d] = self.quad([x0, x1], [y0, y1]);
+                let top = a * (1.0 - fx) + b * fx;
+                let bottom = c * (1.0 - fx) + d * fx;
                 top * (1.0 - fy) + bottom * fy
             }
         }
+    }
+}
+
+/// Texel index `i` of a row or column of `n` wrapped into it.
+#[inline(always)]
+fn wrapped(i: i64, n: usize, wrap: Wrap) -> usize {
+    let n = n as i64;
+    let i = match wrap {
+        Wrap::Repeat => i.rem_euclid(n),
+        Wrap::Clamp => i.clamp(0, n - 1),
+        Wrap::Mirror => {
+            let m = i.rem_euclid(2 * n);
+            if m < n { m } else { 2 * n - 1 - m }
+        }
+    };
+    i as usize
+}
+
+/// Texels `i` and `i` + 1 wrapped: inside the image (almost every
+/// lookup), without the divisions of [`wrapped`].
+#[inline(always)]
+fn wrapped_pair(i: i64, n: usize, wrap: Wrap) -> [usize; 2] {
+    if i >= 0 && i + 1 < n as i64 {
+        [i as usize, i as usize + 1]
+    } else {
+        [wrapped(i, n, wrap), wrapped(i + 1, n, wrap)]
     }
 }
 
