@@ -16,7 +16,8 @@ Neither is given a thread count: both use every core.
 rendered at their own resolution and max_depth.
 
 `--rmse` measures time to equal error instead, on the shipped scenes at a
-reduced resolution (`--rmse-size`): a reference by Mitsuba 3 at
+reduced resolution (`--rmse-size`), and on the `--extra` files at their
+resolution divided by `--rmse-extra-divisor`: a reference by Mitsuba 3 at
 `--reference-spp` (seed 7), then both renderers at 1, 2, 4, ... spp up to
 `--max-spp`, each sampler (Mitsuba: independent, multijitter; tracelab:
 independent, sobol), RMSE against the reference, and the time to reach
@@ -53,15 +54,21 @@ def main():
     ap.add_argument("--extra", nargs="*", default=[])
     ap.add_argument("--rmse", action="store_true", help="time to equal RMSE instead (see above)")
     ap.add_argument("--rmse-size", default="veach-mis=320x180,veach-bidir=128x128,cornell-box=128x128")
+    ap.add_argument("--rmse-extra-divisor", type=int, default=8,
+                    help="--rmse on --extra files: their resolution divided by this")
     ap.add_argument("--reference-spp", type=int, default=8192)
     ap.add_argument("--max-spp", type=int, default=1024)
     args = ap.parse_args()
     mi.set_variant(args.variant)
     if args.rmse:
-        for item in args.rmse_size.split(","):
+        for item in filter(None, args.rmse_size.split(",")):
             name, size = item.split("=")
             w, h = (int(v) for v in size.split("x"))
-            time_to_rmse(args, name, w, h)
+            time_to_rmse(args, name, os.path.join(REPO, "scenes", name, "scene.xml"), w, h, True)
+        for path in args.extra:
+            w, h = mi.load_file(load_copy(path)).sensors()[0].film().size()
+            d = args.rmse_extra_divisor
+            time_to_rmse(args, path, os.path.abspath(path), w // d, h // d, False)
         return
     print("scene | resolution | spp | Mitsuba load s | Mitsuba render s | tracelab load s | tracelab render s | tracelab process s | render ratio")
     runs = [(name, os.path.join(REPO, "scenes", name, "scene.xml"), size)
@@ -93,18 +100,28 @@ def main():
               f"{ours_render:.2f} | {process:.2f} | {render / ours_render:.2f}")
 
 
-def time_to_rmse(args, name, w, h):
-    path = os.path.join(REPO, "scenes", name, "scene.xml")
+def time_to_rmse(args, name, path, w, h, parameters):
+    """`parameters`: the file takes resx, resy and spp as Bitterli's Mitsuba 3
+    files do; otherwise (his 0.6 interiors) a copy gets them written in."""
 
     def mitsuba(spp, seed, sampler="independent", warm_up=True):
         # The files fix their sampler: another is read from a copy beside them.
         file = path
+        text = open(load_copy(path)).read()
         if sampler != "independent":
+            text = text.replace('<sampler type="independent"', f'<sampler type="{sampler}"')
+        if not parameters:
+            for key, value in (("width", w), ("height", h), ("sampleCount|sample_count", spp)):
+                text = re.sub(rf'(<integer name="(?:{key})" value=")\d+', rf"\g<1>{value}", text)
+        if text != open(path).read():
             file = os.path.join(os.path.dirname(path), f".mitsuba3_{sampler}_scene.xml")
             with open(file, "w") as f:
-                f.write(open(path).read().replace('<sampler type="independent"', f'<sampler type="{sampler}"'))
+                f.write(text)
         try:
-            scene = mi.load_file(file, integrator="path", resx=w, resy=h, spp=spp)
+            if parameters:
+                scene = mi.load_file(file, integrator="path", resx=w, resy=h, spp=spp)
+            else:
+                scene = mi.load_file(file)
         finally:
             if file != path:
                 os.remove(file)
@@ -115,8 +132,10 @@ def time_to_rmse(args, name, w, h):
         return image, time.perf_counter() - start
 
     def tracelab(spp, sampler, filter_sampling="splat"):
+        size = (["-D", f"resx={w}", "-D", f"resy={h}"] if parameters
+                else ["--width", str(w), "--height", str(h)])
         out = subprocess.run(
-            [args.tracelab, "render", path, "-D", f"resx={w}", "-D", f"resy={h}",
+            [args.tracelab, "render", path, *size,
              "--integrator", "path", "--sampler", sampler, "--spp", str(spp),
              "--filter-sampling", filter_sampling,
              "--out", "/tmp/mitsuba_scenes_rmse.exr"],
@@ -135,10 +154,11 @@ def time_to_rmse(args, name, w, h):
     runs = [("mitsuba independent", lambda n: mitsuba(n, 1)),
             ("mitsuba multijitter", lambda n: mitsuba(n, 1, "multijitter")),
             ("tracelab independent", lambda n: tracelab(n, "independent")),
-            ("tracelab sobol", lambda n: tracelab(n, "sobol")),
-            # The filter importance-sampled, as before 2026-12-06.
-            ("tracelab independent, importance", lambda n: tracelab(n, "independent", "importance")),
-            ("tracelab sobol, importance", lambda n: tracelab(n, "sobol", "importance"))]
+            ("tracelab sobol", lambda n: tracelab(n, "sobol"))]
+    if parameters:
+        # The filter importance-sampled, as before 2026-12-06.
+        runs += [("tracelab independent, importance", lambda n: tracelab(n, "independent", "importance")),
+                 ("tracelab sobol, importance", lambda n: tracelab(n, "sobol", "importance"))]
     curves = {}
     for label, render in runs:
         points, spp = [], 1
