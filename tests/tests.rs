@@ -21,6 +21,8 @@ mod principled;
 mod emission_textures;
 // Mitsuba sensors: the clips the importer does not apply are warnings.
 mod import_sensor;
+// What a shape gets where the file leaves its BSDF out.
+mod import_defaults;
 // What Mitsuba 3's documentation scenes use: textured roughness, references.
 mod import_mitsuba_docs;
 // White furnace: closed sphere with known radiance Le / (1 - albedo).

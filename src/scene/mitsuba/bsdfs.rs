@@ -38,12 +38,18 @@ impl<'a> Importer<'a> {
                 }
                 m
             }
-            // Mitsuba's default: a one-sided diffuse of reflectance 0.5.
+            // Mitsuba's default: a one-sided diffuse of reflectance 0.5, or
+            // of 0 on an emitter (Mitsuba 3 and 0.6 alike: a lamp given no
+            // BSDF reflects nothing).
             None => self.built(
                 "default",
                 MaterialDesc {
                     kind: MaterialKind::RoughDiffuse,
-                    albedo: Some([0.5; 3]),
+                    albedo: Some(if emission.is_some() {
+                        [0.0; 3]
+                    } else {
+                        [0.5; 3]
+                    }),
                     alpha: Some(0.0),
                     ..Default::default()
                 },
