@@ -362,11 +362,22 @@ impl Lights {
         u_select: f32,
         u: Vec2,
     ) -> Option<LightSample> {
-        let table = self.selection.as_ref()?;
         Some(
-            self.sample_from_table::<false>(table, reference, u_select, u)?
+            self.sample_as_emitted_deferred::<false>(reference, u_select, u)?
                 .0,
         )
+    }
+
+    /// [`Lights::sample_as_emitted`]; with `DEFER`, as
+    /// [`Lights::sample_deferred`] leaves the environment's radiance.
+    #[inline(always)]
+    pub fn sample_as_emitted_deferred<const DEFER: bool>(
+        &self,
+        reference: Vec3A,
+        u_select: f32,
+        u: Vec2,
+    ) -> Option<(LightSample, Option<Vec2>)> {
+        self.sample_from_table::<DEFER>(self.selection.as_ref()?, reference, u_select, u)
     }
 
     /// A light sample; with `DEFER`, an environment sample's radiance is
@@ -410,17 +421,7 @@ impl Lights {
     /// a cache miss that held 14% of path tracing's time).
     #[inline(always)]
     pub fn prefetch_sample(&self, u_select: f32, u: Vec2) {
-        let (Some(environment), Some(table)) = (&self.environment, &self.direct) else {
-            return;
-        };
-        let index = if self.has_choice() {
-            table.sample(u_select).0
-        } else {
-            0
-        };
-        if index >= self.lights.len() {
-            environment.prefetch_sample(u);
-        }
+        self.prefetch_environment(self.direct.as_ref(), u_select, u, false);
     }
 
     /// The second step of [`Lights::prefetch_sample`] with the same numbers,
@@ -428,7 +429,25 @@ impl Lights {
     /// has hit): the table cells that the first step's entry points at.
     #[inline(always)]
     pub fn prefetch_sample_guided(&self, u_select: f32, u: Vec2) {
-        let (Some(environment), Some(table)) = (&self.environment, &self.direct) else {
+        self.prefetch_environment(self.direct.as_ref(), u_select, u, true);
+    }
+
+    /// [`Lights::prefetch_sample`] and [`Lights::prefetch_sample_guided`]
+    /// (`guided`) for [`Lights::sample_as_emitted`].
+    #[inline(always)]
+    pub fn prefetch_sample_as_emitted(&self, u_select: f32, u: Vec2, guided: bool) {
+        self.prefetch_environment(self.selection.as_ref(), u_select, u, guided);
+    }
+
+    #[inline(always)]
+    fn prefetch_environment(
+        &self,
+        table: Option<&AliasTable>,
+        u_select: f32,
+        u: Vec2,
+        guided: bool,
+    ) {
+        let (Some(environment), Some(table)) = (&self.environment, table) else {
             return;
         };
         let index = if self.has_choice() {
@@ -436,8 +455,13 @@ impl Lights {
         } else {
             0
         };
-        if index >= self.lights.len() {
+        if index < self.lights.len() {
+            return;
+        }
+        if guided {
             environment.prefetch_sample_guided(u);
+        } else {
+            environment.prefetch_sample(u);
         }
     }
 

@@ -475,20 +475,31 @@ impl Bdpt {
         }
         let pl = &cam_local[t - 1];
         if s == 1 {
-            // Next-event estimation from z_{t-1}.
-            let ls = scene
-                .lights
-                .sample_as_emitted(pt.point, pt.u_select, pt.u_connect)?;
+            // Next-event estimation from z_{t-1}. The environment's
+            // radiance is looked up behind a clear shadow ray.
+            let (mut ls, deferred) = scene.lights.sample_as_emitted_deferred::<true>(
+                pt.point,
+                pt.u_select,
+                pt.u_connect,
+            )?;
             let (f, pdf_forward, pdf_reverse) =
                 pt.bsdf.eval_with_pdfs(pl.wo, pl.frame.to_local(ls.wi));
-            let value = pt.beta * f * ls.radiance * (pl.shading_cos(ls.wi) / ls.pdf);
-            if !(value.max_element() > 0.0) {
+            let beta_f = pt.beta * f;
+            let scale = pl.shading_cos(ls.wi) / ls.pdf;
+            if !((beta_f * ls.radiance * scale).max_element() > 0.0) {
                 return None;
             }
             counts.shadow += 1;
             let shadow = ray_between(pt.point, pt.error, pt.normal, ls.point, ls.error, ls.normal)
                 .at_time(time);
             if scene.geometry.occluded(&shadow) {
+                return None;
+            }
+            if let (Some(uv), Some(environment)) = (deferred, scene.lights.environment()) {
+                ls.radiance = environment.le_at(uv);
+            }
+            let value = beta_f * ls.radiance * scale;
+            if !(value.max_element() > 0.0) {
                 return None;
             }
             let (pdf_position, pdf_emission) =

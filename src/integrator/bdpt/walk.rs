@@ -102,6 +102,15 @@ impl Bdpt {
                 ),
                 Transport::Importance => (0.0, sampler.next_2d_for(Domain::Lens)),
             };
+            // The environment's table entries for this vertex's light
+            // sample (made later, by the connections), fetched in two steps
+            // as the path tracer fetches them.
+            let radiance = transport == Transport::Radiance;
+            if radiance {
+                scene
+                    .lights
+                    .prefetch_sample_as_emitted(u_select, u_connect, false);
+            }
             let Some(hit) = scene.geometry.intersect(&ray) else {
                 // A camera subpath that leaves the scene ends on the environment.
                 if transport == Transport::Radiance
@@ -131,6 +140,11 @@ impl Bdpt {
                 }
                 break;
             };
+            if radiance {
+                scene
+                    .lights
+                    .prefetch_sample_as_emitted(u_select, u_connect, true);
+            }
             let wo_world = -ray.direction;
             let index = path.len();
             let previous = path.vertices[index - 1];
