@@ -56,6 +56,10 @@ def main():
     ap.add_argument("--rmse-size", default="veach-mis=320x180,veach-bidir=128x128,cornell-box=128x128")
     ap.add_argument("--rmse-extra-divisor", type=int, default=8,
                     help="--rmse on --extra files: their resolution divided by this")
+    ap.add_argument("--rmse-exclude", nargs="*", default=[],
+                    help="NAME=x0,y0,x1,y1: leave this rectangle (fractions of the image) of "
+                         "the file whose path contains NAME out of every RMSE (the kitchen's "
+                         "blinds, which Mitsuba's ray offset renders as one layer: docs/validation.md)")
     ap.add_argument("--reference-spp", type=int, default=8192)
     ap.add_argument("--max-spp", type=int, default=1024)
     args = ap.parse_args()
@@ -143,8 +147,16 @@ def time_to_rmse(args, name, path, w, h, parameters):
         seconds = float(re.search(r"^spp \d+ \| ([0-9.]+) s", out.stdout + out.stderr, re.M).group(1))
         return np.array(mi.Bitmap("/tmp/mitsuba_scenes_rmse.exr"))[..., :3], seconds
 
+    keep = np.ones((h, w), bool)
+    for item in args.rmse_exclude:
+        key, box = item.split("=")
+        if key in path:
+            x0, y0, x1, y1 = (float(v) for v in box.split(","))
+            keep[int(y0 * h):int(y1 * h), int(x0 * w):int(x1 * w)] = False
+            print(f"{name}: RMSE without x {x0}-{x1}, y {y0}-{y1} of the image")
+
     def rmse(a, b):
-        return float(np.sqrt(np.mean((a - b) ** 2)))
+        return float(np.sqrt(np.mean(((a - b) ** 2)[keep])))
 
     reference, seconds = mitsuba(args.reference_spp, 7, warm_up=False)
     quarter, _ = mitsuba(args.reference_spp // 4, 8, warm_up=False)
