@@ -141,14 +141,18 @@ impl Vcm {
     ) -> Rgb {
         let u_select = sampler.next_1d_for(Domain::Light);
         let u_light = sampler.next_2d_for(Domain::Light);
-        let Some(ls) = scene.lights.sample_as_emitted(at.point, u_select, u_light) else {
+        // The environment's radiance is looked up behind a clear shadow ray.
+        let Some((ls, deferred)) = scene
+            .lights
+            .sample_as_emitted_deferred::<true>(at.point, u_select, u_light)
+        else {
             return Rgb::ZERO;
         };
         let wi = at.frame.to_local(ls.wi);
         let (f, pdf, pdf_reverse) = at.bsdf.eval_with_pdfs(at.wo, wi);
         let cos = at.normal.dot(ls.wi).abs();
-        let value = f * ls.radiance * (wi.z.abs() / ls.pdf);
-        if !(value.max_element() > 0.0) {
+        let scale = wi.z.abs() / ls.pdf;
+        if !((f * ls.radiance * scale).max_element() > 0.0) {
             return Rgb::ZERO;
         }
         let dist2 = ls.distance * ls.distance;
@@ -177,7 +181,11 @@ impl Vcm {
         if scene.geometry.occluded(&shadow) {
             return Rgb::ZERO;
         }
-        value / (1.0 + w_light + w_camera)
+        let radiance = match (deferred, scene.lights.environment()) {
+            (Some(uv), Some(environment)) => environment.le_at(uv),
+            _ => ls.radiance,
+        };
+        f * radiance * scale / (1.0 + w_light + w_camera)
     }
 
     /// s >= 2, t >= 2: a shadow ray from the camera vertex to a vertex of
