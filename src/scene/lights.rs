@@ -362,22 +362,24 @@ impl Lights {
         u_select: f32,
         u: Vec2,
     ) -> Option<LightSample> {
+        let table = self.selection.as_ref()?;
         Some(
-            self.sample_as_emitted_deferred::<false>(reference, u_select, u)?
+            self.sample_from_table::<false>(table, reference, u_select, u)?
                 .0,
         )
     }
 
-    /// [`Lights::sample_as_emitted`]; with `DEFER`, as
-    /// [`Lights::sample_deferred`] leaves the environment's radiance.
+    /// [`Lights::sample_as_emitted`], leaving the environment's radiance as
+    /// [`Lights::sample_deferred`] does (BDPT's and VCM's connections to
+    /// a light look it up behind a clear shadow ray).
     #[inline(always)]
-    pub fn sample_as_emitted_deferred<const DEFER: bool>(
+    pub fn sample_as_emitted_deferred(
         &self,
         reference: Vec3A,
         u_select: f32,
         u: Vec2,
     ) -> Option<(LightSample, Option<Vec2>)> {
-        self.sample_from_table::<DEFER>(self.selection.as_ref()?, reference, u_select, u)
+        self.sample_from_table::<true>(self.selection.as_ref()?, reference, u_select, u)
     }
 
     /// A light sample; with `DEFER`, an environment sample's radiance is

@@ -477,11 +477,10 @@ impl Bdpt {
         if s == 1 {
             // Next-event estimation from z_{t-1}. The environment's
             // radiance is looked up behind a clear shadow ray.
-            let (mut ls, deferred) = scene.lights.sample_as_emitted_deferred::<true>(
-                pt.point,
-                pt.u_select,
-                pt.u_connect,
-            )?;
+            let (mut ls, deferred) =
+                scene
+                    .lights
+                    .sample_as_emitted_deferred(pt.point, pt.u_select, pt.u_connect)?;
             let (f, pdf_forward, pdf_reverse) =
                 pt.bsdf.eval_with_pdfs(pl.wo, pl.frame.to_local(ls.wi));
             let beta_f = pt.beta * f;

@@ -144,7 +144,7 @@ impl Vcm {
         // The environment's radiance is looked up behind a clear shadow ray.
         let Some((ls, deferred)) = scene
             .lights
-            .sample_as_emitted_deferred::<true>(at.point, u_select, u_light)
+            .sample_as_emitted_deferred(at.point, u_select, u_light)
         else {
             return Rgb::ZERO;
         };
