@@ -125,7 +125,10 @@ impl Geometry {
                 });
             }
             travelled += hit.t;
-            r = continue_past(&r, hit.t, hit.point, hit.error, hit.normal);
+            // As the techniques' rays leave surfaces (`--offset fixed:EPS`
+            // shows a fixed epsilon passing over a thin sheet's far face).
+            let error = self.offset.spawn_error(hit.error, hit.normal);
+            r = continue_past(&r, hit.t, hit.point, error, hit.normal);
         }
         None
     }
