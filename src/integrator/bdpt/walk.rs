@@ -105,17 +105,15 @@ impl Bdpt {
             // The environment's table entries for this vertex's light
             // sample (made later, by the connections), fetched in two steps
             // as the path tracer fetches them.
-            let radiance = transport == Transport::Radiance;
-            if radiance {
+            let camera_side = transport == Transport::Radiance;
+            if camera_side {
                 scene
                     .lights
                     .prefetch_sample_as_emitted(u_select, u_connect, false);
             }
             let Some(hit) = scene.geometry.intersect(&ray) else {
                 // A camera subpath that leaves the scene ends on the environment.
-                if transport == Transport::Radiance
-                    && let Some(env) = scene.lights.environment()
-                {
+                if camera_side && let Some(env) = scene.lights.environment() {
                     let previous = path.vertices[path.len() - 1];
                     let distance =
                         crate::scene::light::beyond_bounds(ray.origin, env.center, env.radius);
@@ -140,7 +138,7 @@ impl Bdpt {
                 }
                 break;
             };
-            if radiance {
+            if camera_side {
                 scene
                     .lights
                     .prefetch_sample_as_emitted(u_select, u_connect, true);
