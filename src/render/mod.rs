@@ -196,8 +196,14 @@ impl Session {
         let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
         let film = std::mem::size_of::<crate::film::PixelSums>() as u64;
         let image = 12;
+        let threads = match settings.threads {
+            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            n => n,
+        };
+        // A splat buffer's shards, one per thread as memory allows.
+        let shards = crate::film::splats::shard_count(pixels, threads) as u64;
         let splats = match settings.integrator {
-            Integrator::Splatting(_) => 24,
+            Integrator::Splatting(_) => crate::film::splats::SPLAT_BYTES * shards,
             _ => 0,
         };
         // Camera passes that splat keep the weights each pixel received, and
@@ -217,7 +223,7 @@ impl Session {
         };
         let iteration = match settings.integrator {
             Integrator::MultiPass(crate::integrator::MultiPassIntegrator::Vcm(_)) => {
-                crate::integrator::vcm::Vcm::memory_per_iteration(scene)
+                crate::integrator::vcm::Vcm::memory_per_iteration(scene, threads)
             }
             _ => 0,
         };

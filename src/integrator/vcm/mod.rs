@@ -30,7 +30,7 @@ use super::light::{importance_weight, sample_particle};
 use super::photon_map::{self, PARTICLE_CHUNK, PhotonMap, concat};
 use super::{MisHeuristic, MultiPassEstimator, PathLength, RayCounts, Settings, Technique};
 use crate::accel::{NO_LIGHT, SurfaceHit};
-use crate::film::splats::{PendingSplats, SplatBuffer};
+use crate::film::splats::{self, PendingSplats, SplatBuffer};
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domain, Sampler, SamplerKind};
@@ -233,13 +233,14 @@ impl Vcm {
     /// Bytes an iteration holds besides the film: its splat buffer and the
     /// light vertices with their grid, for the typical four stored vertices
     /// per light subpath (roulette ends most before the depth limit).
-    pub fn memory_per_iteration(scene: &Scene) -> u64 {
+    pub fn memory_per_iteration(scene: &Scene, threads: usize) -> u64 {
         let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
+        let light_image = splats::SPLAT_BYTES * splats::shard_count(pixels, threads) as u64;
         let per_vertex = (std::mem::size_of::<LightVertex>()
             + std::mem::size_of::<MergeVertex>()
             + std::mem::size_of::<Vec3>()
             + 4) as u64;
-        pixels * 24 + u64::from(Self::light_paths(scene)) * (4 * per_vertex + 4)
+        pixels * light_image + u64::from(Self::light_paths(scene)) * (4 * per_vertex + 4)
     }
 
     /// The light subpaths of an iteration: as many as pixels, at most
