@@ -5,7 +5,8 @@
 
 use crate::accel::SurfaceHit;
 use crate::error::{Error, Result};
-use crate::integrator::camera_ray;
+use crate::filter::PixelFilter;
+use crate::integrator::camera_ray_through;
 use crate::integrator::path::PathObserver;
 use crate::integrator::{CameraIntegrator, Integrator, RayCounts};
 use crate::math::Rgb;
@@ -14,6 +15,7 @@ use crate::sampling::Sampler;
 use crate::scene::Scene;
 use crate::scene::light::LightSample;
 use crate::scene::material::BsdfSample;
+use crate::shortcuts::CameraSampling;
 use std::fmt::Write;
 
 /// Lines describing one path, one event each.
@@ -114,7 +116,22 @@ pub fn replay_sample(
     let mut sampler = Sampler::new(settings.sampler, settings.seed, settings.planned_spp)
         .with_domains(settings.domains);
     sampler.start(y * width + x, index);
-    let ray = camera_ray(scene, &mut sampler, x, y, false, tracer.general);
+    // The film position as the render drew it: uniform in the pixel where
+    // its samples are splatted through the filter, else from the filter.
+    let splatted = crate::render::splats_through_filter(scene, settings, false);
+    let position_filter = match splatted {
+        true => PixelFilter::Box,
+        false => scene.camera.filter,
+    };
+    let (ray, _) = camera_ray_through(
+        scene,
+        &mut sampler,
+        x,
+        y,
+        false,
+        tracer.general,
+        position_filter,
+    );
     let mut log = PathLog {
         scene,
         lines: vec![format!(
@@ -130,10 +147,15 @@ pub fn replay_sample(
         )],
     };
     // The camera ray tests what the render's does.
-    let pixel = scene
+    let sampling = CameraSampling::of(scene.camera.filter, splatted, false);
+    let mut pixel = scene
         .primary_candidates()
+        .filter(|_| sampling.lists_apply())
         .map(|p| p.pixel(y * scene.camera.width + x))
         .unwrap_or_default();
+    pixel.seen_emission = pixel
+        .seen_emission
+        .filter(|_| sampling.seen_emission_applies());
     let value = tracer.radiance_observed(
         scene,
         ray,

@@ -96,3 +96,60 @@ fn camera_ray_candidates_and_shadow_voxels_change_no_pixel() {
     without_voxels.shortcuts = without_voxels.shortcuts.without_shadow_voxels();
     assert_eq!(with_both, render(without_voxels));
 }
+
+/// With a tent filter whose samples are splatted (drawn uniformly in their
+/// pixel), camera rays still test their pixel's candidates only, and the
+/// seen emission, a box filter's pixel integral, is not read: the film is
+/// bit-identical to the one without lists. Were the seen emission read, the
+/// light's rim would differ.
+#[test]
+fn splatted_samples_use_the_lists_but_not_the_seen_emission() {
+    let mut scene = cornell_box();
+    scene.set_resolution(48, 40);
+    let mut camera = scene.camera.clone();
+    camera.filter = tracelab::filter::PixelFilter::tent();
+    scene.set_camera(camera);
+    let lists = scene
+        .primary_candidates()
+        .expect("lists with a tent filter");
+    assert!(lists.pixels_with_seen_emission() > 0);
+    let render = |scene: tracelab::scene::Scene| {
+        let (snapshot, _) = render_with(
+            scene,
+            Integrator::from(PathTracer::default()),
+            SamplerKind::Sobol,
+            16,
+            3,
+            2,
+            16,
+        );
+        snapshot
+            .image
+            .pixels
+            .iter()
+            .flat_map(|p| p.map(f32::to_bits))
+            .collect::<Vec<_>>()
+    };
+    let mut without_lists = scene.clone();
+    without_lists.shortcuts = without_lists.shortcuts.without_primary_candidates();
+    assert_eq!(render(scene.clone()), render(without_lists));
+    let settings = tracelab::render::RenderSettings {
+        integrator: Integrator::from(PathTracer::default()),
+        sampler: SamplerKind::Sobol,
+        seed: 3,
+        planned_spp: 16,
+        threads: 2,
+        adaptive: None,
+        domains: Default::default(),
+        clamp: None,
+        filter_sampling: Default::default(),
+    };
+    let session = tracelab::render::Session::new(std::sync::Arc::new(scene.clone()), settings)
+        .expect("session starts");
+    let report = session.shortcut_report().join("\n");
+    assert!(
+        report.contains("camera rays: their pixel's candidate triangles only"),
+        "{report}"
+    );
+    assert!(report.contains("lights seen directly: sampled"), "{report}");
+}

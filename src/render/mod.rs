@@ -21,7 +21,7 @@ use crate::math::{Ray, Rgb};
 use crate::sampling::hash::hash_combine;
 use crate::sampling::{Domains, Sampler, SamplerKind};
 use crate::scene::Scene;
-use crate::shortcuts::PrimaryPixel;
+use crate::shortcuts::{CameraSampling, PrimaryPixel};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -331,10 +331,7 @@ impl Session {
     /// splatted through the scene's filter: the one rule of
     /// [`Session::splats_camera_samples`] and the passes.
     fn splats_through_filter(&self, deterministic: bool) -> bool {
-        self.settings.filter_sampling == FilterSampling::Splat
-            && filtered::can_splat(self.scene.camera.filter)
-            && self.settings.adaptive.is_none()
-            && !deterministic
+        splats_through_filter(&self.scene, &self.settings, deterministic)
     }
 
     /// Why the technique could not run, if it could not.
@@ -409,12 +406,16 @@ impl Session {
         let settings = &self.settings;
         let general = matches!(settings.integrator, Integrator::Camera(e) if e.is_general());
         let width = self.film.width();
-        let primary = scene.primary_candidates();
         // Samples uniform in their pixels, splatted through the filter
         // (crate::film::filtered), or drawn from it and kept in their pixel.
         let filter = scene.camera.filter;
         let splat = self.splats_through_filter(deterministic);
         let position_filter = if splat { PixelFilter::Box } else { filter };
+        let sampling = CameraSampling::of(filter, splat, deterministic);
+        let primary = scene
+            .primary_candidates()
+            .filter(|_| sampling.lists_apply());
+        let seen_emission = sampling.seen_emission_applies();
         let aprons = PassAprons::new(self.film.tiles().len(), splat);
         self.pool.install(|| {
             self.film
@@ -471,7 +472,8 @@ impl Session {
                         // sampler, it runs beside the path before it instead
                         // of holding up its own.
                         let end = begin + count;
-                        let known = primary.map(|p| p.pixel(pixel_index)).unwrap_or_default();
+                        let mut known = primary.map(|p| p.pixel(pixel_index)).unwrap_or_default();
+                        known.seen_emission = known.seen_emission.filter(|_| seen_emission);
                         let through = |s: &mut Sampler| {
                             camera_ray_through(
                                 scene,
@@ -566,8 +568,14 @@ impl Session {
     /// Which small-scene shortcuts apply to this render, or why not, one
     /// line each ([`Scene::shortcut_report`]).
     pub fn shortcut_report(&self) -> Vec<String> {
+        let deterministic = self.settings.integrator.is_deterministic();
+        let sampling = CameraSampling::of(
+            self.scene.camera.filter,
+            self.splats_through_filter(deterministic),
+            deterministic,
+        );
         self.scene
-            .shortcut_report(self.settings.integrator.shortcuts_used())
+            .shortcut_report(self.settings.integrator.shortcuts_used(), sampling)
     }
 
     /// The fewest and the most samples any pixel has.
@@ -626,6 +634,20 @@ pub fn clamp_sample(value: &mut Rgb, limit: f32) -> bool {
     } else {
         false
     }
+}
+
+/// Whether a render's camera samples, `deterministic` or not, are splatted
+/// through the scene's filter (drawn uniformly in their pixel), the rule
+/// of the passes and of [`crate::replay`].
+pub(crate) fn splats_through_filter(
+    scene: &Scene,
+    settings: &RenderSettings,
+    deterministic: bool,
+) -> bool {
+    settings.filter_sampling == FilterSampling::Splat
+        && filtered::can_splat(scene.camera.filter)
+        && settings.adaptive.is_none()
+        && !deterministic
 }
 
 /// A pool of `threads` render threads (0 = one per core).

@@ -31,7 +31,7 @@ use crate::accel::{AccelChoice, Geometry, NO_LIGHT, Sphere, TriangleInput};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::math::OffsetMode;
-use crate::shortcuts::{NotApplied, PrimaryCandidates, Shortcuts, ShortcutsUsed};
+use crate::shortcuts::{CameraSampling, NotApplied, PrimaryCandidates, Shortcuts, ShortcutsUsed};
 use crate::texture::Texture;
 use dropped::{Dropped, Survey};
 use emitters::EmitterShape;
@@ -591,10 +591,14 @@ impl Scene {
     /// One line per shortcut that `used` names: whether it applies here and
     /// what it saves, or why not ("lights seen directly: sampled (the scene
     /// has spheres)"). Builds the camera lists if they are not built yet.
-    pub fn shortcut_report(&self, used: ShortcutsUsed) -> Vec<String> {
+    /// `sampling` says where the render's camera samples lie.
+    pub fn shortcut_report(&self, used: ShortcutsUsed, sampling: CameraSampling) -> Vec<String> {
         let mut lines = Vec::new();
         lines.extend(self.lights.direct_summary());
-        let primary = self.try_primary_candidates();
+        let primary = match sampling.lists_apply() {
+            true => self.try_primary_candidates(),
+            false => Err(NotApplied::WideFilter),
+        };
         if used.primary_candidates {
             lines.push(match &primary {
                 Ok(lists) => {
@@ -607,6 +611,9 @@ impl Scene {
             });
         }
         match used.seen_emitters {
+            Some(true) if !sampling.seen_emission_applies() => lines.push(
+                "lights seen directly: sampled (the pixel filter is wider than a pixel)".into(),
+            ),
             Some(true) => lines.push(match &primary {
                 Ok(lists) if lists.pixels_with_seen_emission() > 0 => format!(
                     "lights seen directly: integrated exactly over {} pixels",

@@ -5,8 +5,8 @@
 //!
 //! | shortcut | what it knows | preconditions | caps |
 //! |---|---|---|---|
-//! | camera candidates ([`PrimaryCandidates`]) | per pixel, the triangles its camera rays can hit | a static soup (at most [`crate::accel::SOUP_MAX_TRIANGLES`] triangles, no spheres, nothing moving); a pinhole camera; no triangle reaching behind the eye's image plane | build: 24 overlap tests per pixel; lists: 8 bytes per pixel on average (plus 4 per pixel for where each starts); at most half of the pixels over 16 candidates |
-//! | lights seen directly ([`seen_emitters`]) | per pixel, the emission it sees, integrated exactly over the pixel | the camera candidates; flat emitters of constant radiance; per pixel, no other candidate that could hide part of the emitter | those of the candidates (the values are stored only for pixels that see a light) |
+//! | camera candidates ([`PrimaryCandidates`]) | per pixel, the triangles its camera rays can hit | a static soup (at most [`crate::accel::SOUP_MAX_TRIANGLES`] triangles, no spheres, nothing moving); a pinhole camera; camera rays through their pixel's square ([`CameraSampling`]: the box filter, or samples splatted through a wider one); no triangle reaching behind the eye's image plane | build: 24 overlap tests per pixel; lists: 8 bytes per pixel on average (plus 4 per pixel for where each starts); at most half of the pixels over 16 candidates |
+//! | lights seen directly ([`seen_emitters`]) | per pixel, the emission it sees, integrated exactly over the pixel | the camera candidates; the box filter; flat emitters of constant radiance; per pixel, no other candidate that could hide part of the emitter | those of the candidates (the values are stored only for pixels that see a light) |
 //! | shadow voxels ([`ShadowVoxels`]) | per voxel of the scene's box (16 along its longest side), the few triangles that can block shadow rays to one flat light | a static soup; a triangle or parallelogram light; at most 8 lights; robust ray offsets (per ray: both ends inside the soup's box) | at most 3 occluders listed per voxel, else the voxel takes the full test |
 //!
 //! Nothing here grows with pixels x triangles: the candidate lists are
@@ -47,6 +47,43 @@ pub struct ShortcutsUsed {
     pub shadow_voxels: bool,
 }
 
+/// Where a render's camera samples lie and how its film weighs them, which
+/// decides what the camera lists may be used for: they hold for rays
+/// through their pixel's square, and the emission they know is integrated
+/// over that square, as the box filter weighs it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CameraSampling {
+    /// Uniform in the pixel, the box filter: the lists and the seen emission.
+    BoxFilter,
+    /// In the pixel, weighed by a wider filter (splatted samples, or a
+    /// deterministic ray through the centre): the lists alone.
+    InPixel,
+    /// Drawn from a filter wider than the pixel: rays leave its square.
+    FromFilter,
+}
+
+impl CameraSampling {
+    /// The sampling of a render through `filter` whose samples are
+    /// `splatted` through it, or `deterministic` (pixel centres).
+    pub fn of(filter: crate::filter::PixelFilter, splatted: bool, deterministic: bool) -> Self {
+        match filter {
+            crate::filter::PixelFilter::Box => CameraSampling::BoxFilter,
+            _ if splatted || deterministic => CameraSampling::InPixel,
+            _ => CameraSampling::FromFilter,
+        }
+    }
+
+    /// Whether camera rays may test their pixel's candidates only.
+    pub fn lists_apply(self) -> bool {
+        self != CameraSampling::FromFilter
+    }
+
+    /// Whether a pixel's seen emission may replace its sampled emission.
+    pub fn seen_emission_applies(self) -> bool {
+        self == CameraSampling::BoxFilter
+    }
+}
+
 /// Why a shortcut does not apply.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum NotApplied {
@@ -62,7 +99,9 @@ pub enum NotApplied {
     Instances,
     /// A thin lens: camera rays leave from anywhere on the lens.
     ThinLens,
-    /// A pixel filter wider than the pixel: camera rays leave its square.
+    /// A pixel filter wider than the pixel: camera rays leave its square
+    /// (drawn from the filter), or the film weighs a pixel's samples by
+    /// where they lie (splatted).
     WideFilter,
     /// A triangle reaches behind the eye's image plane (unbounded projection).
     BehindEye,

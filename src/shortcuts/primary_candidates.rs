@@ -53,7 +53,9 @@ const SEEN: u32 = 1 << 30;
 /// The start of a pixel's list, without its flags.
 const START: u32 = SEEN - 1;
 
-/// Per-pixel candidate triangles of camera rays, for one camera.
+/// Per-pixel candidate triangles of camera rays through their pixel's
+/// square, for one camera (a render whose rays leave it does not read them:
+/// [`crate::shortcuts::CameraSampling`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PrimaryCandidates {
     /// The camera the lists are for: a moved camera needs new lists.
@@ -114,9 +116,6 @@ impl PrimaryCandidates {
     pub fn build(camera: &Camera, triangles: &[[Vec3A; 3]]) -> Result<Self, NotApplied> {
         if camera.aperture_radius > 0.0 {
             return Err(NotApplied::ThinLens);
-        }
-        if camera.filter != crate::filter::PixelFilter::Box {
-            return Err(NotApplied::WideFilter);
         }
         let (width, height) = (camera.width as usize, camera.height as usize);
         let pixels = width * height;
