@@ -127,7 +127,7 @@ fn nearest_hash_grid(bencher: Bencher) {
             let mut area = 0.0f32;
             for q in &setup.queries {
                 area += map
-                    .nearest(q.point, Side::Facing(q.normal), K, &mut nearest)
+                    .nearest(q.point, Side::Facing(q.normal), K, |_| true, &mut nearest)
                     .1;
             }
             area

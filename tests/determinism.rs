@@ -106,7 +106,7 @@ fn camera_ray_candidates_and_shadow_voxels_change_no_pixel() {
 fn splatted_samples_use_the_lists_but_not_the_seen_emission() {
     let mut scene = cornell_box();
     scene.set_resolution(48, 40);
-    let mut camera = scene.camera.clone();
+    let mut camera = scene.camera;
     camera.filter = tracelab::filter::PixelFilter::tent();
     scene.set_camera(camera);
     let lists = scene

@@ -111,18 +111,7 @@ impl<P: Stored + Copy + Send + Sync> PhotonMap<P> {
             .par_iter()
             .map(|p| map.hash(map.cell_of(p.position())) as u32)
             .collect();
-        for &h in &hashes {
-            map.starts[h as usize + 1] += 1;
-        }
-        for i in 1..map.starts.len() {
-            map.starts[i] += map.starts[i - 1];
-        }
-        let mut next = map.starts.clone();
-        let mut source = vec![0u32; count];
-        for (i, &h) in hashes.iter().enumerate() {
-            source[next[h as usize] as usize] = i as u32;
-            next[h as usize] += 1;
-        }
+        let source = super::sort::by_bucket(&hashes, &mut map.starts);
         (map, source)
     }
 

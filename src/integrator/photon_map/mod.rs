@@ -3,6 +3,7 @@
 //! and by vertex connection and merging (`vcm/`, for its light vertices).
 
 mod grid;
+mod sort;
 
 pub use grid::{MAX_K, PhotonMap, Side, Stored};
 
