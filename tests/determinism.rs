@@ -73,20 +73,16 @@ fn camera_ray_candidates_and_shadow_voxels_change_no_pixel() {
         clear > 0.3 && listed > 0.1,
         "{clear} clear, {listed} listed"
     );
+    // Seen emitters come with the lists: sampled here, so that only the
+    // lists differ.
     let render = |scene| {
-        // Seen emitters come with the lists: sampled here, so that only
-        // the lists differ.
-        let integrator = Integrator::from(PathTracer {
-            exact_seen_emitters: false,
-            ..PathTracer::default()
-        });
-        let (snapshot, _) = render_with(scene, integrator, SamplerKind::Sobol, 16, 3, 2, 16);
-        snapshot
-            .image
-            .pixels
-            .iter()
-            .flat_map(|p| p.map(f32::to_bits))
-            .collect::<Vec<_>>()
+        film_bits(
+            scene,
+            PathTracer {
+                exact_seen_emitters: false,
+                ..PathTracer::default()
+            },
+        )
     };
     let with_both = render(scene.clone());
     let mut without_lists = scene.clone();
@@ -113,23 +109,7 @@ fn splatted_samples_use_the_lists_but_not_the_seen_emission() {
         .primary_candidates()
         .expect("lists with a tent filter");
     assert!(lists.pixels_with_seen_emission() > 0);
-    let render = |scene: tracelab::scene::Scene| {
-        let (snapshot, _) = render_with(
-            scene,
-            Integrator::from(PathTracer::default()),
-            SamplerKind::Sobol,
-            16,
-            3,
-            2,
-            16,
-        );
-        snapshot
-            .image
-            .pixels
-            .iter()
-            .flat_map(|p| p.map(f32::to_bits))
-            .collect::<Vec<_>>()
-    };
+    let render = |scene| film_bits(scene, PathTracer::default());
     let mut without_lists = scene.clone();
     without_lists.shortcuts = without_lists.shortcuts.without_primary_candidates();
     assert_eq!(render(scene.clone()), render(without_lists));
@@ -152,4 +132,17 @@ fn splatted_samples_use_the_lists_but_not_the_seen_emission() {
         "{report}"
     );
     assert!(report.contains("lights seen directly: sampled"), "{report}");
+}
+
+/// A path-traced film of 16 Sobol samples (seed 3, 2 threads), as bit
+/// patterns.
+fn film_bits(scene: tracelab::scene::Scene, tracer: PathTracer) -> Vec<u32> {
+    let integrator = Integrator::from(tracer);
+    let (snapshot, _) = render_with(scene, integrator, SamplerKind::Sobol, 16, 3, 2, 16);
+    snapshot
+        .image
+        .pixels
+        .iter()
+        .flat_map(|p| p.map(f32::to_bits))
+        .collect()
 }

@@ -9,8 +9,10 @@
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
-/// Points below this are sorted serially, whatever the threads.
-const PARALLEL_MIN: usize = 1 << 14;
+/// Points below this are sorted serially, whatever the threads: the serial
+/// pass takes about a nanosecond a point, and each of the three parallel
+/// passes must first wake the pool's threads (tens of microseconds).
+const PARALLEL_MIN: usize = 1 << 17;
 
 /// The most ranges of the first parallel pass (by the high bits).
 const RANGES: usize = 256;
@@ -145,10 +147,10 @@ mod tests {
             .build()
             .unwrap();
         for (count, buckets, spread) in [
-            (40_000usize, 65_536usize, 65_536u64),
-            (20_000, 32_768, 97),
-            (17_000, 128, 128),
-            (30_000, 1 << 20, 1 << 20),
+            (140_000usize, 262_144usize, 262_144u64),
+            (140_000, 262_144, 97),
+            (135_000, 128, 128),
+            (150_000, 1 << 20, 1 << 20),
         ] {
             let hashes: Vec<u32> = (0..count as u64)
                 .map(|i| (crate::sampling::hash::hash_combine(7, i) % spread) as u32)
