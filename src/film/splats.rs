@@ -32,8 +32,10 @@ pub(crate) struct SplatBuffer {
 const SPLAT_SCALE: f64 = 4294967296.0;
 
 /// The most bytes of shards past the first: a 512 x 512 film gets one per
-/// thread up to 42 threads, a 1920 x 1080 film up to 6 (the rest share).
-pub(crate) const SHARD_BUDGET: u64 = 256 << 20;
+/// thread up to 11 threads, a 1920 x 1080 film two (the rest share). Every
+/// pass makes and fills its shards anew, so at many threads a larger budget
+/// would cost each pass page faults and writes of hundreds of megabytes.
+pub(crate) const SHARD_BUDGET: u64 = 64 << 20;
 
 /// Bytes of one shard per pixel.
 pub(crate) const SPLAT_BYTES: u64 = 24;
@@ -340,7 +342,8 @@ mod tests {
                 }
             }
         }
-        assert_eq!(shard_count(1 << 20, 64), 11);
+        assert_eq!(shard_count(1 << 20, 64), 3);
+        assert_eq!(shard_count(512 * 512, 64), 11);
         assert_eq!(shard_count(100, 64), 64);
     }
 
