@@ -106,10 +106,10 @@ impl PendingShadow {
     /// What the light adds where the shadow ray is clear.
     #[inline(always)]
     fn added(&self, scene: &Scene) -> Rgb {
-        match (self.environment_uv, scene.lights.environment()) {
-            (Some(uv), Some(environment)) => self.added * environment.le_at(uv),
-            _ => self.added,
-        }
+        self.added
+            * scene
+                .lights
+                .deferred_radiance(self.environment_uv, Rgb::ONE)
     }
 }
 
@@ -390,11 +390,9 @@ impl PathTracer {
                         } else {
                             Rgb::ZERO
                         };
-                        if let (Some(uv), Some(e)) =
-                            (shadow.environment_uv, scene.lights.environment())
-                        {
-                            ls.radiance = e.le_at(uv);
-                        }
+                        ls.radiance = scene
+                            .lights
+                            .deferred_radiance(shadow.environment_uv, ls.radiance);
                         observer.light_sample(&ls, f, weight, visible, added);
                         radiance += added;
                     } else {

@@ -352,6 +352,17 @@ impl Lights {
         self.sample_from_table::<true>(self.direct.as_ref()?, reference, u_select, u)
     }
 
+    /// The radiance of a sample from [`Lights::sample_deferred`] or
+    /// [`Lights::sample_as_emitted_deferred`]: the environment's at the map
+    /// coordinates `deferred` where it left them, else `radiance` as given.
+    #[inline(always)]
+    pub fn deferred_radiance(&self, deferred: Option<Vec2>, radiance: Rgb) -> Rgb {
+        match (deferred, &self.environment) {
+            (Some(uv), Some(environment)) => environment.le_at(uv),
+            _ => radiance,
+        }
+    }
+
     /// [`Lights::sample`] with the light chosen as [`Lights::sample_emission`]
     /// chooses it: the connection to a light of BDPT and VCM, whose weights
     /// give a path's light end one density whichever strategy made it.

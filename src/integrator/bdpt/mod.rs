@@ -494,9 +494,7 @@ impl Bdpt {
             if scene.geometry.occluded(&shadow) {
                 return None;
             }
-            if let (Some(uv), Some(environment)) = (deferred, scene.lights.environment()) {
-                ls.radiance = environment.le_at(uv);
-            }
+            ls.radiance = scene.lights.deferred_radiance(deferred, ls.radiance);
             let value = beta_f * ls.radiance * scale;
             if !(value.max_element() > 0.0) {
                 return None;

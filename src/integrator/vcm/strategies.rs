@@ -181,10 +181,7 @@ impl Vcm {
         if scene.geometry.occluded(&shadow) {
             return Rgb::ZERO;
         }
-        let radiance = match (deferred, scene.lights.environment()) {
-            (Some(uv), Some(environment)) => environment.le_at(uv),
-            _ => ls.radiance,
-        };
+        let radiance = scene.lights.deferred_radiance(deferred, ls.radiance);
         f * radiance * scale / (1.0 + w_light + w_camera)
     }
 
