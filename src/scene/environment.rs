@@ -156,7 +156,7 @@ impl Environment {
     #[inline(always)]
     pub fn prefetch_le(&self, uv: Vec2) {
         if let Radiance::Map(map) = &self.radiance {
-            let (x, y) = texel_corner(map, uv);
+            let (x, y, _, _) = bilinear_corner(map, uv);
             map.prefetch(x, y);
             map.prefetch(x, (y + 1).min(map.height - 1));
         }
@@ -259,31 +259,29 @@ fn lookup(map: &Bitmap, uv: Vec2) -> Rgb {
     if !uv.is_finite() {
         return Rgb::ZERO;
     }
-    let (w, h) = (map.width, map.height);
-    let x = uv.x * w as f32 - 0.5;
-    let y = uv.y * (h.max(2) - 1) as f32;
-    let (x0, y0) = (x.floor(), y.floor().clamp(0.0, (h.max(2) - 2) as f32));
-    let (fx, fy) = (x - x0, (y - y0).clamp(0.0, 1.0));
-    let x0 = (x0 as i64).rem_euclid(w as i64) as usize;
-    let x1 = (x0 + 1) % w;
-    let (y0, y1) = ((y0 as usize).min(h - 1), (y0 as usize + 1).min(h - 1));
+    let (x0, y0, fx, fy) = bilinear_corner(map, uv);
+    let x1 = (x0 + 1) % map.width;
+    let y1 = (y0 + 1).min(map.height - 1);
     let t = |x: usize, y: usize| map.at(x, y);
     (t(x0, y0) * (1.0 - fx) + t(x1, y0) * fx) * (1.0 - fy)
         + (t(x0, y1) * (1.0 - fx) + t(x1, y1) * fx) * fy
 }
 
-/// The texel at the top left of [`lookup`]'s 2 × 2 at `uv` (in range).
+/// The texel at the top left of the 2 × 2 that [`lookup`] blends at `uv`
+/// (in range: a non-finite uv lands on a corner, the casts saturating),
+/// and the blend's fractions along x and y.
 #[inline(always)]
-fn texel_corner(map: &Bitmap, uv: Vec2) -> (usize, usize) {
+fn bilinear_corner(map: &Bitmap, uv: Vec2) -> (usize, usize, f32, f32) {
     let (w, h) = (map.width, map.height);
-    let x = (uv.x * w as f32 - 0.5).floor();
-    let y = (uv.y * (h.max(2) - 1) as f32)
-        .floor()
-        .clamp(0.0, (h.max(2) - 2) as f32);
-    // Casts saturate: a non-finite uv lands on a corner, harmlessly.
+    let x = uv.x * w as f32 - 0.5;
+    let y = uv.y * (h.max(2) - 1) as f32;
+    let (x0, y0) = (x.floor(), y.floor().clamp(0.0, (h.max(2) - 2) as f32));
+    let (fx, fy) = (x - x0, (y - y0).clamp(0.0, 1.0));
     (
-        (x as i64).rem_euclid(w as i64) as usize,
-        (y as usize).min(h - 1),
+        (x0 as i64).rem_euclid(w as i64) as usize,
+        (y0 as usize).min(h - 1),
+        fx,
+        fy,
     )
 }
 
