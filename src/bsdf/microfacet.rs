@@ -4,7 +4,7 @@
 //! inversion (2014). Directions are in the local frame (normal = +z) and on
 //! its upper side; callers flip them there first.
 
-use crate::math::{erf, erfinv};
+use crate::math::{erf_and_gaussian, erfinv};
 use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
 
@@ -90,7 +90,8 @@ impl Microfacet {
                 if a > 6.0 {
                     return 0.0;
                 }
-                (0.5 * (erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * PI.sqrt())).max(0.0)
+                let (erf_a, gaussian) = erf_and_gaussian(a);
+                (0.5 * (erf_a - 1.0) + gaussian / (2.0 * a * PI.sqrt())).max(0.0)
             }
         }
     }
@@ -173,12 +174,15 @@ fn beckmann_visible_slope(cos_theta: f32, u: Vec2) -> Vec2 {
     let cot_theta = 1.0 / tan_theta;
     let ux = u.x.clamp(1e-6, 1.0 - 1e-6);
     // The CDF of b = erf(slope) is (1 + b + tan e^{-slope²} / √π) / norm on [-1, erf(cot)].
-    let (mut lo, mut hi) = (-1.0f32, erf(cot_theta));
-    let norm = 1.0 / (1.0 + hi + INV_SQRT_PI * tan_theta * (-cot_theta * cot_theta).exp());
+    let (erf_cot, gaussian_cot) = erf_and_gaussian(cot_theta);
+    let (mut lo, mut hi) = (-1.0f32, erf_cot);
+    let norm = 1.0 / (1.0 + hi + INV_SQRT_PI * tan_theta * gaussian_cot);
     // Initial guess: a fit of the inverse (Mitsuba's).
     let theta = cos_theta.acos();
     let fit = 1.0 + theta * (-0.876 + theta * (0.4265 - 0.0594 * theta));
     let mut b = hi - (1.0 + hi) * (1.0 - ux).powf(fit);
+    // The slope of the converged b, so that it is not inverted twice.
+    let mut converged = None;
     for _ in 0..10 {
         if !(b >= lo && b <= hi) {
             b = 0.5 * (lo + hi);
@@ -187,6 +191,7 @@ fn beckmann_visible_slope(cos_theta: f32, u: Vec2) -> Vec2 {
         let value = norm * (1.0 + b + INV_SQRT_PI * tan_theta * (-slope * slope).exp()) - ux;
         let derivative = norm * (1.0 - slope * tan_theta);
         if value.abs() < 1e-6 {
+            converged = Some(slope);
             break;
         }
         if value > 0.0 {
@@ -196,16 +201,19 @@ fn beckmann_visible_slope(cos_theta: f32, u: Vec2) -> Vec2 {
         }
         b -= value / derivative;
     }
+    let clamped = b.clamp(-1.0 + 1e-7, 1.0 - 1e-7);
+    let slope_x = match converged {
+        Some(slope) if clamped == b => slope,
+        _ => erfinv(clamped),
+    };
     let uy = u.y.clamp(1e-6, 1.0 - 1e-6);
-    Vec2::new(
-        erfinv(b.clamp(-1.0 + 1e-7, 1.0 - 1e-7)),
-        erfinv(2.0 * uy - 1.0),
-    )
+    Vec2::new(slope_x, erfinv(2.0 * uy - 1.0))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::erf;
 
     /// ∫ f over the hemisphere by a midpoint rule in (cos θ, φ).
     fn hemisphere_integral(f: impl Fn(Vec3A) -> f64, n: usize) -> f64 {
