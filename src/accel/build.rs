@@ -163,6 +163,10 @@ impl Geometry {
         };
         geometry.store_triangles(triangles, use_soup, drop_degenerate);
         if spheres.len() <= SPHERE_LIST_MAX {
+            if spheres.len() >= SPHERE_LANES_MIN {
+                geometry.sphere_lanes =
+                    SphereLanes::pack(spheres.iter().map(|s| (s.center, s.radius)));
+            }
             geometry.spheres = spheres;
         } else {
             let aabbs: Vec<Aabb> = spheres
@@ -184,6 +188,8 @@ impl Geometry {
                     geometry.sphere_bvh = Some(bvh);
                 }
                 None => {
+                    geometry.sphere_lanes =
+                        SphereLanes::pack(spheres.iter().map(|s| (s.center, s.radius)));
                     geometry.spheres = spheres;
                     geometry.bvh_too_deep = true;
                 }
@@ -270,6 +276,7 @@ impl Geometry {
             keep_uvs: self.keep_uvs,
             keep_normals: self.keep_normals,
             sphere_bvh: self.sphere_bvh.clone(),
+            sphere_lanes: self.sphere_lanes.clone(),
             spheres: self.spheres.clone(),
             moving: self.moving.clone(),
             offset: self.offset,
@@ -355,6 +362,7 @@ impl Geometry {
             keep_uvs: self.keep_uvs,
             keep_normals: inputs.iter().any(|t| t.normals.is_some()),
             sphere_bvh: self.sphere_bvh.clone(),
+            sphere_lanes: self.sphere_lanes.clone(),
             spheres: self.spheres.clone(),
             moving: self.moving.clone(),
             offset: self.offset,

@@ -179,7 +179,8 @@ impl Instances {
         let search = |index: usize, t_max: f32, best: &mut Option<SurfaceHit>| {
             let instance = &self.list[index];
             let local = instance.local_ray(ray, t_max);
-            let found = self.prototypes[instance.prototype as usize].intersect_static(&local);
+            let found =
+                self.prototypes[instance.prototype as usize].intersect_static::<false>(&local);
             if let Some(hit) = found {
                 *best = Some(instance.to_world_hit(hit, index as u32));
             }
@@ -209,7 +210,7 @@ impl Instances {
         let blocks = |index: usize| {
             let instance = &self.list[index];
             let local = instance.local_ray(ray, ray.t_max);
-            self.prototypes[instance.prototype as usize].occluded_static(&local)
+            self.prototypes[instance.prototype as usize].occluded_static::<false>(&local)
         };
         match &self.bvh {
             None => (0..self.list.len()).any(blocks),

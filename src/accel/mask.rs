@@ -149,7 +149,7 @@ impl Geometry {
         if self.triangle_blocks(ray, &mut opaque) {
             return true;
         }
-        let maybe = met_mask || self.spheres_block(ray) || self.occluded_elsewhere(ray);
+        let maybe = met_mask || self.spheres_block::<true>(ray) || self.occluded_elsewhere(ray);
         maybe && self.intersect_masked(ray, masks).is_some()
     }
 }
