@@ -12,6 +12,7 @@ Gauss-Seidel, smooth display, against tests/data/cornell_box_path_ref.exr.
 With --max-penumbrae the meshes with lines are also solved with each
 --max-penumbra value; the element counts where the lines' envelope (all
 their kinds together) is not below the plain one are printed last.
+--min-angles sweeps --adaptive-min-angle for every kind alike.
 """
 import argparse, itertools, subprocess
 
@@ -23,6 +24,8 @@ parser.add_argument("--tolerances", default="0.8,1,1.3")
 parser.add_argument("--max-penumbrae", default="all",
                     help="for the kinds with lines: --max-penumbra values to sweep too "
                          "(comma-separated; all: every line)")
+parser.add_argument("--min-angles", default="0",
+                    help="--adaptive-min-angle values to sweep for every kind (comma-separated)")
 parser.add_argument("--kinds", default="plain,lines,regular",
                     help="plain (adaptive subdivision), lines (discontinuity meshing first), "
                          "regular (its lines on the regular mesh: --lines-on-regular-mesh)")
@@ -31,12 +34,12 @@ args = parser.parse_args()
 FLAGS = {"plain": [], "lines": ["--discontinuity-meshing"],
          "regular": ["--discontinuity-meshing", "--lines-on-regular-mesh"]}
 
-def solve(size, rounds, tolerance, kind, max_penumbra):
+def solve(size, rounds, tolerance, kind, max_penumbra, min_angle):
     command = [args.tracelab, "radiosity", "scenes/cornell_box.toml",
                "--reference", "tests/data/cornell_box_path_ref.exr",
                "--solver", "gauss-seidel", "--display", "smooth",
                "--patch-size", size, "--adaptive-rounds", rounds,
-               "--adaptive-tolerance", tolerance]
+               "--adaptive-tolerance", tolerance, "--adaptive-min-angle", min_angle]
     command += FLAGS[kind]
     if kind != "plain" and max_penumbra != "all":
         command += ["--max-penumbra", max_penumbra]
@@ -58,18 +61,22 @@ def configurations(kind):
     sizes, rounds = args.sizes.split(","), args.rounds.split(",")
     tolerances = args.tolerances.split(",")
     penumbrae = ["all"] if kind == "plain" else args.max_penumbrae.split(",")
-    for size, r, tolerance, m in itertools.product(sizes, rounds, tolerances, penumbrae):
-        if r != "0" or tolerance == tolerances[0]:
-            yield size, r, tolerance, m
+    angles = args.min_angles.split(",")
+    for size, r, tolerance, m, a in itertools.product(sizes, rounds, tolerances, penumbrae, angles):
+        # Without rounds neither the tolerance nor the angle does anything.
+        if r != "0" or (tolerance == tolerances[0] and a == angles[0]):
+            yield size, r, tolerance, m, a
 
 envelopes = {}
 for kind in args.kinds.split(","):
     points = []
-    for size, rounds, tolerance, max_penumbra in configurations(kind):
-        elements, rmse, seconds = solve(size, rounds, tolerance, kind, max_penumbra)
+    for size, rounds, tolerance, max_penumbra, min_angle in configurations(kind):
+        elements, rmse, seconds = solve(size, rounds, tolerance, kind, max_penumbra, min_angle)
         config = f"patch {size}, {rounds} rounds, tolerance {tolerance}"
         if max_penumbra != "all":
             config += f", max penumbra {max_penumbra}"
+        if min_angle != "0":
+            config += f", min angle {min_angle}"
         print(f"{kind}\t{elements}\t{rmse:.5f}\t{seconds:.1f} s\t{config}", flush=True)
         points.append((elements, rmse, config))
     print(f"\nlower envelope, {kind}:")

@@ -88,6 +88,12 @@ pub struct RadiosityFlags {
     /// [default: 0.5].
     #[arg(long)]
     adaptive_tolerance: Option<f32>,
+    /// Radiosity, matrix solvers: adaptive subdivision leaves elements with
+    /// an angle under this many degrees whole (their four children would be
+    /// as thin; 20 leaves the slivers beside discontinuity lines whole)
+    /// [default: 0].
+    #[arg(long)]
+    adaptive_min_angle: Option<f32>,
     /// Radiosity: draw the elements' edges over the image, coloured by level.
     #[arg(long)]
     wireframe: bool,
@@ -122,6 +128,7 @@ impl RadiosityFlags {
             || self.ff_method.is_some()
             || self.adaptive_rounds.is_some()
             || self.adaptive_tolerance.is_some()
+            || self.adaptive_min_angle.is_some()
             || self.wireframe
             || self.discontinuity_meshing
             || self.lines_on_regular_mesh
@@ -153,6 +160,9 @@ impl RadiosityFlags {
         settings.adaptive_tolerance = self
             .adaptive_tolerance
             .unwrap_or(settings.adaptive_tolerance);
+        settings.adaptive_min_angle = self
+            .adaptive_min_angle
+            .unwrap_or(settings.adaptive_min_angle);
         settings.ambient |= self.ambient_term;
         settings.wireframe |= self.wireframe;
         settings.discontinuity |=

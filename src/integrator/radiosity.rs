@@ -74,6 +74,12 @@ pub struct Radiosity {
     /// (relative to the mean reflected radiance).
     pub adaptive_rounds: u32,
     pub adaptive_tolerance: f32,
+    /// Matrix solvers: adaptive subdivision leaves elements with an angle
+    /// under this many degrees whole, since their four children would be as
+    /// thin. 0 splits every steep element; 20 leaves whole the slivers that
+    /// a discontinuity line cuts off the regular mesh's elements, which
+    /// pays at coarse meshes (docs/validation.md).
+    pub adaptive_min_angle: f32,
     /// Draw the elements' edges over the image, coloured by level (and
     /// the discontinuity lines in cyan).
     pub wireframe: bool,
@@ -117,8 +123,14 @@ impl Technique for Radiosity {
             self.patch_size,
             if self.adaptive_rounds > 0 && self.solver.matrix().is_some() {
                 format!(
-                    ", {} adaptive rounds at tolerance {}",
-                    self.adaptive_rounds, self.adaptive_tolerance
+                    ", {} adaptive rounds at tolerance {}{}",
+                    self.adaptive_rounds,
+                    self.adaptive_tolerance,
+                    if self.adaptive_min_angle > 0.0 {
+                        format!(" (angles under {}° left whole)", self.adaptive_min_angle)
+                    } else {
+                        String::new()
+                    }
                 )
             } else {
                 String::new()
@@ -652,9 +664,12 @@ impl Radiosity {
             .as_ref()
             .map(Meshed::line_edges)
             .unwrap_or_default();
-        let steep = m
-            .mesh
-            .steep(&m.solution.radiance, self.adaptive_tolerance, &lines);
+        let steep = m.mesh.steep(
+            &m.solution.radiance,
+            self.adaptive_tolerance,
+            self.adaptive_min_angle,
+            &lines,
+        );
         let added = 3 * steep.iter().filter(|&&s| s).count();
         if added == 0 {
             state.settled = true;

@@ -276,11 +276,14 @@ impl Mesh {
     /// differ) and emit alike; across a T-vertex only the elements that have
     /// it count; where discontinuity `lines` pass through a vertex, only
     /// the elements on the same side (the mesh already holds that jump, and
-    /// splitting along it spends elements for nothing).
+    /// splitting along it spends elements for nothing). Elements with an
+    /// angle under `min_angle` degrees are never steep: midpoint
+    /// subdivision would make four as thin.
     pub fn steep(
         &self,
         radiance: &[Rgb],
         tolerance: f32,
+        min_angle: f32,
         lines: &[super::reconstruct::LineEdge],
     ) -> Vec<bool> {
         use std::collections::HashMap;
@@ -313,10 +316,11 @@ impl Mesh {
         self.elements
             .iter()
             .map(|e| {
-                e.vertices.iter().any(|&v| {
-                    let (low, high) = range[&(vertex_key(v, e), crossing.side(v, e))];
-                    (high - low).cmpgt(limit).any()
-                })
+                smallest_angle(&e.vertices) >= min_angle
+                    && e.vertices.iter().any(|&v| {
+                        let (low, high) = range[&(vertex_key(v, e), crossing.side(v, e))];
+                        (high - low).cmpgt(limit).any()
+                    })
             })
             .collect()
     }
@@ -373,6 +377,12 @@ impl Mesh {
             }
         }
     }
+}
+
+/// The smallest angle of triangle `v`, in degrees.
+pub fn smallest_angle(v: &[Vec3A; 3]) -> f32 {
+    let angle = |i: usize| (v[(i + 1) % 3] - v[i]).angle_between(v[(i + 2) % 3] - v[i]);
+    angle(0).min(angle(1)).min(angle(2)).to_degrees()
 }
 
 /// The longest edge of triangle `v`.
@@ -484,8 +494,30 @@ mod tests {
             ends: [p(0.0, 0.0), p(0.0, 1.0)],
             normal: Vec3A::Z,
         };
-        assert_eq!(mesh.steep(&radiance, 0.5, &[]), [true; 4]);
-        assert_eq!(mesh.steep(&radiance, 0.5, &[line]), [false; 4]);
+        assert_eq!(mesh.steep(&radiance, 0.5, 0.0, &[]), [true; 4]);
+        assert_eq!(mesh.steep(&radiance, 0.5, 0.0, &[line]), [false; 4]);
+    }
+
+    /// With a smallest angle to split, a sliver beside a steep change stays
+    /// whole (its four children would be as thin); its well-shaped
+    /// neighbour across the same change splits.
+    #[test]
+    fn adaptive_subdivision_leaves_slivers_whole() {
+        let p = |x: f32, y: f32| Vec3A::new(x, y, 0.0);
+        let element = |v| Element::new(0, v, Rgb::splat(0.5), Rgb::ZERO);
+        let sliver = [p(0.0, 0.0), p(1.0, 0.0), p(1.0, 0.2)];
+        // atan(0.2) at the shared corner.
+        assert!((smallest_angle(&sliver) - 11.31).abs() < 0.01);
+        let mesh = Mesh {
+            elements: vec![
+                element([p(-1.0, 0.0), p(0.0, 0.0), p(0.0, 1.0)]),
+                element(sliver),
+            ],
+            ..Mesh::default()
+        };
+        let radiance = [1.0, 0.2].map(Rgb::splat);
+        assert_eq!(mesh.steep(&radiance, 0.5, 0.0, &[]), [true, true]);
+        assert_eq!(mesh.steep(&radiance, 0.5, 20.0, &[]), [true, false]);
     }
 
     #[test]

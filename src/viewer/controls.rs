@@ -183,6 +183,14 @@ fn radiosity(ui: &mut egui::Ui, s: &mut Radiosity) {
                     .logarithmic(true)
                     .text("Tolerance (of the mean)"),
             );
+            ui.add(
+                slider(&mut s.adaptive_min_angle, 0.0..=30.0)
+                    .text("Leave elements with angles under (°) whole"),
+            )
+            .on_hover_text(
+                "Their four children would be as thin: 20° leaves the slivers beside \
+                 discontinuity lines whole, which pays at coarse meshes",
+            );
         }
     }
     ui.checkbox(&mut s.wireframe, "Wireframe (colour by level)");

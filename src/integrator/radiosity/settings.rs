@@ -18,6 +18,7 @@ impl Default for Radiosity {
             epsilon: 1e-4,
             adaptive_rounds: 0,
             adaptive_tolerance: 0.5,
+            adaptive_min_angle: 0.0,
             wireframe: false,
             discontinuity: false,
             lines_on_regular_mesh: false,
@@ -35,6 +36,12 @@ impl Settings for Radiosity {
             return Err(format!(
                 "adaptive tolerance must be positive, got {}",
                 self.adaptive_tolerance
+            ));
+        }
+        if !(0.0..60.0).contains(&self.adaptive_min_angle) {
+            return Err(format!(
+                "adaptive min angle must be in [0, 60) degrees, got {}",
+                self.adaptive_min_angle
             ));
         }
         if let Some(m) = self.max_penumbra
