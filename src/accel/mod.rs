@@ -29,7 +29,7 @@ use mask::Masks;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use soup::TriangleSoup;
-use sphere::{SphereLanes, intersect_sphere};
+use sphere::{SPHERE_LANES_MIN, SphereLanes, intersect_sphere};
 use std::sync::Arc;
 use wide_bvh::WideBvh;
 
@@ -182,15 +182,6 @@ pub enum AccelChoice {
 /// (path tracing, 2 threads, median of 5): `scenes/motion_blur.toml` with its
 /// two balls at rest 2.06 -> 2.32 M paths/s, moving 1.70 -> 2.12 M paths/s.
 pub const SPHERE_LIST_MAX: usize = 8;
-
-/// Fewest spheres (without a BVH) tested in lanes of eight rather than one
-/// by one. Path tracing, 2 threads, alternating renders: four spheres
-/// (veach-mis, `scenes/sphere_light.toml`) +2% and +4%, three +3%, two
-/// small ones +1% (within the spread); one large sphere (SmallVCM's mirror
-/// ball, and each of `motion_blur.toml`'s moving balls, which are tested
-/// alone) −4.5% and −5%, where the lanes pay their root and division on
-/// most rays.
-pub const SPHERE_LANES_MIN: usize = 3;
 
 /// Largest mesh tested without a BVH. `cargo bench --bench throughput --
 /// rays` (closest hit, incoherent, one thread): on the 32-triangle Cornell

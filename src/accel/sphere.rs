@@ -36,6 +36,15 @@ pub fn intersect_sphere(
     }
 }
 
+/// Fewest spheres (without a BVH) tested in lanes of eight rather than one
+/// by one. Path tracing, 2 threads, alternating renders: four spheres
+/// (veach-mis, `scenes/sphere_light.toml`) +2% and +4%, three +3%, two
+/// small ones +1% (within the spread); one large sphere (SmallVCM's mirror
+/// ball, and each of `motion_blur.toml`'s moving balls, which are tested
+/// alone) −4.5% and −5%, where the lanes pay their root and division on
+/// most rays.
+pub const SPHERE_LANES_MIN: usize = 3;
+
 /// Up to eight spheres tested by one instruction per step, a lane each: the
 /// few spheres of a scene that gets no sphere BVH (veach-mis's four lights,
 /// tested one by one, were 5% of its path tracing on one thread). Each lane

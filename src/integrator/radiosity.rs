@@ -74,11 +74,8 @@ pub struct Radiosity {
     /// (relative to the mean reflected radiance).
     pub adaptive_rounds: u32,
     pub adaptive_tolerance: f32,
-    /// Matrix solvers: adaptive subdivision leaves elements with an angle
-    /// under this many degrees whole, since their four children would be as
-    /// thin. 0 splits every steep element; 20 leaves whole the slivers that
-    /// a discontinuity line cuts off the regular mesh's elements, which
-    /// pays at coarse meshes (docs/validation.md).
+    /// Matrix solvers: elements with an angle under this (degrees) are not
+    /// split (20: the slivers beside lines on the regular mesh; docs/validation.md).
     pub adaptive_min_angle: f32,
     /// Draw the elements' edges over the image, coloured by level (and
     /// the discontinuity lines in cyan).
@@ -664,12 +661,10 @@ impl Radiosity {
             .as_ref()
             .map(Meshed::line_edges)
             .unwrap_or_default();
-        let steep = m.mesh.steep(
-            &m.solution.radiance,
-            self.adaptive_tolerance,
-            self.adaptive_min_angle,
-            &lines,
-        );
+        let (tolerance, min_angle) = (self.adaptive_tolerance, self.adaptive_min_angle);
+        let steep = m
+            .mesh
+            .steep(&m.solution.radiance, tolerance, min_angle, &lines);
         let added = 3 * steep.iter().filter(|&&s| s).count();
         if added == 0 {
             state.settled = true;
