@@ -164,8 +164,7 @@ impl Geometry {
         geometry.store_triangles(triangles, use_soup, drop_degenerate);
         if spheres.len() <= SPHERE_LIST_MAX {
             if spheres.len() >= SPHERE_LANES_MIN {
-                geometry.sphere_lanes =
-                    SphereLanes::pack(spheres.iter().map(|s| (s.center, s.radius)));
+                geometry.sphere_lanes = SphereLanes::pack(&spheres);
             }
             geometry.spheres = spheres;
         } else {
@@ -188,8 +187,7 @@ impl Geometry {
                     geometry.sphere_bvh = Some(bvh);
                 }
                 None => {
-                    geometry.sphere_lanes =
-                        SphereLanes::pack(spheres.iter().map(|s| (s.center, s.radius)));
+                    geometry.sphere_lanes = SphereLanes::pack(&spheres);
                     geometry.spheres = spheres;
                     geometry.bvh_too_deep = true;
                 }

@@ -1,5 +1,6 @@
 //! Ray/sphere intersection.
 
+use super::Sphere;
 use glam::Vec3A;
 use wide::f32x8;
 
@@ -60,20 +61,19 @@ pub struct SphereLanes {
 }
 
 impl SphereLanes {
-    /// The spheres (centre, radius) in groups of eight, in order.
-    pub fn pack(spheres: impl ExactSizeIterator<Item = (Vec3A, f32)>) -> Vec<SphereLanes> {
-        let spheres: Vec<(Vec3A, f32)> = spheres.collect();
+    /// The spheres in groups of eight, in order.
+    pub fn pack(spheres: &[Sphere]) -> Vec<SphereLanes> {
         spheres
             .chunks(8)
             .enumerate()
             .map(|(k, chunk)| {
                 let mut center = [[0.0f32; 8]; 3];
                 let mut radius2 = [-1.0f32; 8];
-                for (lane, &(c, r)) in chunk.iter().enumerate() {
+                for (lane, sphere) in chunk.iter().enumerate() {
                     for axis in 0..3 {
-                        center[axis][lane] = c[axis];
+                        center[axis][lane] = sphere.center[axis];
                     }
-                    radius2[lane] = r * r;
+                    radius2[lane] = sphere.radius * sphere.radius;
                 }
                 SphereLanes {
                     center: center.map(f32x8::new),
@@ -151,13 +151,15 @@ mod tests {
     #[test]
     fn lanes_agree_with_the_scalar_test() {
         let u = |k: u64, i: u64| to_unit_float(hash_combine(k, i));
-        let spheres: Vec<(Vec3A, f32)> = (0..9u64)
-            .map(|i| {
-                let c = Vec3A::new(u(1, i), u(2, i), u(3, i)) * 4.0 - Vec3A::splat(2.0);
-                (c, 0.1 + u(4, i))
+        let spheres: Vec<Sphere> = (0..9u64)
+            .map(|i| Sphere {
+                center: Vec3A::new(u(1, i), u(2, i), u(3, i)) * 4.0 - Vec3A::splat(2.0),
+                radius: 0.1 + u(4, i),
+                material: 0,
+                light: 0,
             })
             .collect();
-        let lanes = SphereLanes::pack(spheres.iter().copied());
+        let lanes = SphereLanes::pack(&spheres);
         assert_eq!(lanes.len(), 2);
         let (mut hits, mut misses) = (0, 0);
         for i in 0..50_000u64 {
@@ -167,14 +169,14 @@ mod tests {
             let direction = if i % 2 == 0 {
                 random.normalize()
             } else {
-                let (c, r) = spheres[(i / 2 % 9) as usize];
-                (c + 1.2 * r * random - origin).normalize()
+                let s = spheres[(i / 2 % 9) as usize];
+                (s.center + 1.2 * s.radius * random - origin).normalize()
             };
             let t_max = if i % 3 == 0 { 1.0 } else { f32::INFINITY };
             let mut expected = None;
-            for (k, &(c, r)) in spheres.iter().enumerate() {
+            for (k, s) in spheres.iter().enumerate() {
                 let limit = expected.map_or(t_max, |(_, t)| t);
-                if let Some(t) = intersect_sphere(origin, direction, c, r, limit) {
+                if let Some(t) = intersect_sphere(origin, direction, s.center, s.radius, limit) {
                     expected = Some((k, t));
                 }
             }
