@@ -14,8 +14,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// memory allows: splats land anywhere, and two threads writing one shared
 /// film pass its cache lines back and forth (half of the splats' time, 5%
 /// of BDPT's, on two threads). A thread alone on its shard adds by a plain
-/// load and store; threads that share one (past [`SHARD_BUDGET`], or from
-/// outside the pool) add atomically. Reading a pixel sums its shards.
+/// load and store; threads that share one (past [`SHARD_BUDGET`]) add
+/// atomically, and so do threads outside the pool, to a film of their own
+/// made when one first adds. Reading a pixel sums its shards.
 pub(crate) struct SplatBuffer {
     width: u32,
     height: u32,
@@ -26,6 +27,8 @@ pub(crate) struct SplatBuffer {
     /// Whether pool thread i (below `shards`) is the only one to write
     /// shard i: the pool has no more threads than shards.
     exclusive: bool,
+    /// The film of threads outside the pool (none in a render's pass).
+    outside: std::sync::OnceLock<Vec<[AtomicU64; 3]>>,
 }
 
 /// 2^32: resolution 2.3e-10 per splat, overflow past 4e9 per pixel and pass.
@@ -54,8 +57,8 @@ impl SplatBuffer {
 
     /// A buffer whose splats spread over the pixels `filter` covers, with a
     /// shard per thread of the pool it is made in, as memory allows: it is
-    /// to be filled from that pool's threads (others add atomically, to
-    /// the first shard).
+    /// to be filled from that pool's threads (others add atomically, to a
+    /// film of their own).
     pub(crate) fn with_filter(width: u32, height: u32, filter: PixelFilter) -> Self {
         let pixels = u64::from(width) * u64::from(height);
         let shards = shard_count(pixels, rayon::current_num_threads());
@@ -65,30 +68,28 @@ impl SplatBuffer {
     fn with_shards(width: u32, height: u32, filter: PixelFilter, shards: usize) -> Self {
         let pixels = width as usize * height as usize;
         let threads = rayon::current_num_threads();
-        // Filled in parallel: a pass makes one before any thread can start.
-        let sums = (0..shards * pixels)
-            .into_par_iter()
-            .map(|_| [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)])
-            .collect();
         SplatBuffer {
             width,
             height,
             filter,
-            sums,
+            sums: zeroed(shards * pixels),
             shards,
             exclusive: threads <= shards,
+            outside: std::sync::OnceLock::new(),
         }
     }
 
-    /// The first index of the calling thread's shard, and whether the
-    /// thread is its only writer. Thread 0 shares the first shard with
-    /// threads outside the pool.
+    /// The calling thread's shard, and whether the thread is its only
+    /// writer.
     #[inline]
-    fn shard(&self) -> (usize, bool) {
+    fn shard(&self) -> (&[[AtomicU64; 3]], bool) {
         let pixels = (self.width * self.height) as usize;
         match rayon::current_thread_index() {
-            Some(i) => (i % self.shards * pixels, self.exclusive && i > 0),
-            None => (0, false),
+            Some(i) => {
+                let first = i % self.shards * pixels;
+                (&self.sums[first..first + pixels], self.exclusive)
+            }
+            None => (self.outside.get_or_init(|| zeroed(pixels)), false),
         }
     }
 
@@ -100,7 +101,7 @@ impl SplatBuffer {
     /// (a tent's 2 x 2 pixels span two rows and up to four lines).
     #[inline]
     fn prefetch(&self, film: Vec2, filtered: bool) {
-        let sums = &self.sums[self.shard().0..];
+        let sums = self.shard().0;
         let r = if filtered { self.filter.radius() } else { 0.0 };
         if r == 0.0 || self.filter == PixelFilter::Box {
             let (x, y) = (film.x as u32, film.y as u32);
@@ -156,7 +157,7 @@ impl SplatBuffer {
 
     /// [`SplatBuffer::add_to_pixel`] in the shard [`SplatBuffer::shard`] chose.
     #[inline]
-    fn add_in(&self, (shard, alone): (usize, bool), film: Vec2, value: Rgb) -> bool {
+    fn add_in(&self, (shard, alone): (&[[AtomicU64; 3]], bool), film: Vec2, value: Rgb) -> bool {
         let (x, y) = (film.x as u32, film.y as u32);
         if x >= self.width || y >= self.height {
             return true;
@@ -172,7 +173,7 @@ impl SplatBuffer {
         if fixed == [0; 3] {
             return true;
         }
-        let sums = &self.sums[shard + (y * self.width + x) as usize];
+        let sums = &shard[(y * self.width + x) as usize];
         for c in 0..3 {
             if alone {
                 // No other thread writes this shard: no lock needed.
@@ -189,14 +190,23 @@ impl SplatBuffer {
     pub(crate) fn get(&self, index: u32) -> [f64; 3] {
         let pixels = (self.width * self.height) as usize;
         let mut total = [0u64; 3];
-        for shard in 0..self.shards {
-            let sums = &self.sums[shard * pixels + index as usize];
+        let shards = (0..self.shards).map(|shard| &self.sums[shard * pixels + index as usize]);
+        for sums in shards.chain(self.outside.get().map(|film| &film[index as usize])) {
             for c in 0..3 {
                 total[c] = total[c].wrapping_add(sums[c].load(Ordering::Relaxed));
             }
         }
         total.map(|t| t as f64 / SPLAT_SCALE)
     }
+}
+
+/// `count` pixels' sums at zero, filled in parallel: a pass makes its
+/// buffer before any thread can start.
+fn zeroed(count: usize) -> Vec<[AtomicU64; 3]> {
+    (0..count)
+        .into_par_iter()
+        .map(|_| [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)])
+        .collect()
 }
 
 /// A sample's splats held back until the sample is traced: each one's cache
@@ -318,7 +328,7 @@ mod tests {
                     let (film, value) = splat(k);
                     assert!(buffer.add(film, value));
                 });
-                // A thread outside the pool adds to the first shard too.
+                // A thread outside the pool adds to a film of its own.
                 let (film, value) = splat(5000);
                 std::thread::scope(|s| {
                     s.spawn(|| assert!(buffer.add(film, value)));
