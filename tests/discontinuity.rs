@@ -72,9 +72,12 @@ fn penumbra_lines_fall_where_similar_triangles_put_them_and_pieces_never_straddl
     use discontinuity::Base;
     for base in [
         Base::Delaunay { max_edge: 0.3 },
-        Base::Regular { max_edge: 0.3 },
+        Base::Regular {
+            max_edge: 0.3,
+            min_piece: 0.0,
+        },
     ] {
-        let pieces = discontinuity::split(&scene, &lines, Some(base));
+        let (pieces, _) = discontinuity::split(&scene, &lines, Some(base));
         let mut area = 0.0;
         for (t, pieces) in pieces.iter().enumerate() {
             if !on_floor(t) {
@@ -132,7 +135,8 @@ fn lines_know_their_penumbras_width_and_a_limit_keeps_the_narrow_ones() {
     }
     let on_line = |max_penumbra: f32| {
         let kept = lines.narrower_than(max_penumbra);
-        let pieces = discontinuity::split(&scene, &kept, Some(Base::Delaunay { max_edge: 0.3 }));
+        let (pieces, _) =
+            discontinuity::split(&scene, &kept, Some(Base::Delaunay { max_edge: 0.3 }));
         let flagged = pieces
             .iter()
             .flatten()
@@ -169,7 +173,7 @@ fn the_penumbra_limit_does_not_depend_on_the_scenes_units() {
         let base = Base::Delaunay {
             max_edge: 0.3 * scale,
         };
-        let pieces = discontinuity::split(scene, &lines, Some(base));
+        let (pieces, _) = discontinuity::split(scene, &lines, Some(base));
         (lines.count(), pieces.iter().map(Vec::len).sum::<usize>())
     };
     let metres = input(1.0);
@@ -311,7 +315,7 @@ fn the_pieces_under_the_blocks_are_found_hidden() {
     let scene = crate::common::cornell_box();
     let lines = discontinuity::find(&scene);
     let base = discontinuity::Base::Delaunay { max_edge: 100.0 };
-    let pieces = discontinuity::split(&scene, &lines, Some(base));
+    let (pieces, _) = discontinuity::split(&scene, &lines, Some(base));
     let corners: Vec<Vec<[Vec3A; 3]>> = pieces
         .iter()
         .map(|p| p.iter().map(|p| p.vertices).collect())

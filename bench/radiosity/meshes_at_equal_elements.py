@@ -12,7 +12,8 @@ Gauss-Seidel, smooth display, against tests/data/cornell_box_path_ref.exr.
 With --max-penumbrae the meshes with lines are also solved with each
 --max-penumbra value; the element counts where the lines' envelope (all
 their kinds together) is not below the plain one are printed last.
---min-angles sweeps --adaptive-min-angle for every kind alike.
+--min-angles sweeps --adaptive-min-angle for every kind alike, and
+--min-piece-areas sweeps --min-piece-area for the regular kind.
 """
 import argparse, itertools, subprocess
 
@@ -26,6 +27,8 @@ parser.add_argument("--max-penumbrae", default="all",
                          "(comma-separated; all: every line)")
 parser.add_argument("--min-angles", default="0",
                     help="--adaptive-min-angle values to sweep for every kind (comma-separated)")
+parser.add_argument("--min-piece-areas", default="0",
+                    help="--min-piece-area values to sweep for the regular kind (comma-separated)")
 parser.add_argument("--kinds", default="plain,lines,regular",
                     help="plain (adaptive subdivision), lines (discontinuity meshing first), "
                          "regular (its lines on the regular mesh: --lines-on-regular-mesh)")
@@ -34,7 +37,7 @@ args = parser.parse_args()
 FLAGS = {"plain": [], "lines": ["--discontinuity-meshing"],
          "regular": ["--discontinuity-meshing", "--lines-on-regular-mesh"]}
 
-def solve(size, rounds, tolerance, kind, max_penumbra, min_angle):
+def solve(size, rounds, tolerance, kind, max_penumbra, min_angle, min_piece):
     command = [args.tracelab, "radiosity", "scenes/cornell_box.toml",
                "--reference", "tests/data/cornell_box_path_ref.exr",
                "--solver", "gauss-seidel", "--display", "smooth",
@@ -43,6 +46,8 @@ def solve(size, rounds, tolerance, kind, max_penumbra, min_angle):
     command += FLAGS[kind]
     if kind != "plain" and max_penumbra != "all":
         command += ["--max-penumbra", max_penumbra]
+    if kind == "regular":
+        command += ["--min-piece-area", min_piece]
     out = subprocess.run(command, capture_output=True, text=True, check=True).stdout
     row = [l for l in out.splitlines() if l.strip() and l.split()[0].isdigit()][-1].split()
     # Columns: steps, elements, links, rays, bytes, solve s, residual, RMSE, masked RMSE.
@@ -62,21 +67,26 @@ def configurations(kind):
     tolerances = args.tolerances.split(",")
     penumbrae = ["all"] if kind == "plain" else args.max_penumbrae.split(",")
     angles = args.min_angles.split(",")
-    for size, r, tolerance, m, a in itertools.product(sizes, rounds, tolerances, penumbrae, angles):
+    pieces = args.min_piece_areas.split(",") if kind == "regular" else ["0"]
+    for size, r, tolerance, m, a, piece in itertools.product(
+            sizes, rounds, tolerances, penumbrae, angles, pieces):
         # Without rounds neither the tolerance nor the angle does anything.
         if r != "0" or (tolerance == tolerances[0] and a == angles[0]):
-            yield size, r, tolerance, m, a
+            yield size, r, tolerance, m, a, piece
 
 envelopes = {}
 for kind in args.kinds.split(","):
     points = []
-    for size, rounds, tolerance, max_penumbra, min_angle in configurations(kind):
-        elements, rmse, seconds = solve(size, rounds, tolerance, kind, max_penumbra, min_angle)
+    for size, rounds, tolerance, max_penumbra, min_angle, piece in configurations(kind):
+        elements, rmse, seconds = solve(size, rounds, tolerance, kind, max_penumbra, min_angle,
+                                        piece)
         config = f"patch {size}, {rounds} rounds, tolerance {tolerance}"
         if max_penumbra != "all":
             config += f", max penumbra {max_penumbra}"
         if min_angle != "0":
             config += f", min angle {min_angle}"
+        if piece != "0":
+            config += f", min piece area {piece}"
         print(f"{kind}\t{elements}\t{rmse:.5f}\t{seconds:.1f} s\t{config}", flush=True)
         points.append((elements, rmse, config))
     print(f"\nlower envelope, {kind}:")

@@ -107,6 +107,11 @@ pub struct RadiosityFlags {
     /// line crosses (better at fine meshes, worse at coarse ones).
     #[arg(long)]
     lines_on_regular_mesh: bool,
+    /// Radiosity, lines on the regular mesh (implied): an element that a
+    /// line crosses stays whole where a piece would be smaller than this
+    /// fraction of its area (0.035 pays at coarse meshes) [default: 0].
+    #[arg(long)]
+    min_piece_area: Option<f32>,
     /// Radiosity, matrix solvers: discontinuity meshing that keeps a
     /// penumbra's boundary lines only where the penumbra is narrower than
     /// this many patch sizes (0: contact lines only) [default: every line].
@@ -132,6 +137,7 @@ impl RadiosityFlags {
             || self.wireframe
             || self.discontinuity_meshing
             || self.lines_on_regular_mesh
+            || self.min_piece_area.is_some()
             || self.max_penumbra.is_some()
     }
 
@@ -165,9 +171,11 @@ impl RadiosityFlags {
             .unwrap_or(settings.adaptive_min_angle);
         settings.ambient |= self.ambient_term;
         settings.wireframe |= self.wireframe;
+        let regular = self.lines_on_regular_mesh || self.min_piece_area.is_some();
         settings.discontinuity |=
-            self.discontinuity_meshing || self.lines_on_regular_mesh || self.max_penumbra.is_some();
-        settings.lines_on_regular_mesh |= self.lines_on_regular_mesh;
+            self.discontinuity_meshing || regular || self.max_penumbra.is_some();
+        settings.lines_on_regular_mesh |= regular;
+        settings.min_piece_area = self.min_piece_area.unwrap_or(settings.min_piece_area);
         settings.max_penumbra = self.max_penumbra.or(settings.max_penumbra);
         if let Some(display) = self.display {
             settings.display = match display {

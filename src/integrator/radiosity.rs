@@ -88,6 +88,10 @@ pub struct Radiosity {
     /// meshing every receiver by Delaunay refinement (better from about
     /// 2 000 elements on the Cornell box, worse below: docs/validation.md).
     pub lines_on_regular_mesh: bool,
+    /// With `lines_on_regular_mesh`: a crossed element stays whole where a
+    /// piece would be smaller than this fraction of its area (0: every
+    /// crossed element is split). Fewer slivers pay at coarse meshes.
+    pub min_piece_area: f32,
     /// Matrix solvers with `discontinuity`: keep a penumbra's boundary lines
     /// (D1) only where the penumbra is narrower than this many element
     /// sizes (`patch_size`); contact lines (D0) are always kept. None keeps
@@ -110,7 +114,7 @@ impl Technique for Radiosity {
 
     fn describe(&self) -> String {
         format!(
-            "radiosity ({}{}, patch size {}{}{}, form factors {:?} x {}, {} display)",
+            "radiosity ({}{}, patch size {}{}, form factors {:?} x {}, {} display)",
             self.solver.name(),
             if self.solver == RadiositySolver::Progressive && self.ambient {
                 " + ambient"
@@ -118,32 +122,7 @@ impl Technique for Radiosity {
                 ""
             },
             self.patch_size,
-            if self.adaptive_rounds > 0 && self.solver.matrix().is_some() {
-                format!(
-                    ", {} adaptive rounds at tolerance {}{}",
-                    self.adaptive_rounds,
-                    self.adaptive_tolerance,
-                    if self.adaptive_min_angle > 0.0 {
-                        format!(" (angles under {}° left whole)", self.adaptive_min_angle)
-                    } else {
-                        String::new()
-                    }
-                )
-            } else {
-                String::new()
-            },
-            match (self.discontinuity, self.lines_on_regular_mesh) {
-                (false, _) => String::new(),
-                (true, regular) => format!(
-                    ", discontinuity meshing{}{}",
-                    if regular { " on the regular mesh" } else { "" },
-                    match self.max_penumbra.filter(|_| self.solver.matrix().is_some()) {
-                        Some(0.0) => " (contact lines only)".to_string(),
-                        Some(m) => format!(" (lines of penumbrae narrower than {m} patch sizes)"),
-                        None => String::new(),
-                    }
-                ),
-            },
+            self.meshing_summary(),
             self.form_factors,
             self.form_factor_samples,
             self.display.name()
@@ -451,7 +430,11 @@ impl Radiosity {
                 let b = scene.geometry.bounds();
                 let max_edge = self.patch_size * (b.max - b.min).length();
                 let base = if self.lines_on_regular_mesh {
-                    Base::Regular { max_edge }
+                    let min_piece = self.min_piece_area;
+                    Base::Regular {
+                        max_edge,
+                        min_piece,
+                    }
                 } else {
                     Base::Delaunay { max_edge }
                 };

@@ -209,6 +209,16 @@ fn radiosity(ui: &mut egui::Ui, s: &mut Radiosity) {
                  crosses (better at fine meshes); off: every receiver meshed by Delaunay \
                  refinement (fewer pieces at coarse ones)",
             );
+        if s.lines_on_regular_mesh {
+            ui.add(
+                slider(&mut s.min_piece_area, 0.0..=0.2).text("Smallest piece (of its element)"),
+            )
+            .on_hover_text(
+                "An element that a line crosses stays whole where a piece would be \
+                     smaller than this fraction of its area: fewer slivers, which pays at \
+                     coarse meshes",
+            );
+        }
         let mut some = s.max_penumbra.is_some();
         ui.horizontal(|ui| {
             ui.checkbox(&mut some, "Only narrow penumbrae")

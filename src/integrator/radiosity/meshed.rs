@@ -61,7 +61,7 @@ pub(super) fn discontinuity_mesh(
         Some((_, Some(limit))) => found.narrower_than(limit),
         _ => found,
     };
-    let pieces = discontinuity::split(scene, &lines, base.map(|(b, _)| b));
+    let (pieces, left_whole) = discontinuity::split(scene, &lines, base.map(|(b, _)| b));
     let corners: Vec<Vec<[glam::Vec3A; 3]>> = pieces
         .iter()
         .map(|p| p.iter().map(|p| p.vertices).collect())
@@ -94,6 +94,12 @@ pub(super) fn discontinuity_mesh(
         notes.push(format!(
             "{enclosed} pieces enclosed by contact lines (under what stands on them) are not \
              patches: no light reaches or leaves them"
+        ));
+    }
+    if left_whole > 0 {
+        notes.push(format!(
+            "{left_whole} elements that lines cross left whole: a piece would have been smaller \
+             than the minimum piece area"
         ));
     }
     notes.push(format!(

@@ -22,8 +22,41 @@ impl Default for Radiosity {
             wireframe: false,
             discontinuity: false,
             lines_on_regular_mesh: false,
+            min_piece_area: 0.0,
             max_penumbra: None,
         }
+    }
+}
+
+impl Radiosity {
+    /// The adaptive rounds and discontinuity meshing, for the summary.
+    pub(super) fn meshing_summary(&self) -> String {
+        let adaptive = if self.adaptive_rounds > 0 && self.solver.matrix().is_some() {
+            let angle = match self.adaptive_min_angle {
+                0.0 => String::new(),
+                a => format!(" (angles under {a}° left whole)"),
+            };
+            format!(
+                ", {} adaptive rounds at tolerance {}{angle}",
+                self.adaptive_rounds, self.adaptive_tolerance
+            )
+        } else {
+            String::new()
+        };
+        if !self.discontinuity {
+            return adaptive;
+        }
+        let base = match (self.lines_on_regular_mesh, self.min_piece_area) {
+            (false, _) => String::new(),
+            (true, 0.0) => " on the regular mesh".to_string(),
+            (true, a) => format!(" on the regular mesh (no piece under {a} of its element)"),
+        };
+        let lines = match self.max_penumbra.filter(|_| self.solver.matrix().is_some()) {
+            Some(0.0) => " (contact lines only)".to_string(),
+            Some(m) => format!(" (lines of penumbrae narrower than {m} patch sizes)"),
+            None => String::new(),
+        };
+        format!("{adaptive}, discontinuity meshing{base}{lines}")
     }
 }
 
@@ -42,6 +75,12 @@ impl Settings for Radiosity {
             return Err(format!(
                 "adaptive min angle must be in [0, 60) degrees, got {}",
                 self.adaptive_min_angle
+            ));
+        }
+        if !(0.0..0.5).contains(&self.min_piece_area) {
+            return Err(format!(
+                "min piece area must be in [0, 0.5) of an element, got {}",
+                self.min_piece_area
             ));
         }
         if let Some(m) = self.max_penumbra

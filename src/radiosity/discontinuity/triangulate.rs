@@ -16,8 +16,10 @@ pub enum Base {
     /// The regular elements of the mesh without lines (edges at most
     /// `max_edge`, [`crate::radiosity::Mesh::build`]'s depth), only those a
     /// line crosses triangulated along it; receivers without lines stay
-    /// whole for the mesh to subdivide the same way.
-    Regular { max_edge: f32 },
+    /// whole for the mesh to subdivide the same way. An element whose
+    /// pieces would include one smaller than `min_piece` of its area stays
+    /// whole: a sliver costs an element and adds little (docs/validation.md).
+    Regular { max_edge: f32, min_piece: f32 },
 }
 
 /// Splits receiver triangles along their discontinuities: a constrained
@@ -30,8 +32,14 @@ pub enum Base {
 /// Delaunay pieces are fewer for a coarse size, the regular base keeps the
 /// walls' regular elements at fine ones. Without (the hierarchy, which
 /// subdivides on its own), only triangles with lines are split, and only
-/// along them. Per scene triangle, its pieces, or none where it stays whole.
-pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<Vec<Piece>> {
+/// along them. Per scene triangle, its pieces, or none where it stays whole;
+/// and how many regular elements that lines cross were left whole
+/// ([`Base::Regular`]'s `min_piece`).
+pub fn split(
+    scene: &Scene,
+    lines: &Discontinuities,
+    base: Option<Base>,
+) -> (Vec<Vec<Piece>>, usize) {
     let geometry = &scene.geometry;
     let tracer = Tracer {
         scene,
@@ -39,7 +47,8 @@ pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<
         offset: 0.0,
         rays: 0,
     };
-    lines
+    let mut left_whole = 0;
+    let pieces = lines
         .segments
         .iter()
         .enumerate()
@@ -52,21 +61,33 @@ pub fn split(scene: &Scene, lines: &Discontinuities, base: Option<Base>) -> Vec<
                 Some(Base::Delaunay { max_edge }) if !segments.is_empty() || receiver() => {
                     split_triangle(v, segments, Some(max_edge))
                 }
-                Some(Base::Regular { max_edge }) if !segments.is_empty() => {
-                    split_regular(v, segments, max_edge)
+                Some(Base::Regular {
+                    max_edge,
+                    min_piece,
+                }) if !segments.is_empty() => {
+                    let (pieces, whole) = split_regular(v, segments, max_edge, min_piece);
+                    left_whole += whole;
+                    pieces
                 }
                 // Left whole: the mesh subdivides it (a receiver without
                 // lines on the regular base).
                 Some(_) => Vec::new(),
             }
         })
-        .collect()
+        .collect();
+    (pieces, left_whole)
 }
 
 /// Triangle `v` cut into the regular elements of the mesh without lines
 /// (edges at most `max_edge`), each element that `segments` cross split
-/// along the part of them inside it.
-fn split_regular(v: [Vec3A; 3], segments: &[Segment], max_edge: f32) -> Vec<Piece> {
+/// along the part of them inside it, unless a piece would be smaller than
+/// `min_piece` of its area; and how many crossed elements stayed whole.
+fn split_regular(
+    v: [Vec3A; 3],
+    segments: &[Segment],
+    max_edge: f32,
+    min_piece: f32,
+) -> (Vec<Piece>, usize) {
     let lines: Vec<&Segment> = segments.iter().filter(|s| !along_an_edge(s, &v)).collect();
     let longest = crate::radiosity::mesh::longest_edge(&v);
     let depth = crate::radiosity::mesh::depth_for(longest, max_edge);
@@ -79,19 +100,30 @@ fn split_regular(v: [Vec3A; 3], segments: &[Segment], max_edge: f32) -> Vec<Piec
     }
     let mut pieces = Vec::with_capacity(elements.len());
     let mut inside = Vec::new();
+    let mut left_whole = 0;
+    let area = |v: &[Vec3A; 3]| (v[1] - v[0]).cross(v[2] - v[0]).length();
     for element in elements {
         inside.clear();
         inside.extend(lines.iter().filter_map(|s| clip(s, &element)));
-        if inside.is_empty() {
+        let split = match inside.is_empty() {
+            true => Vec::new(),
+            false => split_triangle(element, &inside, None),
+        };
+        let smallest = split
+            .iter()
+            .map(|p| area(&p.vertices))
+            .fold(f32::MAX, f32::min);
+        if split.is_empty() || smallest < min_piece * area(&element) {
+            left_whole += usize::from(!split.is_empty());
             pieces.push(Piece {
                 vertices: element,
                 on_line: [false; 3],
             });
         } else {
-            pieces.extend(split_triangle(element, &inside, None));
+            pieces.extend(split);
         }
     }
-    pieces
+    (pieces, left_whole)
 }
 
 /// Whether segment `s` lies along one of triangle `v`'s edges (within a
@@ -401,7 +433,7 @@ mod tests {
             penumbra: [0.0; 2],
         };
         // Longest edge √2 at most 0.3: three levels, 64 elements.
-        let pieces = split_regular(v, &[line], 0.3);
+        let (pieces, _) = split_regular(v, &[line], 0.3, 0.0);
         let mut regular = vec![v];
         for _ in 0..3 {
             regular = regular
@@ -433,6 +465,27 @@ mod tests {
     }
 
     #[test]
+    fn an_element_whose_piece_would_be_a_sliver_stays_whole() {
+        let v = [Vec3A::ZERO, Vec3A::X, Vec3A::Y];
+        let line = |a: f32| Segment {
+            ends: [Vec3A::new(a, 0.0, 0.0), Vec3A::new(0.0, a, 0.0)],
+            event: Event::VertexEdge,
+            penumbra: [0.0; 2],
+        };
+        // One element (edges under 2); the corner line's piece is 0.25% of it.
+        let (pieces, whole) = split_regular(v, &[line(0.05)], 2.0, 0.01);
+        assert_eq!((pieces.len(), whole), (1, 1));
+        assert_eq!(pieces[0].vertices, v);
+        assert_eq!(pieces[0].on_line, [false; 3]);
+        let (pieces, whole) = split_regular(v, &[line(0.05)], 2.0, 0.0);
+        assert!(pieces.len() > 1 && whole == 0, "{}", pieces.len());
+        // A line through the middle leaves no piece under a tenth: split.
+        let (pieces, whole) = split_regular(v, &[line(0.5)], 2.0, 0.01);
+        assert!(pieces.len() > 1 && whole == 0, "{}", pieces.len());
+        assert!(pieces.iter().any(|p| p.on_line != [false; 3]));
+    }
+
+    #[test]
     fn a_line_along_the_receivers_edge_leaves_its_regular_elements_whole() {
         // A crease's contact line, traced a thousandth of the edge short
         // of its corners (as on the Cornell box's walls): its ends, inside
@@ -444,7 +497,7 @@ mod tests {
             event: Event::VertexEdge,
             penumbra: [0.0; 2],
         };
-        let pieces = split_regular(v, &[crease], 0.3);
+        let (pieces, _) = split_regular(v, &[crease], 0.3, 0.0);
         assert_eq!(pieces.len(), 64);
         assert!(pieces.iter().all(|p| p.on_line == [false; 3]));
     }
