@@ -96,18 +96,17 @@ impl PixelFilter {
     /// The normalised filter at offset `d` from a pixel's centre.
     #[inline]
     pub fn eval(&self, d: Vec2) -> f32 {
+        self.eval_1d(d.x) * self.eval_1d(d.y)
+    }
+
+    /// The normalised 1D filter at `x`: the 2D filter is the product in x
+    /// and y, so a splat's footprint needs one per row and column.
+    #[inline]
+    pub fn eval_1d(&self, x: f32) -> f32 {
         match *self {
-            PixelFilter::Box => {
-                if d.x.abs() <= 0.5 && d.y.abs() <= 0.5 {
-                    1.0
-                } else {
-                    0.0
-                }
-            }
-            PixelFilter::Tent { radius } => tent(d.x, radius) * tent(d.y, radius),
-            PixelFilter::Gaussian { stddev, radius } => {
-                gaussian(d.x, stddev, radius) * gaussian(d.y, stddev, radius)
-            }
+            PixelFilter::Box => f32::from(u8::from(x.abs() <= 0.5)),
+            PixelFilter::Tent { radius } => tent(x, radius),
+            PixelFilter::Gaussian { stddev, radius } => gaussian(x, stddev, radius),
         }
     }
 

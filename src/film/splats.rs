@@ -1,6 +1,7 @@
 //! The splat buffer of splatting estimators: per-pixel sums whose value does
 //! not depend on the order in which threads add to them.
 
+use crate::film::filtered::MAX_SIDE;
 use crate::filter::PixelFilter;
 use crate::math::Rgb;
 use glam::Vec2;
@@ -130,20 +131,35 @@ impl SplatBuffer {
         if self.filter == PixelFilter::Box {
             return self.add_in(shard, film, value);
         }
-        // Every pixel whose filter reaches `film`, weighted by it.
+        // Every pixel whose filter reaches `film`, weighted by it: the
+        // filter is a product of 1D ones, so a column's weight is computed
+        // once (a Gaussian's are an erf and an exponential each).
         let r = self.filter.radius();
-        let (x0, x1) = ((film.x - r - 0.5).ceil(), (film.x + r - 0.5).floor());
+        let x0 = (film.x - r - 0.5).ceil().max(0.0);
+        let x1 = (film.x + r - 0.5).floor().min(self.width as f32 - 1.0);
         let (y0, y1) = ((film.y - r - 0.5).ceil(), (film.y + r - 0.5).floor());
+        let columns = (x1 - x0 + 1.0).max(0.0) as usize;
+        let mut column_weights = [0.0f32; MAX_SIDE];
+        let stored = columns <= MAX_SIDE;
+        if stored {
+            for (i, w) in column_weights.iter_mut().enumerate().take(columns) {
+                *w = self.filter.eval_1d(film.x - (x0 + i as f32 + 0.5));
+            }
+        }
         let mut ok = true;
         let mut y = y0.max(0.0);
         while y <= y1.min(self.height as f32 - 1.0) {
-            let mut x = x0.max(0.0);
-            while x <= x1.min(self.width as f32 - 1.0) {
-                let weight = self.filter.eval(film - Vec2::new(x + 0.5, y + 0.5));
+            let row_weight = self.filter.eval_1d(film.y - (y + 0.5));
+            for i in 0..columns * usize::from(row_weight > 0.0) {
+                let x = x0 + i as f32;
+                let column_weight = match stored {
+                    true => column_weights[i],
+                    false => self.filter.eval_1d(film.x - (x + 0.5)),
+                };
+                let weight = column_weight * row_weight;
                 if weight > 0.0 {
                     ok &= self.add_in(shard, Vec2::new(x + 0.5, y + 0.5), value * weight);
                 }
-                x += 1.0;
             }
             y += 1.0;
         }
