@@ -135,10 +135,13 @@ impl SplatBuffer {
         // filter is a product of 1D ones, so a column's weight is computed
         // once (a Gaussian's are an erf and an exponential each).
         let r = self.filter.radius();
-        let x0 = (film.x - r - 0.5).ceil().max(0.0);
-        let x1 = (film.x + r - 0.5).floor().min(self.width as f32 - 1.0);
-        let (y0, y1) = ((film.y - r - 0.5).ceil(), (film.y + r - 0.5).floor());
-        let columns = (x1 - x0 + 1.0).max(0.0) as usize;
+        // The footprint's first pixel and count along an axis of `size` pixels.
+        let span = |f: f32, size: u32| {
+            let first = (f - r - 0.5).ceil().max(0.0);
+            let last = (f + r - 0.5).floor().min(size as f32 - 1.0);
+            (first, (last - first + 1.0).max(0.0) as usize)
+        };
+        let ((x0, columns), (y0, rows)) = (span(film.x, self.width), span(film.y, self.height));
         let mut column_weights = [0.0f32; MAX_SIDE];
         let stored = columns <= MAX_SIDE;
         if stored {
@@ -147,10 +150,13 @@ impl SplatBuffer {
             }
         }
         let mut ok = true;
-        let mut y = y0.max(0.0);
-        while y <= y1.min(self.height as f32 - 1.0) {
+        for j in 0..rows {
+            let y = y0 + j as f32;
             let row_weight = self.filter.eval_1d(film.y - (y + 0.5));
-            for i in 0..columns * usize::from(row_weight > 0.0) {
+            if !(row_weight > 0.0) {
+                continue;
+            }
+            for i in 0..columns {
                 let x = x0 + i as f32;
                 let column_weight = match stored {
                     true => column_weights[i],
@@ -161,7 +167,6 @@ impl SplatBuffer {
                     ok &= self.add_in(shard, Vec2::new(x + 0.5, y + 0.5), value * weight);
                 }
             }
-            y += 1.0;
         }
         ok
     }
