@@ -103,10 +103,23 @@ impl PixelFilter {
     /// and y, so a splat's footprint needs one per row and column.
     #[inline]
     pub fn eval_1d(&self, x: f32) -> f32 {
-        match *self {
-            PixelFilter::Box => f32::from(u8::from(x.abs() <= 0.5)),
-            PixelFilter::Tent { radius } => tent(x, radius),
-            PixelFilter::Gaussian { stddev, radius } => gaussian(x, stddev, radius),
+        self.one_dimensional().eval(x)
+    }
+
+    /// The normalised 1D filter with its constants computed once (a
+    /// Gaussian's mass is an erf), for many evaluations.
+    #[inline]
+    pub fn one_dimensional(&self) -> Filter1d {
+        let scale = match *self {
+            PixelFilter::Gaussian { stddev, radius } => {
+                let mass = erf(radius / (stddev * std::f32::consts::SQRT_2));
+                stddev * (2.0 * std::f32::consts::PI).sqrt() * mass
+            }
+            _ => 1.0,
+        };
+        Filter1d {
+            filter: *self,
+            scale,
         }
     }
 
@@ -153,14 +166,29 @@ fn sample_tent(u: f32, r: f32) -> f32 {
     (r * (1.0 - (1.0 - d.abs()).max(0.0).sqrt())).copysign(d)
 }
 
-/// The normalised 1D Gaussian cut at ±r.
-#[inline]
-fn gaussian(x: f32, s: f32, r: f32) -> f32 {
-    if x.abs() > r {
-        return 0.0;
+/// A pixel filter's normalised 1D profile ([`PixelFilter::one_dimensional`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Filter1d {
+    filter: PixelFilter,
+    /// The Gaussian's normalisation: σ √(2π) times its mass within ±r.
+    scale: f32,
+}
+
+impl Filter1d {
+    /// The filter at `x` (the Gaussian cut at ±r).
+    #[inline]
+    pub fn eval(&self, x: f32) -> f32 {
+        match self.filter {
+            PixelFilter::Box => f32::from(u8::from(x.abs() <= 0.5)),
+            PixelFilter::Tent { radius } => tent(x, radius),
+            PixelFilter::Gaussian { stddev, radius } => {
+                if x.abs() > radius {
+                    return 0.0;
+                }
+                (-(x * x) / (2.0 * stddev * stddev)).exp() / self.scale
+            }
+        }
     }
-    let mass = erf(r / (s * std::f32::consts::SQRT_2));
-    (-(x * x) / (2.0 * s * s)).exp() / (s * (2.0 * std::f32::consts::PI).sqrt() * mass)
 }
 
 /// Inverse CDF of the Gaussian cut at ±r, through erf and its inverse.
@@ -208,7 +236,7 @@ mod tests {
             // eval at y = 0 is the 1D filter times its peak: normalise by it.
             let peak = match filter {
                 PixelFilter::Tent { radius } => tent(0.0, radius),
-                PixelFilter::Gaussian { stddev, radius } => gaussian(0.0, stddev, radius),
+                PixelFilter::Gaussian { .. } => filter.eval_1d(0.0),
                 PixelFilter::Box => 1.0,
             };
             assert!(

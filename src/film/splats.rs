@@ -142,17 +142,18 @@ impl SplatBuffer {
             (first, (last - first + 1.0).max(0.0) as usize)
         };
         let ((x0, columns), (y0, rows)) = (span(film.x, self.width), span(film.y, self.height));
+        let filter = self.filter.one_dimensional();
         let mut column_weights = [0.0f32; MAX_SIDE];
         let stored = columns <= MAX_SIDE;
         if stored {
             for (i, w) in column_weights.iter_mut().enumerate().take(columns) {
-                *w = self.filter.eval_1d(film.x - (x0 + i as f32 + 0.5));
+                *w = filter.eval(film.x - (x0 + i as f32 + 0.5));
             }
         }
         let mut ok = true;
         for j in 0..rows {
             let y = y0 + j as f32;
-            let row_weight = self.filter.eval_1d(film.y - (y + 0.5));
+            let row_weight = filter.eval(film.y - (y + 0.5));
             if !(row_weight > 0.0) {
                 continue;
             }
@@ -160,7 +161,7 @@ impl SplatBuffer {
                 let x = x0 + i as f32;
                 let column_weight = match stored {
                     true => column_weights[i],
-                    false => self.filter.eval_1d(film.x - (x + 0.5)),
+                    false => filter.eval(film.x - (x + 0.5)),
                 };
                 let weight = column_weight * row_weight;
                 if weight > 0.0 {
