@@ -1,8 +1,8 @@
 //! The `tracelab` binary: renders, comparisons, and a clear message with a
 //! non-zero exit for every kind of bad input (never a panic).
 
-use crate::common::{repo_path, temp_dir};
-use std::path::{Path, PathBuf};
+use crate::common::{TempDir, repo_path, temp_dir};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
 pub(crate) fn tracelab(args: &[&str]) -> Output {
@@ -30,7 +30,7 @@ pub(crate) const CAMERA: &str =
     "[camera]\neye = [0, 1, -3]\nlook_at = [0, 1, 0]\nfov_y = 40\nwidth = 16\nheight = 16\n";
 
 /// Writes `files` into a fresh directory and returns the directory.
-pub(crate) fn scene_dir(name: &str, files: &[(&str, &str)]) -> PathBuf {
+pub(crate) fn scene_dir(name: &str, files: &[(&str, &str)]) -> TempDir {
     let dir = temp_dir(name);
     for (file, text) in files {
         std::fs::write(dir.join(file), text).unwrap();

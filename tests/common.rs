@@ -26,7 +26,8 @@ pub fn cornell_box() -> Scene {
 pub fn load_scene_text(name: &str, text: &str) -> Scene {
     static CALLS: AtomicUsize = AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, Ordering::Relaxed);
-    let path = temp_dir(&format!("{name}-{call}")).join("scene.toml");
+    let dir = temp_dir(&format!("{name}-{call}"));
+    let path = dir.join("scene.toml");
     std::fs::write(&path, text).unwrap();
     Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
 }
@@ -93,12 +94,38 @@ pub fn render(
     render_with(scene, integrator, sampler, spp, seed, 0, 8)
 }
 
-/// A fresh empty directory under the system temp dir.
-pub fn temp_dir(name: &str) -> PathBuf {
+/// A fresh empty directory under the system temp dir, removed when the
+/// guard is dropped: every run of the tests would otherwise leave its
+/// directories behind. A failing test keeps its own, to be looked at.
+pub fn temp_dir(name: &str) -> TempDir {
     let dir = std::env::temp_dir().join(format!("tracelab-test-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
+    TempDir(dir)
+}
+
+/// See [`temp_dir`]; reads as the directory's path.
+pub struct TempDir(PathBuf);
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for TempDir {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
 }
 
 /// Mean of a per-channel quantity over an image and the standard error of

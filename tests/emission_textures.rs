@@ -197,7 +197,8 @@ material = "lamp"
         assert_regions_agree(&regions(kind), &path, &format!("{kind:?}"));
     }
     // A name that no texture has is an error naming it.
-    let file = temp_dir("sphere-lamp-typo").join("scene.toml");
+    let dir = temp_dir("sphere-lamp-typo");
+    let file = dir.join("scene.toml");
     std::fs::write(&file, text.replace("= \"quadrant\"", "= \"quadrnat\"")).unwrap();
     let error = Scene::load(&file)
         .err()

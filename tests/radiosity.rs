@@ -450,7 +450,8 @@ fn lit_panel(twin: bool, camera_above: bool, name: &str) -> Scene {
     text.push_str(
         "[[quad]]\ncorner = [-0.5, 1.0, -0.5]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 0.0, 1.0]\nmaterial = \"white\"\n",
     );
-    let path = temp_dir(name).join("panel.toml");
+    let dir = temp_dir(name);
+    let path = dir.join("panel.toml");
     std::fs::write(&path, text).unwrap();
     Scene::load(&path).expect("the panel loads")
 }
@@ -519,7 +520,8 @@ fn panel_over_lamp(name: &str) -> Scene {
          [[quad]]\ncorner = [-2.0, -0.001, -2.0]\nu = [0.0, 0.0, 4.0]\nv = [4.0, 0.0, 0.0]\nmaterial = \"white\"\n\n\
          [[quad]]\ncorner = [-0.25, 0.0, -0.25]\nu = [0.0, 0.0, 0.5]\nv = [0.5, 0.0, 0.0]\nmaterial = \"lamp\"\n\n\
          [[quad]]\ncorner = [-0.5, 1.0, -0.5]\nu = [0.0, 0.0, 1.0]\nv = [1.0, 0.0, 0.0]\nmaterial = \"white\"\n";
-    let path = temp_dir(name).join("panel.toml");
+    let dir = temp_dir(name);
+    let path = dir.join("panel.toml");
     std::fs::write(&path, text).unwrap();
     Scene::load(&path).expect("the scene loads")
 }

@@ -88,7 +88,7 @@ fn controls_drive_the_renderer_and_export_writes_files() {
     let dir = temp_dir("viewer-export");
     let mut harness = Harness::builder()
         .with_size(SIZE)
-        .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 4)));
+        .build_eframe(|cc| Window::new(cc, launch(dir.to_path_buf(), 4)));
     step_until(&mut harness, "the first render", finished);
     assert_eq!(harness.state().app.frame().views[0].stats.spp, 4);
 
@@ -192,7 +192,7 @@ fn a_bad_scene_shows_an_error_and_keeps_the_last_good_one() {
     std::fs::write(&bad, "[camera]\neye = [0, 0]\n").unwrap();
     let mut harness = Harness::builder()
         .with_size(SIZE)
-        .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 2)));
+        .build_eframe(|cc| Window::new(cc, launch(dir.to_path_buf(), 2)));
     step_until(&mut harness, "the first render", finished);
     let good = harness.state().app.scene().unwrap().clone();
 
@@ -293,7 +293,7 @@ fn the_lab_tab_runs_every_experiment_live_and_cancels() {
     let dir = temp_dir("viewer-lab");
     let mut harness = Harness::builder()
         .with_size(SIZE)
-        .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 4)));
+        .build_eframe(|cc| Window::new(cc, launch(dir.to_path_buf(), 4)));
     harness.get_by_label("MC lab").click();
     // One frame to take the click, one to draw the lab.
     harness.step();
@@ -336,7 +336,7 @@ fn radiosity_controls_drive_the_solver() {
     let dir = temp_dir("viewer-radiosity");
     let mut harness = Harness::builder()
         .with_size(SIZE)
-        .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 4)));
+        .build_eframe(|cc| Window::new(cc, launch(dir.to_path_buf(), 4)));
     // Every solver runs on a coarse mesh (206 uniform elements), for time.
     radiosity(&mut harness).patch_size = 0.3;
     click(&mut harness, "Radiosity");
@@ -437,7 +437,7 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
     let dir = temp_dir("viewer-bdpt");
     let mut harness = Harness::builder()
         .with_size(SIZE)
-        .build_eframe(|cc| Window::new(cc, launch(dir.clone(), 2)));
+        .build_eframe(|cc| Window::new(cc, launch(dir.to_path_buf(), 2)));
     click(&mut harness, "Bidirectional path tracing");
     click(&mut harness, "Balance");
     let options = harness.state().app.settings.a.integrator;
@@ -522,6 +522,7 @@ fn bidirectional_and_photon_mapping_controls_drive_the_renderer() {
 fn a_comparison_renders_the_files_depth_in_both_views() {
     // veach-bidir asks for max_depth 7 (6 bounces): B, path tracing beside
     // BDPT, must not keep its own default of 8.
+    let exports = temp_dir("viewer-compare-depth");
     let launch = Launch {
         scene: Some(repo_path("scenes/veach-bidir/scene.xml")),
         integrator: Some(IntegratorKind::Bdpt),
@@ -530,7 +531,7 @@ fn a_comparison_renders_the_files_depth_in_both_views() {
         target_spp: Some(1),
         threads: 2,
         fresh: true,
-        export_dir: Some(temp_dir("viewer-compare-depth")),
+        export_dir: Some(exports.to_path_buf()),
         ..Default::default()
     };
     let mut harness = Harness::builder()

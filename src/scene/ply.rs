@@ -258,5 +258,6 @@ mod tests {
         assert_eq!(a.uvs, b.uvs);
         let bad = load_ply(&dir.join("missing.ply")).unwrap_err();
         assert!(bad.message().contains("missing.ply"), "{bad}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
