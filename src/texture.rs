@@ -5,6 +5,7 @@
 
 use crate::math::Rgb;
 use glam::Vec2;
+use half::f16;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -53,6 +54,10 @@ enum Texels {
     },
     /// Linear values (float and 16-bit images).
     Floats(Vec<[f32; 3]>),
+    /// Linear values that half floats hold exactly (OpenEXR's usual
+    /// format): half the memory, so that fewer lookups into a large map
+    /// (an environment's) miss the cache.
+    Halves(Vec<[f16; 3]>),
 }
 
 /// Side of the square tiles texels are stored in. A bilinear lookup reads
@@ -372,11 +377,11 @@ impl Bitmap {
                     if linear || raw { c } else { srgb_to_linear(c) }
                 };
                 let rgb = image.into_rgb32f();
-                Texels::Floats(
-                    rgb.pixels()
-                        .map(|p| [decode(p[0]), decode(p[1]), decode(p[2])])
-                        .collect(),
-                )
+                let texels: Vec<[f32; 3]> = rgb
+                    .pixels()
+                    .map(|p| [decode(p[0]), decode(p[1]), decode(p[2])])
+                    .collect();
+                halves_if_exact(&texels).unwrap_or(Texels::Floats(texels))
             }
         };
         Ok(Bitmap::new(width, height, texels))
@@ -405,6 +410,7 @@ impl Bitmap {
                 )
             }
             Texels::Floats(texels) => Rgb::from_array(texels[y * self.width + x]),
+            Texels::Halves(texels) => from_halves(texels[y * self.width + x]),
         }
     }
 
@@ -425,6 +431,7 @@ impl Bitmap {
             Texels::Floats(texels) => {
                 corners.map(|(x, y)| Rgb::from_array(texels[y * self.width + x]))
             }
+            Texels::Halves(texels) => corners.map(|(x, y)| from_halves(texels[y * self.width + x])),
         }
     }
 
@@ -448,6 +455,13 @@ impl Bitmap {
                     }
                 }
             }
+            Texels::Halves(texels) => {
+                for x in [x, x1] {
+                    if let Some(t) = texels.get(y * self.width + x) {
+                        crate::math::prefetch(t);
+                    }
+                }
+            }
         }
     }
 
@@ -456,6 +470,7 @@ impl Bitmap {
         match &self.texels {
             Texels::Bytes { bytes, .. } => bytes.len() + 1024,
             Texels::Floats(texels) => 12 * texels.len(),
+            Texels::Halves(texels) => 6 * texels.len(),
         }
     }
 
@@ -515,6 +530,22 @@ fn wrapped_pair(i: i64, n: usize, wrap: Wrap) -> [usize; 2] {
     }
 }
 
+/// `texels` as half floats, where each value is exactly one (an EXR of
+/// halves, read as floats); else `None`.
+fn halves_if_exact(texels: &[[f32; 3]]) -> Option<Texels> {
+    let exact = |v: f32| f16::from_f32(v).to_f32() == v;
+    texels
+        .iter()
+        .flatten()
+        .all(|&v| exact(v))
+        .then(|| Texels::Halves(texels.iter().map(|t| t.map(f16::from_f32)).collect()))
+}
+
+#[inline(always)]
+fn from_halves([r, g, b]: [f16; 3]) -> Rgb {
+    Rgb::new(r.to_f32(), g.to_f32(), b.to_f32())
+}
+
 /// The sRGB transfer function's inverse (IEC 61966-2-1).
 pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 {
@@ -527,6 +558,25 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A float image whose values half floats hold exactly (an EXR of
+    /// halves) is kept in halves and reads back the same; one other value
+    /// keeps it in floats.
+    #[test]
+    fn float_images_of_halves_are_kept_in_halves() {
+        let image = |values: [f32; 3]| {
+            image::DynamicImage::ImageRgb32F(image::ImageBuffer::from_fn(2, 1, |x, _| {
+                image::Rgb(values.map(|v| v * (x + 1) as f32))
+            }))
+        };
+        let exact = Bitmap::from_image(image([0.5, 1.25, 3.0e4]), false).unwrap();
+        assert!(matches!(exact.texels, Texels::Halves(_)));
+        assert_eq!(exact.at(1, 0), Rgb::new(1.0, 2.5, 6.0e4));
+        assert_eq!(exact.memory_bytes(), 12);
+        let inexact = Bitmap::from_image(image([0.1, 1.25, 3.0e4]), false).unwrap();
+        assert!(matches!(inexact.texels, Texels::Floats(_)));
+        assert_eq!(inexact.at(0, 0), Rgb::new(0.1, 1.25, 3.0e4));
+    }
 
     /// Every texel reads back where it was given: bytes stored in tiles, at
     /// a size that leaves partial tiles, and floats stored row-major.
