@@ -256,15 +256,16 @@ impl McRayTracer {
             counts.bounce += 1;
             let Some(next) = scene.geometry.intersect(&ray) else {
                 if let Some(env) = scene.lights.environment() {
+                    let towards = env.towards(wi_world);
                     let weight = if sample.specular || n_light == 0 {
                         1.0
                     } else if self.mis == MisHeuristic::None {
                         0.0
                     } else {
-                        let light_pdf = scene.lights.environment_pdf(wi_world);
+                        let light_pdf = scene.lights.environment_pdf_towards(towards);
                         multi_sample_weight(self.mis, n_bsdf, sample.pdf, n_light, light_pdf)
                     };
-                    radiance += sample.weight / n_bsdf as f32 * env.le(wi_world) * weight;
+                    radiance += sample.weight / n_bsdf as f32 * env.le_towards(towards) * weight;
                 }
                 continue;
             };

@@ -341,10 +341,11 @@ impl PathTracer {
                 observer.escaped();
                 // Light from infinity, weighed against its light samples.
                 if let Some(env) = scene.lights.environment() {
+                    let towards = env.towards(ray.direction);
                     let weight = self.found_light_weight(specular_bounce, prev_bsdf_pdf, || {
-                        scene.lights.environment_pdf(ray.direction)
+                        scene.lights.environment_pdf_towards(towards)
                     });
-                    radiance += beta * env.le(ray.direction) * weight;
+                    radiance += beta * env.le_towards(towards) * weight;
                 }
                 break;
             };

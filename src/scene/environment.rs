@@ -24,6 +24,14 @@ pub enum Radiance {
     Map(Arc<Bitmap>),
 }
 
+/// A direction towards the environment and, on a map, its coordinates
+/// ([`Environment::towards`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Towards {
+    pub d: Vec3A,
+    uv: Option<Vec2>,
+}
+
 /// An environment light.
 #[derive(Clone, Debug)]
 pub struct Environment {
@@ -104,10 +112,26 @@ impl Environment {
     /// Radiance arriving from direction `d` (unit, pointing away from the scene).
     #[inline]
     pub fn le(&self, d: Vec3A) -> Rgb {
-        match &self.radiance {
-            Radiance::Constant(c) => *c * self.scale,
-            Radiance::Map(_) => self.le_at(direction_to_uv(self.to_local * d)),
-        }
+        self.le_towards(self.towards(d))
+    }
+
+    /// Direction `d` with its map coordinates, for a caller that reads both
+    /// the radiance and a density there (a ray that left the scene): the
+    /// arc tangent and cosine of the conversion once, not twice.
+    #[inline]
+    pub fn towards(&self, d: Vec3A) -> Towards {
+        let uv = match &self.radiance {
+            Radiance::Constant(_) => None,
+            Radiance::Map(_) => Some(direction_to_uv(self.to_local * d)),
+        };
+        Towards { d, uv }
+    }
+
+    /// [`Environment::le`] of a [`Environment::towards`].
+    #[inline]
+    pub fn le_towards(&self, towards: Towards) -> Rgb {
+        // A constant environment reads no coordinates.
+        self.le_at(towards.uv.unwrap_or(Vec2::ZERO))
     }
 
     /// Radiance at map coordinates `uv` (as [`Environment::sample_direction`]
@@ -188,6 +212,16 @@ impl Environment {
             return 1.0 / (4.0 * PI);
         };
         pdf_at(distribution, direction_to_uv(self.to_local * d))
+    }
+
+    /// [`Environment::pdf`] of a [`Environment::towards`].
+    #[inline]
+    pub fn pdf_towards(&self, towards: Towards) -> f32 {
+        match (&self.distribution, towards.uv) {
+            (Some(distribution), Some(uv)) => pdf_at(distribution, uv),
+            (Some(_), None) => self.pdf(towards.d),
+            (None, _) => 1.0 / (4.0 * PI),
+        }
     }
 
     /// Power, for choosing between lights: π R² ∫ luminance(L) dω.

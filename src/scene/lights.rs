@@ -1,7 +1,7 @@
 //! All lights of a scene and how one is chosen: the emitters of `light.rs`
 //! and the environment, for next-event estimation and for light paths.
 
-use super::environment::Environment;
+use super::environment::{Environment, Towards};
 use super::light::{EmissionSample, EmissionTexture, Light, LightSample, LightSampling};
 use crate::math::{OffsetMode, Rgb};
 use crate::sampling::AliasTable;
@@ -272,11 +272,29 @@ impl Lights {
         }
     }
 
+    /// [`Lights::environment_pdf`] of an [`Environment::towards`].
+    #[inline]
+    pub fn environment_pdf_towards(&self, towards: Towards) -> f32 {
+        match (&self.environment, &self.direct) {
+            (Some(env), Some(table)) => table.pmf(self.lights.len()) * env.pdf_towards(towards),
+            _ => 0.0,
+        }
+    }
+
     /// [`Lights::environment_pdf`] for [`Lights::sample_as_emitted`].
     #[inline]
     pub fn environment_pdf_as_emitted(&self, d: Vec3A) -> f32 {
         match (&self.environment, &self.selection) {
             (Some(env), Some(table)) => table.pmf(self.lights.len()) * env.pdf(d),
+            _ => 0.0,
+        }
+    }
+
+    /// [`Lights::environment_pdf_as_emitted`] of an [`Environment::towards`].
+    #[inline]
+    pub fn environment_pdf_as_emitted_towards(&self, towards: Towards) -> f32 {
+        match (&self.environment, &self.selection) {
+            (Some(env), Some(table)) => table.pmf(self.lights.len()) * env.pdf_towards(towards),
             _ => 0.0,
         }
     }

@@ -312,9 +312,10 @@ pub fn camera_to_diffuse(
     for bounces in 0..=max_depth {
         let Some(hit) = scene.geometry.intersect(&ray) else {
             if let Some(env) = scene.lights.environment() {
-                let d = ray.direction;
-                let weight = found_light_weight(glossy, |_| scene.lights.environment_pdf(d));
-                emitted += beta * env.le(d) * weight;
+                let towards = env.towards(ray.direction);
+                let weight =
+                    found_light_weight(glossy, |_| scene.lights.environment_pdf_towards(towards));
+                emitted += beta * env.le_towards(towards) * weight;
             }
             break;
         };

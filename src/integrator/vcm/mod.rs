@@ -633,11 +633,12 @@ impl Vcm {
         let Some(env) = scene.lights.environment() else {
             return Rgb::ZERO;
         };
-        let le = env.le(ray.direction);
+        let towards = env.towards(ray.direction);
+        let le = env.le_towards(towards);
         if segments == 1 {
             return le;
         }
-        let direct = scene.lights.environment_pdf_as_emitted(ray.direction);
+        let direct = scene.lights.environment_pdf_as_emitted_towards(towards);
         let (pdf_position, pdf_direction) =
             scene
                 .lights
