@@ -55,8 +55,8 @@ enum Texels {
     /// Linear values (float and 16-bit images).
     Floats(Vec<[f32; 3]>),
     /// Linear values that half floats hold exactly (OpenEXR's usual
-    /// format): half the memory, so that fewer lookups into a large map
-    /// (an environment's) miss the cache.
+    /// format), in half the memory: a 2048 × 1024 sky takes 12.6 MB, not
+    /// 25.2.
     Halves(Vec<[f16; 3]>),
 }
 
@@ -448,20 +448,8 @@ impl Bitmap {
                     }
                 }
             }
-            Texels::Floats(texels) => {
-                for x in [x, x1] {
-                    if let Some(t) = texels.get(y * self.width + x) {
-                        crate::math::prefetch(t);
-                    }
-                }
-            }
-            Texels::Halves(texels) => {
-                for x in [x, x1] {
-                    if let Some(t) = texels.get(y * self.width + x) {
-                        crate::math::prefetch(t);
-                    }
-                }
-            }
+            Texels::Floats(texels) => prefetch_texels(texels, y * self.width, [x, x1]),
+            Texels::Halves(texels) => prefetch_texels(texels, y * self.width, [x, x1]),
         }
     }
 
@@ -539,6 +527,16 @@ fn halves_if_exact(texels: &[[f32; 3]]) -> Option<Texels> {
         .flatten()
         .all(|&v| exact(v))
         .then(|| Texels::Halves(texels.iter().map(|t| t.map(f16::from_f32)).collect()))
+}
+
+/// Asks the cache for texels `row + x` of row-major `texels`.
+#[inline(always)]
+fn prefetch_texels<T>(texels: &[T], row: usize, xs: [usize; 2]) {
+    for x in xs {
+        if let Some(t) = texels.get(row + x) {
+            crate::math::prefetch(t);
+        }
+    }
 }
 
 #[inline(always)]
