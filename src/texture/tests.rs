@@ -66,28 +66,13 @@ fn two_by_two() -> Bitmap {
 #[test]
 fn bitmap_lookup_filters_and_wraps() {
     let b = two_by_two();
+    let repeat = |u, v, filter| b.lookup(Vec2::new(u, v), Wrap::Repeat, filter).x;
     // Texel centres read exactly; the middle is the mean of four.
-    assert_eq!(
-        b.lookup(Vec2::new(0.25, 0.25), Wrap::Repeat, Filter::Bilinear)
-            .x,
-        0.0
-    );
-    assert_eq!(
-        b.lookup(Vec2::new(0.75, 0.75), Wrap::Repeat, Filter::Bilinear)
-            .x,
-        3.0
-    );
-    assert_eq!(
-        b.lookup(Vec2::new(0.5, 0.5), Wrap::Repeat, Filter::Bilinear)
-            .x,
-        1.5
-    );
+    assert_eq!(repeat(0.25, 0.25, Filter::Bilinear), 0.0);
+    assert_eq!(repeat(0.75, 0.75, Filter::Bilinear), 3.0);
+    assert_eq!(repeat(0.5, 0.5, Filter::Bilinear), 1.5);
     // Row 0 is the top: v = 0.25 reads texels 0 and 1.
-    assert_eq!(
-        b.lookup(Vec2::new(0.75, 0.25), Wrap::Repeat, Filter::Nearest)
-            .x,
-        1.0
-    );
+    assert_eq!(repeat(0.75, 0.25, Filter::Nearest), 1.0);
     // Repeat, clamp and mirror one texel beyond the right edge.
     let beyond = Vec2::new(1.25, 0.25);
     assert_eq!(b.lookup(beyond, Wrap::Repeat, Filter::Nearest).x, 0.0);
