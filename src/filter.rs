@@ -116,7 +116,8 @@ impl PixelFilter {
                 let mass = erf(radius / (stddev * std::f32::consts::SQRT_2));
                 stddev * (2.0 * std::f32::consts::PI).sqrt() * mass
             }
-            _ => 1.0,
+            PixelFilter::Tent { radius } => radius * radius,
+            PixelFilter::Box => 1.0,
         };
         Filter1d {
             filter: *self,
@@ -152,12 +153,6 @@ impl PixelFilter {
     }
 }
 
-/// The normalised 1D tent of radius r: (r − |x|) / r².
-#[inline]
-fn tent(x: f32, r: f32) -> f32 {
-    ((r - x.abs()) / (r * r)).max(0.0)
-}
-
 /// Inverse CDF of the tent: each half is a triangle of mass 1/2, and the
 /// half is the sign of 2u − 1 (without a branch, which a random u
 /// mispredicts every other sample).
@@ -171,7 +166,8 @@ fn sample_tent(u: f32, r: f32) -> f32 {
 #[derive(Clone, Copy, Debug)]
 pub struct Filter1d {
     filter: PixelFilter,
-    /// The Gaussian's normalisation: σ √(2π) times its mass within ±r.
+    /// The integral of [`PixelFilter::shape_1d`]: r² for the tent, σ √(2π)
+    /// times its mass within ±r for the Gaussian.
     scale: f32,
 }
 
@@ -179,16 +175,7 @@ impl Filter1d {
     /// The filter at `x` (the Gaussian cut at ±r).
     #[inline]
     pub fn eval(&self, x: f32) -> f32 {
-        match self.filter {
-            PixelFilter::Box => f32::from(u8::from(x.abs() <= 0.5)),
-            PixelFilter::Tent { radius } => tent(x, radius),
-            PixelFilter::Gaussian { stddev, radius } => {
-                if x.abs() > radius {
-                    return 0.0;
-                }
-                (-(x * x) / (2.0 * stddev * stddev)).exp() / self.scale
-            }
-        }
+        self.filter.shape_1d(x) / self.scale
     }
 }
 
