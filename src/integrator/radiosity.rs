@@ -430,10 +430,9 @@ impl Radiosity {
                 let b = scene.geometry.bounds();
                 let max_edge = self.patch_size * (b.max - b.min).length();
                 let base = if self.lines_on_regular_mesh {
-                    let min_piece = self.min_piece_area;
                     Base::Regular {
                         max_edge,
-                        min_piece,
+                        min_piece: self.min_piece_area,
                     }
                 } else {
                     Base::Delaunay { max_edge }
