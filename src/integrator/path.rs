@@ -350,9 +350,6 @@ impl PathTracer {
                 break;
             };
             observer.vertex(bounces, &hit, beta);
-            if !DIFFUSE_ONLY && self.nee {
-                scene.lights.prefetch_sample_guided(u.light_select, u.light);
-            }
             let wo_world = -ray.direction;
             if hit.light != NO_LIGHT && !(seen_known && bounces == 0) {
                 let emitted = scene.emitted(&hit, wo_world);

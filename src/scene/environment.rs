@@ -185,22 +185,13 @@ impl Environment {
         }
     }
 
-    /// Asks the cache for the table entry that [`Environment::sample`]
-    /// reads first for `u`: the caller knows u before it traces the ray
-    /// whose hit the sample lights, and the entry arrives meanwhile.
+    /// Asks the cache for the table line that [`Environment::sample`]
+    /// reads for `u`: the caller knows u before it traces the ray whose
+    /// hit the sample lights, and the line arrives meanwhile.
     #[inline(always)]
     pub fn prefetch_sample(&self, u: Vec2) {
         if let Some(distribution) = &self.distribution {
             distribution.prefetch(u);
-        }
-    }
-
-    /// The second step of [`Environment::prefetch_sample`], once its entry
-    /// has arrived: the cells that entry points at.
-    #[inline(always)]
-    pub fn prefetch_sample_guided(&self, u: Vec2) {
-        if let Some(distribution) = &self.distribution {
-            distribution.prefetch_guided(u);
         }
     }
 

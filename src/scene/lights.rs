@@ -447,37 +447,22 @@ impl Lights {
     }
 
     /// A hint before [`Lights::sample`] with the same numbers: where that
-    /// sample would be the environment's, its first table entry is fetched
-    /// into the cache while the caller traces (living-room: the entry was
-    /// a cache miss that held 14% of path tracing's time).
+    /// sample would be the environment's, the line of its table that it
+    /// reads is fetched into the cache while the caller traces
+    /// (living-room: that miss held 14% of path tracing's time).
     #[inline(always)]
     pub fn prefetch_sample(&self, u_select: f32, u: Vec2) {
-        self.prefetch_environment(self.direct.as_ref(), u_select, u, false);
+        self.prefetch_environment(self.direct.as_ref(), u_select, u);
     }
 
-    /// The second step of [`Lights::prefetch_sample`] with the same numbers,
-    /// some time after it (the path tracer: once the ray it traced meanwhile
-    /// has hit): the table cells that the first step's entry points at.
+    /// [`Lights::prefetch_sample`] for [`Lights::sample_as_emitted`].
     #[inline(always)]
-    pub fn prefetch_sample_guided(&self, u_select: f32, u: Vec2) {
-        self.prefetch_environment(self.direct.as_ref(), u_select, u, true);
-    }
-
-    /// [`Lights::prefetch_sample`] and [`Lights::prefetch_sample_guided`]
-    /// (`guided`) for [`Lights::sample_as_emitted`].
-    #[inline(always)]
-    pub fn prefetch_sample_as_emitted(&self, u_select: f32, u: Vec2, guided: bool) {
-        self.prefetch_environment(self.selection.as_ref(), u_select, u, guided);
+    pub fn prefetch_sample_as_emitted(&self, u_select: f32, u: Vec2) {
+        self.prefetch_environment(self.selection.as_ref(), u_select, u);
     }
 
     #[inline(always)]
-    fn prefetch_environment(
-        &self,
-        table: Option<&AliasTable>,
-        u_select: f32,
-        u: Vec2,
-        guided: bool,
-    ) {
+    fn prefetch_environment(&self, table: Option<&AliasTable>, u_select: f32, u: Vec2) {
         let (Some(environment), Some(table)) = (&self.environment, table) else {
             return;
         };
@@ -489,11 +474,7 @@ impl Lights {
         if index < self.lights.len() {
             return;
         }
-        if guided {
-            environment.prefetch_sample_guided(u);
-        } else {
-            environment.prefetch_sample(u);
-        }
+        environment.prefetch_sample(u);
     }
 
     /// Chooses a light by power and samples a particle leaving it (light tracing).

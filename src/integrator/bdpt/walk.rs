@@ -102,14 +102,12 @@ impl Bdpt {
                 ),
                 Transport::Importance => (0.0, sampler.next_2d_for(Domain::Lens)),
             };
-            // The environment's table entries for this vertex's light
-            // sample (made later, by the connections), fetched in two steps
-            // as the path tracer fetches them.
+            // The environment's table line for this vertex's light sample
+            // (made later, by the connections), fetched as the path tracer
+            // fetches it.
             let camera_side = transport == Transport::Radiance;
             if camera_side {
-                scene
-                    .lights
-                    .prefetch_sample_as_emitted(u_select, u_connect, false);
+                scene.lights.prefetch_sample_as_emitted(u_select, u_connect);
             }
             let Some(hit) = scene.geometry.intersect(&ray) else {
                 // A camera subpath that leaves the scene ends on the environment.
@@ -138,11 +136,6 @@ impl Bdpt {
                 }
                 break;
             };
-            if camera_side {
-                scene
-                    .lights
-                    .prefetch_sample_as_emitted(u_select, u_connect, true);
-            }
             let wo_world = -ray.direction;
             let index = path.len();
             let previous = path.vertices[index - 1];
