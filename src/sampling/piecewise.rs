@@ -98,25 +98,7 @@ impl Piecewise1D {
     /// take it as its own number.
     #[inline]
     fn sample_cell(&self, u: f32) -> (usize, f32) {
-        // The last cell whose cdf start is <= u, from the guide's start
-        // (a step back where u * n rounded up into the next entry).
-        let c = &self.cells;
-        let n = self.len();
-        let k = ((u * n as f32) as usize).min(n - 1);
-        let mut i = c[k].guide as usize;
-        while i > 0 && c[i].cdf > u {
-            i -= 1;
-        }
-        while i + 1 < n && c[i + 1].cdf <= u {
-            i += 1;
-        }
-        let width = c[i + 1].cdf - c[i].cdf;
-        let t = if width > 0.0 {
-            ((u - c[i].cdf) / width).clamp(0.0, 1.0)
-        } else {
-            0.5
-        };
-        (i, t)
+        sample_cell(&self.cells, u)
     }
 
     /// The density at x.
@@ -125,6 +107,29 @@ impl Piecewise1D {
         let i = ((x * self.len() as f32) as usize).min(self.len() - 1);
         self.cells[i].func / self.integral
     }
+}
+
+/// [`Piecewise1D::sample_cell`] over a table's cells (n + 1 of them).
+#[inline]
+fn sample_cell(c: &[Cell], u: f32) -> (usize, f32) {
+    // The last cell whose cdf start is <= u, from the guide's start (a step
+    // back where u * n rounded up into the next entry).
+    let n = c.len() - 1;
+    let k = ((u * n as f32) as usize).min(n - 1);
+    let mut i = c[k].guide as usize;
+    while i > 0 && c[i].cdf > u {
+        i -= 1;
+    }
+    while i + 1 < n && c[i + 1].cdf <= u {
+        i += 1;
+    }
+    let width = c[i + 1].cdf - c[i].cdf;
+    let t = if width > 0.0 {
+        ((u - c[i].cdf) / width).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    (i, t)
 }
 
 /// Side of the square blocks of cells that [`Piecewise2D`] samples in
@@ -151,8 +156,10 @@ struct Block([u16; BLOCK_CELLS]);
 pub struct Piecewise2D {
     /// The marginal over rows of blocks.
     marginal: Piecewise1D,
-    /// Per row of blocks, the conditional over its blocks.
-    rows: Vec<Piecewise1D>,
+    /// Per row of blocks, the conditional over its blocks' sums: the
+    /// [`Piecewise1D`] tables' cells, row after row in one array (one
+    /// dependent load fewer than a table per row).
+    conditionals: Vec<Cell>,
     /// The cells, block by block, row by row of blocks.
     blocks: Vec<Block>,
     /// Per block, the value of a stored 1 times width × height / the sum of
@@ -210,6 +217,7 @@ impl Piecewise2D {
             .collect();
         let rows: Vec<Piecewise1D> = sums.par_chunks(blocks_wide).map(Piecewise1D::new).collect();
         let marginal = Piecewise1D::new(&rows.iter().map(|r| r.integral).collect::<Vec<_>>());
+        let conditionals = rows.into_iter().flat_map(|r| r.cells).collect();
         let total: f64 = sums.iter().map(|&s| s as f64).sum();
         let per_cell = (width * height) as f64 / total;
         for unit in &mut scales {
@@ -217,7 +225,7 @@ impl Piecewise2D {
         }
         Piecewise2D {
             marginal,
-            rows,
+            conditionals,
             blocks,
             scales,
             blocks_wide,
@@ -229,11 +237,7 @@ impl Piecewise2D {
     /// Bytes of the tables.
     pub fn memory_bytes(&self) -> usize {
         self.marginal.memory_bytes()
-            + self
-                .rows
-                .iter()
-                .map(Piecewise1D::memory_bytes)
-                .sum::<usize>()
+            + std::mem::size_of_val(&self.conditionals[..])
             + std::mem::size_of_val(&self.blocks[..])
             + std::mem::size_of_val(&self.scales[..])
     }
@@ -242,7 +246,8 @@ impl Piecewise2D {
     #[inline]
     fn sample_block(&self, u: Vec2) -> (usize, Vec2) {
         let (row, ty) = self.marginal.sample_cell(u.y);
-        let (column, tx) = self.rows[row].sample_cell(u.x);
+        let stride = self.blocks_wide + 1;
+        let (column, tx) = sample_cell(&self.conditionals[row * stride..(row + 1) * stride], u.x);
         (row * self.blocks_wide + column, Vec2::new(tx, ty))
     }
 
