@@ -153,6 +153,20 @@ impl Texture {
         }
     }
 
+    /// Asks the cache for the texels [`Texture::eval`] reads at `uv`.
+    #[inline(always)]
+    pub fn prefetch(&self, uv: Vec2) {
+        if let Texture::Bitmap {
+            image,
+            wrap,
+            filter,
+            to_uv,
+        } = self
+        {
+            image.prefetch_lookup(uv * to_uv.scale + to_uv.offset, *wrap, *filter);
+        }
+    }
+
     /// One value at `uv`, as Mitsuba's `eval_1` reads it for a roughness or
     /// an opacity: the luminance; a checkerboard's squares swapped, as
     /// Mitsuba 3 (3.9.1) gives color1 from `eval_1` where `eval` gives
@@ -465,6 +479,31 @@ impl Bitmap {
     #[inline]
     fn texel(&self, x: i64, y: i64, wrap: Wrap) -> Rgb {
         self.at(wrapped(x, self.width, wrap), wrapped(y, self.height, wrap))
+    }
+
+    /// Asks the cache for the texels [`Bitmap::lookup`] reads at `uv`.
+    #[inline(always)]
+    pub fn prefetch_lookup(&self, uv: Vec2, wrap: Wrap, filter: Filter) {
+        if !uv.is_finite() {
+            return;
+        }
+        let x = uv.x * self.width as f32 - 0.5;
+        let y = uv.y * self.height as f32 - 0.5;
+        let (x, rows) = match filter {
+            Filter::Nearest => {
+                let x = wrapped((x + 0.5).floor() as i64, self.width, wrap);
+                let y = wrapped((y + 0.5).floor() as i64, self.height, wrap);
+                (x, [y, y])
+            }
+            Filter::Bilinear => (
+                wrapped_pair(x.floor() as i64, self.width, wrap)[0],
+                wrapped_pair(y.floor() as i64, self.height, wrap),
+            ),
+        };
+        self.prefetch(x, rows[0]);
+        if rows[1] != rows[0] {
+            self.prefetch(x, rows[1]);
+        }
     }
 
     /// The bitmap at texture coordinates `uv` (texel centres at

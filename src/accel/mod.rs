@@ -509,6 +509,20 @@ impl Geometry {
         self.masks.is_some()
     }
 
+    /// Asks the cache for triangle `i`'s texture coordinates and vertex
+    /// normals, which shading reads at a hit (living-room: a miss each,
+    /// after the traversal).
+    #[inline(always)]
+    fn prefetch_shading(&self, i: usize) {
+        if let Some(uvs) = self.tri_uvs.get(i) {
+            crate::math::prefetch(uvs);
+        }
+        if let Some(normals) = self.tri_normals.get(i) {
+            crate::math::prefetch(&normals[0]);
+            crate::math::prefetch(&normals[2]);
+        }
+    }
+
     /// Closest hit among the geometry at rest.
     #[inline(always)]
     fn intersect_static<const LANES: bool>(&self, ray: &Ray) -> Option<SurfaceHit> {
@@ -523,7 +537,10 @@ impl Geometry {
                 }
             }
             TriangleIndex::Bvh(bvh) => {
-                if let Some(((i, t, b1, b2), v)) = bvh.closest(ray, best_t, &self.tri_vertices) {
+                let found = |i: usize| self.prefetch_shading(i);
+                if let Some(((i, t, b1, b2), v)) =
+                    bvh.closest(ray, best_t, &self.tri_vertices, found)
+                {
                     (best_tri, best_t, best_b1, best_b2) = (i as u32, t, b1, b2);
                     vertices = Some(v);
                 }

@@ -52,13 +52,17 @@ impl WideBvh {
         std::mem::size_of_val(&self.nodes[..]) + std::mem::size_of_val(&self.leaves[..])
     }
 
-    /// Closest hit in (0, t_max), front to back, with the hit triangle's vertices.
+    /// Closest hit in (0, t_max), front to back, with the hit triangle's
+    /// vertices. `found` hears of each triangle that becomes the closest
+    /// so far (to ask for what the caller reads at the hit while the
+    /// traversal goes on).
     #[inline]
     pub fn closest(
         &self,
         ray: &Ray,
         t_max: f32,
         triangles: &[[Vec3A; 3]],
+        mut found: impl FnMut(usize),
     ) -> Option<(TriangleHit, [Vec3A; 3])> {
         let axes = Axes::new(ray);
         let slabs = SlabAxes::new(ray);
@@ -80,8 +84,11 @@ impl WideBvh {
                 // retest of edge cases may return a hit at exactly best_t.
                 let before = best.map(|h: TriangleHit| h.0);
                 self.leaves[leaf].closest(&axes, ray, triangles, &mut best_t, &mut best);
-                if best.map(|h| h.0) != before {
+                if let Some(hit) = best
+                    && Some(hit.0) != before
+                {
                     best_leaf = leaf;
+                    found(hit.0);
                 }
                 continue;
             }
@@ -212,7 +219,7 @@ mod tests {
         let mut hits = 0;
         for (i, ray) in rays.enumerate() {
             let expected = nearest(&ray, &triangles);
-            let found = bvh.closest(&ray, f32::INFINITY, &triangles);
+            let found = bvh.closest(&ray, f32::INFINITY, &triangles, |_| {});
             assert_eq!(found.map(|h| h.0.1), expected, "ray {i}");
             if let Some(((index, t, _, _), vertices)) = found {
                 assert_eq!(vertices, triangles[index], "ray {i}");

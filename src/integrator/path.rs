@@ -350,6 +350,9 @@ impl PathTracer {
                 break;
             };
             observer.vertex(bounces, &hit, beta);
+            // The material's texels arrive while the light sample, which
+            // needs no BSDF, is made.
+            scene.prefetch_bsdf(&hit);
             let wo_world = -ray.direction;
             if hit.light != NO_LIGHT && !(seen_known && bounces == 0) {
                 let emitted = scene.emitted(&hit, wo_world);
@@ -363,8 +366,18 @@ impl PathTracer {
                     observer.emission(emitted, weight, beta * emitted * weight);
                 }
             }
+            if bounces >= self.max_depth {
+                break;
+            }
+            let light_sample = if self.nee && !(!DIFFUSE_ONLY && scene.bsdf_is_specular(&hit)) {
+                scene
+                    .lights
+                    .sample_deferred(hit.point, u.light_select, u.light)
+            } else {
+                None
+            };
             let bsdf = scene.bsdf_at(&hit);
-            if bounces >= self.max_depth || bsdf.is_black() {
+            if bsdf.is_black() {
                 break;
             }
             let frame = scene.shading_frame(&hit);
@@ -377,9 +390,9 @@ impl PathTracer {
             // -> 3.61 M paths/s, independent 3.81 -> 4.10). An observer
             // hears of it in path order; the image is the same either way.
             let mut pending = None;
-            if self.nee && !(!DIFFUSE_ONLY && bsdf.is_specular()) {
+            if let Some(light_sample) = light_sample {
                 let light =
-                    self.sample_light::<DIFFUSE_ONLY>(scene, &hit, &frame, &bsdf, wo, beta, &u);
+                    self.weigh_light::<DIFFUSE_ONLY>(light_sample, &hit, &frame, &bsdf, wo, beta);
                 if let Some((shadow, mut ls, f, weight)) = light {
                     if O::IN_ORDER {
                         let visible = shadow.visible::<PLAIN>(scene, counts);
@@ -449,25 +462,21 @@ impl PathTracer {
         }
     }
 
-    /// A light sample from `hit`: its shadow ray and what it adds where
-    /// the light is visible (throughput `beta`), then for observers the
-    /// sample, the BSDF's value towards it and its MIS weight against BSDF
-    /// sampling; `None` where it adds nothing.
+    /// A light sample made at `hit` (with its deferred environment
+    /// coordinates): its shadow ray and what it adds where the light is
+    /// visible (throughput `beta`), then for observers the sample, the
+    /// BSDF's value towards it and its MIS weight against BSDF sampling;
+    /// `None` where it adds nothing.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn sample_light<const DIFFUSE_ONLY: bool>(
+    fn weigh_light<const DIFFUSE_ONLY: bool>(
         &self,
-        scene: &Scene,
+        (ls, deferred): (LightSample, Option<Vec2>),
         hit: &SurfaceHit,
         frame: &Frame,
         bsdf: &Bsdf,
         wo: Vec3A,
         beta: Rgb,
-        u: &VertexNumbers,
     ) -> Option<(PendingShadow, LightSample, Rgb, f32)> {
-        let (ls, deferred) = scene
-            .lights
-            .sample_deferred(hit.point, u.light_select, u.light)?;
         let wi = frame.to_local(ls.wi);
         let f = eval::<DIFFUSE_ONLY>(bsdf, wo, wi);
         if f.max_element() <= 0.0 {

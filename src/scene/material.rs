@@ -104,6 +104,18 @@ impl Material {
         };
     }
 
+    /// Asks the cache for the texels that [`Material::bsdf_at`] reads at
+    /// `uv`: a caller with work that needs no BSDF starts them early.
+    #[inline(always)]
+    pub fn prefetch_textures(&self, textures: &[Texture], uv: Vec2) {
+        let t = &self.textures;
+        for slot in [t.diffuse, t.specular, t.alpha, t.alpha_v, t.metallic] {
+            if let Some(i) = slot {
+                textures[i as usize].prefetch(uv);
+            }
+        }
+    }
+
     /// The BSDF at a hit with texture coordinates `uv`: the textured
     /// parameters read from `textures`, the rest as stored.
     #[inline]

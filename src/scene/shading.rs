@@ -20,6 +20,22 @@ impl Scene {
         self.textured_bsdf_at(material, hit)
     }
 
+    /// Asks the cache for the texels [`Scene::bsdf_at`] reads at `hit`.
+    #[inline(always)]
+    pub fn prefetch_bsdf(&self, hit: &SurfaceHit) {
+        let material = &self.materials[hit.material as usize];
+        if !material.textures.is_empty() {
+            material.prefetch_textures(&self.textures, self.geometry.uv(hit));
+        }
+    }
+
+    /// Whether the BSDF at `hit` is specular, before it is read
+    /// (textures change its parameters, never its kind).
+    #[inline(always)]
+    pub fn bsdf_is_specular(&self, hit: &SurfaceHit) -> bool {
+        self.materials[hit.material as usize].bsdf.is_specular()
+    }
+
     /// Radiance that the surface at `hit` emits towards `w`: its
     /// material's emission, times its texture where it has one.
     #[inline]
