@@ -509,11 +509,14 @@ impl Geometry {
         self.masks.is_some()
     }
 
-    /// Asks the cache for triangle `i`'s texture coordinates and vertex
-    /// normals, which shading reads at a hit (living-room: a miss each,
-    /// after the traversal).
+    /// Asks the cache for triangle `i`'s record, texture coordinates and
+    /// vertex normals, which the hit and its shading read (living-room,
+    /// staircase: a miss each, after the traversal).
     #[inline(always)]
     fn prefetch_shading(&self, i: usize) {
+        if let Some(record) = self.tri_shading.get(i) {
+            crate::math::prefetch(record);
+        }
         if let Some(uvs) = self.tri_uvs.get(i) {
             crate::math::prefetch(uvs);
         }
