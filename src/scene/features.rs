@@ -29,6 +29,8 @@ pub struct Features {
     /// Some material's roughness differs along u and v: its frame follows
     /// the surface's dp/du.
     pub anisotropic: bool,
+    /// Some material's BSDF reads a texture.
+    pub textures: bool,
 }
 
 impl Features {
@@ -74,6 +76,7 @@ impl Features {
                 || materials.iter().any(|m| m.normal_map.is_some()),
             normal_maps: materials.iter().any(|m| m.normal_map.is_some()),
             anisotropic: materials.iter().any(Material::is_anisotropic),
+            textures: materials.iter().any(|m| !m.textures.is_empty()),
         }
     }
 

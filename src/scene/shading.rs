@@ -23,6 +23,9 @@ impl Scene {
     /// Asks the cache for the texels [`Scene::bsdf_at`] reads at `hit`.
     #[inline(always)]
     pub fn prefetch_bsdf(&self, hit: &SurfaceHit) {
+        if !self.features.textures {
+            return;
+        }
         let material = &self.materials[hit.material as usize];
         if !material.textures.is_empty() {
             material.prefetch_textures(&self.textures, self.geometry.uv(hit));
