@@ -5,6 +5,23 @@
 use super::*;
 
 impl Geometry {
+    /// Asks the cache for triangle `i`'s record, texture coordinates and
+    /// vertex normals, which the hit and its shading read (living-room,
+    /// staircase: a miss each, after the traversal).
+    #[inline(always)]
+    pub(super) fn prefetch_shading(&self, i: usize) {
+        if let Some(record) = self.tri_shading.get(i) {
+            crate::math::prefetch(record);
+        }
+        if let Some(uvs) = self.tri_uvs.get(i) {
+            crate::math::prefetch(uvs);
+        }
+        if let Some(normals) = self.tri_normals.get(i) {
+            crate::math::prefetch(&normals[0]);
+            crate::math::prefetch(&normals[2]);
+        }
+    }
+
     /// The unit shading normal at `hit`: its triangle's vertex normals
     /// interpolated, else the geometric normal. BSDFs act in its frame;
     /// offsets, emission and area densities keep the geometric one.

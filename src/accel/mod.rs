@@ -509,23 +509,6 @@ impl Geometry {
         self.masks.is_some()
     }
 
-    /// Asks the cache for triangle `i`'s record, texture coordinates and
-    /// vertex normals, which the hit and its shading read (living-room,
-    /// staircase: a miss each, after the traversal).
-    #[inline(always)]
-    fn prefetch_shading(&self, i: usize) {
-        if let Some(record) = self.tri_shading.get(i) {
-            crate::math::prefetch(record);
-        }
-        if let Some(uvs) = self.tri_uvs.get(i) {
-            crate::math::prefetch(uvs);
-        }
-        if let Some(normals) = self.tri_normals.get(i) {
-            crate::math::prefetch(&normals[0]);
-            crate::math::prefetch(&normals[2]);
-        }
-    }
-
     /// Closest hit among the geometry at rest.
     #[inline(always)]
     fn intersect_static<const LANES: bool>(&self, ray: &Ray) -> Option<SurfaceHit> {
