@@ -1,6 +1,7 @@
 //! Piecewise-constant densities on [0, 1) and [0, 1)², sampled by
-//! inverting their CDFs (pbrt's Distribution1D / 2D): the environment
-//! map's importance sampling.
+//! inverting their CDFs (pbrt's Distribution1D / 2D; the 2D one in two
+//! steps, a block of cells and then a cell): the environment map's
+//! importance sampling.
 
 use glam::Vec2;
 
@@ -219,7 +220,12 @@ impl Piecewise2D {
         let marginal = Piecewise1D::new(&rows.iter().map(|r| r.integral).collect::<Vec<_>>());
         let conditionals = rows.into_iter().flat_map(|r| r.cells).collect();
         let total: f64 = sums.iter().map(|&s| s as f64).sum();
-        let per_cell = (width * height) as f64 / total;
+        // (Zero where every block's unit underflowed: no density, no NaN.)
+        let per_cell = if total > 0.0 {
+            (width * height) as f64 / total
+        } else {
+            0.0
+        };
         for unit in &mut scales {
             *unit = (*unit as f64 * per_cell) as f32;
         }
