@@ -487,23 +487,41 @@ impl Bitmap {
         if !uv.is_finite() {
             return;
         }
+        match filter {
+            Filter::Nearest => {
+                let (x, y) = self.nearest(uv, wrap);
+                self.prefetch(x, y);
+            }
+            Filter::Bilinear => {
+                let ([x0, _], [y0, y1], _) = self.bilinear(uv, wrap);
+                self.prefetch(x0, y0);
+                if y1 != y0 {
+                    self.prefetch(x0, y1);
+                }
+            }
+        }
+    }
+
+    /// The texel [`Filter::Nearest`] reads at `uv`.
+    #[inline(always)]
+    fn nearest(&self, uv: Vec2, wrap: Wrap) -> (usize, usize) {
+        // As the bilinear filter's grid places texel centres (the half
+        // texel's rounding included).
+        let x = (uv.x * self.width as f32 - 0.5 + 0.5).floor() as i64;
+        let y = (uv.y * self.height as f32 - 0.5 + 0.5).floor() as i64;
+        (wrapped(x, self.width, wrap), wrapped(y, self.height, wrap))
+    }
+
+    /// The columns and rows [`Filter::Bilinear`] reads at `uv`, and the
+    /// weights of the second of each.
+    #[inline(always)]
+    fn bilinear(&self, uv: Vec2, wrap: Wrap) -> ([usize; 2], [usize; 2], Vec2) {
         let x = uv.x * self.width as f32 - 0.5;
         let y = uv.y * self.height as f32 - 0.5;
-        let (x, rows) = match filter {
-            Filter::Nearest => {
-                let x = wrapped((x + 0.5).floor() as i64, self.width, wrap);
-                let y = wrapped((y + 0.5).floor() as i64, self.height, wrap);
-                (x, [y, y])
-            }
-            Filter::Bilinear => (
-                wrapped_pair(x.floor() as i64, self.width, wrap)[0],
-                wrapped_pair(y.floor() as i64, self.height, wrap),
-            ),
-        };
-        self.prefetch(x, rows[0]);
-        if rows[1] != rows[0] {
-            self.prefetch(x, rows[1]);
-        }
+        let (x0, y0) = (x.floor(), y.floor());
+        let xs = wrapped_pair(x0 as i64, self.width, wrap);
+        let ys = wrapped_pair(y0 as i64, self.height, wrap);
+        (xs, ys, Vec2::new(x - x0, y - y0))
     }
 
     /// The bitmap at texture coordinates `uv` (texel centres at
@@ -513,16 +531,15 @@ impl Bitmap {
         if !uv.is_finite() {
             return Rgb::ZERO;
         }
-        let x = uv.x * self.width as f32 - 0.5;
-        let y = uv.y * self.height as f32 - 0.5;
         match filter {
-            Filter::Nearest => self.texel((x + 0.5).floor() as i64, (y + 0.5).floor() as i64, wrap),
+            Filter::Nearest => {
+                let (x, y) = self.nearest(uv, wrap);
+                self.at(x, y)
+            }
             Filter::Bilinear => {
-                let (x0, y0) = (x.floor(), y.floor());
-                let (fx, fy) = (x - x0, y - y0);
-                let [x0, x1] = wrapped_pair(x0 as i64, self.width, wrap);
-                let [y0, y1] = wrapped_pair(y0 as i64, self.height, wrap);
-                let [a, b, c, d] = self.quad([x0, x1], [y0, y1]);
+                let (xs, ys, f) = self.bilinear(uv, wrap);
+                let (fx, fy) = (f.x, f.y);
+                let [a, b, c, d] = self.quad(xs, ys);
                 let top = a * (1.0 - fx) + b * fx;
                 let bottom = c * (1.0 - fx) + d * fx;
                 top * (1.0 - fy) + bottom * fy
