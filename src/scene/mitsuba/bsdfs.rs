@@ -205,13 +205,12 @@ impl<'a> Importer<'a> {
                     "conductor" => MaterialKind::Conductor,
                     _ => MaterialKind::RoughConductor,
                 };
-                d.conductor = p
-                    .string("material")?
-                    .filter(|m| *m != "none")
-                    .map(String::from);
+                let material = p.string("material")?;
+                d.conductor = material.filter(|m| *m != "none").map(String::from);
                 d.eta = p.rgb("eta", false)?.map(|c| c.to_array());
                 d.k = p.rgb("k", false)?.map(|c| c.to_array());
-                if d.conductor.is_none()
+                // An explicit "none" is the mirror in every version.
+                if material.is_none()
                     && d.eta.is_none()
                     && d.k.is_none()
                     && self.doc.major_version == 0
