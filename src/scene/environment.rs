@@ -165,12 +165,11 @@ impl Environment {
             return None;
         }
         let d = (self.to_world * local).normalize();
-        // The density read back from the direction, as MIS reads it: at a
-        // cell's edge rounding may move the direction into its neighbour.
-        // The radiance from the same coordinates (one atan2 and acos).
-        let uv = direction_to_uv(self.to_local * d);
-        let pdf = pdf_at(distribution, uv);
-        (pdf > 0.0).then_some((d, uv, pdf))
+        // The sample's own density and coordinates, as pbrt and Mitsuba
+        // give them: reading them back from the direction (an arc tangent,
+        // an arc cosine, a sine and a second table read) differs only where
+        // rounding moves a direction across a cell's edge.
+        Some((d, uv, pdf_uv / (2.0 * PI * PI * sin_theta)))
     }
 
     /// Asks the cache for the texels that [`Environment::le_at`] reads at
