@@ -30,6 +30,7 @@ pub enum Radiance {
 pub struct Towards {
     pub d: Vec3A,
     uv: Option<Vec2>,
+    sin_theta: f32,
 }
 
 /// An environment light.
@@ -120,11 +121,21 @@ impl Environment {
     /// arc tangent and cosine of the conversion once, not twice.
     #[inline]
     pub fn towards(&self, d: Vec3A) -> Towards {
-        let uv = match &self.radiance {
-            Radiance::Constant(_) => None,
-            Radiance::Map(_) => Some(direction_to_uv(self.to_local * d)),
-        };
-        Towards { d, uv }
+        match &self.radiance {
+            Radiance::Constant(_) => Towards {
+                d,
+                uv: None,
+                sin_theta: 0.0,
+            },
+            Radiance::Map(_) => {
+                let local = self.to_local * d;
+                Towards {
+                    d,
+                    uv: Some(direction_to_uv(local)),
+                    sin_theta: sin_theta_of(local),
+                }
+            }
+        }
     }
 
     /// [`Environment::le`] of a [`Environment::towards`].
@@ -200,14 +211,15 @@ impl Environment {
         let Some(distribution) = &self.distribution else {
             return 1.0 / (4.0 * PI);
         };
-        pdf_at(distribution, direction_to_uv(self.to_local * d))
+        let local = self.to_local * d;
+        pdf_at(distribution, direction_to_uv(local), sin_theta_of(local))
     }
 
     /// [`Environment::pdf`] of a [`Environment::towards`].
     #[inline]
     pub fn pdf_towards(&self, towards: Towards) -> f32 {
         match (&self.distribution, towards.uv) {
-            (Some(distribution), Some(uv)) => pdf_at(distribution, uv),
+            (Some(distribution), Some(uv)) => pdf_at(distribution, uv, towards.sin_theta),
             (Some(_), None) => self.pdf(towards.d),
             (None, _) => 1.0 / (4.0 * PI),
         }
@@ -263,20 +275,20 @@ impl Environment {
     }
 }
 
-/// The map at `uv`, bilinear between texels placed as Mitsuba's envmap
-/// places them (checked against its `eval` to 1e-5 of the peak): texel
-/// (i, j) at u = (i + 1/2) / width (wrapping), v = j / (height − 1), so the
-/// first and last rows are the poles.
-/// Density per solid angle of `distribution` at map coordinates `uv`.
+/// Density per solid angle of `distribution` at map coordinates `uv`, of
+/// polar angle θ.
 #[inline]
-fn pdf_at(distribution: &Piecewise2D, uv: Vec2) -> f32 {
-    let sin_theta = (uv.y * PI).sin();
+fn pdf_at(distribution: &Piecewise2D, uv: Vec2, sin_theta: f32) -> f32 {
     if sin_theta <= 0.0 {
         return 0.0;
     }
     distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)
 }
 
+/// The map at `uv`, bilinear between texels placed as Mitsuba's envmap
+/// places them (checked against its `eval` to 1e-5 of the peak): texel
+/// (i, j) at u = (i + 1/2) / width (wrapping), v = j / (height − 1), so the
+/// first and last rows are the poles.
 #[inline]
 fn lookup(map: &Bitmap, uv: Vec2) -> Rgb {
     if !uv.is_finite() {
@@ -315,6 +327,14 @@ pub fn direction_to_uv(v: Vec3A) -> Vec2 {
     let u = u - u.floor();
     let theta = v.y.clamp(-1.0, 1.0).acos();
     Vec2::new(u, theta / PI)
+}
+
+/// sin θ of a local unit direction (θ from +y, as [`direction_to_uv`]
+/// reads it): from the other two coordinates, no sine, and precise near
+/// the poles where 1 − y² would cancel.
+#[inline]
+fn sin_theta_of(v: Vec3A) -> f32 {
+    (v.x * v.x + v.z * v.z).sqrt()
 }
 
 /// The local direction of lat-long coordinates.
