@@ -48,3 +48,34 @@ fn an_emitter_given_no_bsdf_reflects_nothing() {
     let reflecting = mean(r#"<bsdf type="diffuse"/>"#);
     assert!(reflecting[0] > 1.3, "{reflecting:?}");
 }
+
+/// Mitsuba 0.6's conductor defaults to copper, but its preset "none" is the
+/// perfect mirror there too (Bitterli's living-room mirrors; read as copper,
+/// they were a dark, red reflection).
+#[test]
+fn a_06_conductor_named_none_is_a_mirror_and_one_named_nothing_copper() {
+    let xml = |material: &str| {
+        format!(
+            r#"<scene version="0.6.0">
+  <shape type="rectangle"><bsdf type="conductor">{material}</bsdf></shape>
+  <emitter type="constant"/>
+</scene>"#
+        )
+    };
+    let conductor = |name: &str, xml: &str| match load(name, xml, &[], false)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .materials[0]
+        .bsdf
+    {
+        tracelab::bsdf::Bsdf::Conductor { lobe, .. } => lobe,
+        ref other => panic!("{other:?}"),
+    };
+    let mirror = conductor(
+        "v06-none",
+        &xml(r#"<string name="material" value="none"/>"#),
+    );
+    use tracelab::math::Rgb;
+    assert_eq!((mirror.eta, mirror.k), (Rgb::ZERO, Rgb::ONE));
+    let copper = conductor("v06-default", &xml(""));
+    assert!(copper.k.x > 3.0 && copper.eta.x < 0.5, "{copper:?}");
+}
