@@ -54,6 +54,7 @@ fn an_emitter_given_no_bsdf_reflects_nothing() {
 /// they were a dark, red reflection).
 #[test]
 fn a_06_conductor_named_none_is_a_mirror_and_one_named_nothing_copper() {
+    use tracelab::math::Rgb;
     let xml = |material: &str| {
         format!(
             r#"<scene version="0.6.0">
@@ -74,7 +75,6 @@ fn a_06_conductor_named_none_is_a_mirror_and_one_named_nothing_copper() {
         "v06-none",
         &xml(r#"<string name="material" value="none"/>"#),
     );
-    use tracelab::math::Rgb;
     assert_eq!((mirror.eta, mirror.k), (Rgb::ZERO, Rgb::ONE));
     let copper = conductor("v06-default", &xml(""));
     assert!(copper.k.x > 3.0 && copper.eta.x < 0.5, "{copper:?}");
