@@ -153,10 +153,10 @@ fn nearest_kiddo(bencher: Bencher) {
                     .nearest_n::<SquaredEuclidean<f32>>(k)
                     .within(r2)
                     .execute();
-                let near_side = found
+                let mut near_side = found
                     .iter()
                     .filter(|f| setup.photons[f.item as usize].normal.dot(q.normal) > 0.0);
-                area += near_side.last().map_or(r2, |f| f.distance);
+                area += near_side.next_back().map_or(r2, |f| f.distance);
             }
             area
         });

@@ -43,7 +43,8 @@ fn path_runs(threads: usize, general: bool) -> Vec<f64> {
         Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml"))
             .unwrap(),
     );
-    let runs = (0..5)
+
+    (0..5)
         .map(|seed| {
             let settings = RenderSettings {
                 integrator: Integrator::from(PathTracer {
@@ -66,8 +67,7 @@ fn path_runs(threads: usize, general: bool) -> Vec<f64> {
             let stats = session.stats();
             stats.samples as f64 / stats.render_time.as_secs_f64()
         })
-        .collect();
-    runs
+        .collect()
 }
 
 fn incoherent_rays(count: u64, radius: f32, center: Vec3A, spread: f32) -> Vec<Ray> {

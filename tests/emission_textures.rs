@@ -201,8 +201,7 @@ material = "lamp"
     let file = dir.join("scene.toml");
     std::fs::write(&file, text.replace("= \"quadrant\"", "= \"quadrnat\"")).unwrap();
     let error = Scene::load(&file)
-        .err()
-        .expect("an unknown texture")
+        .expect_err("an unknown texture")
         .to_string();
     assert!(
         error.contains("unknown texture `quadrnat` for `emission_texture`"),

@@ -51,7 +51,7 @@ fn a_textured_normal_mapped_gltf_renders_and_bdpt_agrees() {
     for image in [&checks, &normals, &roughness] {
         views.push((buffer.len(), image.len()));
         buffer.extend_from_slice(image);
-        while buffer.len() % 4 != 0 {
+        while !buffer.len().is_multiple_of(4) {
             buffer.push(0);
         }
     }

@@ -342,9 +342,7 @@ fn what_is_not_rendered_is_a_warning_and_strict_makes_it_an_error() {
     ] {
         assert!(w.contains(expected), "missing {expected:?} in\n{w}");
     }
-    let e = load("strict", &xml, &[], true)
-        .err()
-        .expect("strict refuses");
+    let e = load("strict", &xml, &[], true).expect_err("strict refuses");
     assert!(
         e.to_string().contains("property `mystery` ignored") && e.to_string().contains("--strict")
     );
@@ -425,7 +423,7 @@ fn gltf_nodes_meshes_camera_materials_and_lights_land_where_the_file_puts_them()
     std::fs::write(dir.join("scene.gltf"), gltf_json(Some("quad.bin"))).unwrap();
     // The same scene as one binary file: JSON chunk, then BIN chunk.
     let mut json = gltf_json(None).into_bytes();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let bin = gltf_buffer();
@@ -498,8 +496,7 @@ fn gltf_nodes_meshes_camera_materials_and_lights_land_where_the_file_puts_them()
             .replace(r#""children": [4]"#, &format!(r#""children": {children}"#));
         std::fs::write(dir.join("bad.gltf"), json).unwrap();
         let e = Scene::load(&dir.join("bad.gltf"))
-            .err()
-            .expect("refused")
+            .expect_err("refused")
             .to_string();
         assert!(e.contains("bad.gltf") && e.contains("not a tree"), "{e}");
     }
@@ -617,7 +614,7 @@ fn instances_render_as_their_copies() {
         let render = |scene: &Scene| {
             let (snapshot, stats) = crate::common::render_with(
                 scene.clone(),
-                integrator.clone(),
+                integrator,
                 SamplerKind::Independent,
                 64,
                 7,

@@ -416,7 +416,7 @@ fn extreme_texels_stay_finite() {
         }
     }
     std::fs::write(dir.join("sky.pfm"), &pfm).unwrap();
-    let mut nan_texture = format!("PF\n2 2\n-1.0\n").into_bytes();
+    let mut nan_texture = "PF\n2 2\n-1.0\n".to_string().into_bytes();
     for v in [f32::NAN, 0.5, 0.5, f32::NEG_INFINITY]
         .iter()
         .flat_map(|v| [*v; 3])

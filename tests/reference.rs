@@ -323,10 +323,10 @@ fn check_replicates_against_reference(
 
     let ref_mean = reference.mean();
     for c in 0..3 {
-        let means: Vec<f64> = images.iter().map(|im| f64::from(im.mean()[c])).collect();
+        let means: Vec<f64> = images.iter().map(|im| im.mean()[c]).collect();
         let mean = means.iter().sum::<f64>() / r;
         let se = (means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (r - 1.0) / r).sqrt();
-        let z = (mean - f64::from(ref_mean[c])) / se;
+        let z = (mean - ref_mean[c]) / se;
         assert!(
             z.abs() < 5.41,
             "channel {c}: mean {mean} vs reference {} ({z:.2} standard errors)",

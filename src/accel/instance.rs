@@ -42,7 +42,7 @@ pub(super) struct Instances {
 
 /// The world bounds of `local` placed by `to_world`: its eight corners moved.
 pub(super) fn transformed_bounds(local: &Aabb, to_world: &Affine3A) -> Aabb {
-    let (min, max) = (Vec3A::from(local.min), Vec3A::from(local.max));
+    let (min, max) = (local.min, local.max);
     let mut b = Aabb::empty();
     for corner in 0..8 {
         let pick = |axis: usize| if corner >> axis & 1 == 0 { min } else { max };

@@ -163,12 +163,12 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         }
         _ => None,
     };
-    if let Some(t) = args.time {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(Error::new(format!(
-                "--time must be a positive number of seconds, got {t}"
-            )));
-        }
+    if let Some(t) = args.time
+        && !(t.is_finite() && t > 0.0)
+    {
+        return Err(Error::new(format!(
+            "--time must be a positive number of seconds, got {t}"
+        )));
     }
     if args.spp == Some(0) {
         return Err(Error::new("--spp must be at least 1"));

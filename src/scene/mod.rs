@@ -160,7 +160,7 @@ pub struct MovingInput {
 /// for an empty scene): where light from infinity enters.
 fn bounding_sphere(geometry: &Geometry) -> (Vec3A, f32) {
     let b = geometry.bounds();
-    let (min, max) = (Vec3A::from(b.min), Vec3A::from(b.max));
+    let (min, max) = (b.min, b.max);
     if (max - min).is_finite() && max.cmpge(min).all() {
         (0.5 * (min + max), (0.5 * (max - min).length()).max(1e-3))
     } else {
