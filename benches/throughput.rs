@@ -43,7 +43,6 @@ fn path_runs(threads: usize, general: bool) -> Vec<f64> {
         Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box.toml"))
             .unwrap(),
     );
-
     (0..5)
         .map(|seed| {
             let settings = RenderSettings {
