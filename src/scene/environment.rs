@@ -180,7 +180,7 @@ impl Environment {
         // give them: reading them back from the direction (an arc tangent,
         // an arc cosine, a sine and a second table read) differs only where
         // rounding moves a direction across a cell's edge.
-        Some((d, uv, pdf_uv / (2.0 * PI * PI * sin_theta)))
+        Some((d, uv, per_solid_angle(pdf_uv, sin_theta)))
     }
 
     /// Asks the cache for the texels that [`Environment::le_at`] reads at
@@ -279,10 +279,17 @@ impl Environment {
 /// polar angle θ.
 #[inline]
 fn pdf_at(distribution: &Piecewise2D, uv: Vec2, sin_theta: f32) -> f32 {
+    per_solid_angle(distribution.pdf(uv), sin_theta)
+}
+
+/// A density over map coordinates as one over solid angle, at polar angle
+/// θ: the lat-long map's Jacobian, 2π² sin θ (none at the poles).
+#[inline]
+fn per_solid_angle(pdf_uv: f32, sin_theta: f32) -> f32 {
     if sin_theta <= 0.0 {
         return 0.0;
     }
-    distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)
+    pdf_uv / (2.0 * PI * PI * sin_theta)
 }
 
 /// The map at `uv`, bilinear between texels placed as Mitsuba's envmap
