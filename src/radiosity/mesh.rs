@@ -14,6 +14,7 @@ use crate::math::Rgb;
 use crate::scene::Scene;
 use crate::scene::material::Bsdf;
 use glam::Vec3A;
+use rayon::prelude::*;
 
 /// The elements of a scene and where each scene triangle's elements are.
 #[derive(Clone, Debug, Default)]
@@ -668,9 +669,11 @@ pub fn exposed_backs(scene: &Scene) -> Vec<bool> {
                 .0
         })
     };
+    // In parallel: each triangle's rays are its own (one thread, this was
+    // a third of the solve's serial time for a sphere of 100 000 triangles).
     geometry
         .triangles()
-        .iter()
+        .par_iter()
         .enumerate()
         .map(|(i, v)| exposed(i, v))
         .collect()

@@ -610,21 +610,26 @@ impl Hierarchy {
         if self.budget_spent {
             return coarse;
         }
-        for i in 0..self.clusters.links.len() {
-            let p = CLUSTER | i as u32;
-            let before = coarse.len();
-            for l in &self.clusters.links[i] {
-                let transfer = self.cluster_transfer(p, l.source, l.bound);
-                if transfer > epsilon
-                    || (transfer > epsilon * PARTIAL_SHARE && partly_visible(l.visibility))
-                {
-                    coarse.push((p, l.source, true));
-                }
-            }
-            if coarse.len() > before {
-                let removed = &coarse[before..];
-                self.clusters.links[i].retain(|l| !removed.iter().any(|&(_, q, _)| q == l.source));
-            }
+        // Read in parallel, removed in order (as the elements' links).
+        let removed: Vec<(usize, Vec<u32>)> = (0..self.clusters.links.len())
+            .into_par_iter()
+            .filter_map(|i| {
+                let p = CLUSTER | i as u32;
+                let sources: Vec<u32> = self.clusters.links[i]
+                    .iter()
+                    .filter(|l| {
+                        let transfer = self.cluster_transfer(p, l.source, l.bound);
+                        transfer > epsilon
+                            || (transfer > epsilon * PARTIAL_SHARE && partly_visible(l.visibility))
+                    })
+                    .map(|l| l.source)
+                    .collect();
+                (!sources.is_empty()).then_some((i, sources))
+            })
+            .collect();
+        for (i, sources) in removed {
+            coarse.extend(sources.iter().map(|&q| (CLUSTER | i as u32, q, true)));
+            self.clusters.links[i].retain(|l| !sources.contains(&l.source));
         }
         coarse
     }
