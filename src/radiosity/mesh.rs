@@ -576,7 +576,8 @@ pub fn back_twins(geometry: &Geometry) -> Vec<u32> {
         corners
     };
     let triangles = geometry.triangles();
-    let mut by_corners = std::collections::HashMap::with_capacity(triangles.len());
+    let mut by_corners =
+        rustc_hash::FxHashMap::with_capacity_and_hasher(triangles.len(), Default::default());
     for (t, v) in triangles.iter().enumerate() {
         by_corners
             .entry(key(*v))

@@ -6,10 +6,9 @@ use crate::accel::Geometry;
 use crate::math::Rgb;
 use crate::radiosity::VertexField;
 use crate::radiosity::form_factor::{open_at, point_to_polygon, point_visibility};
-use crate::radiosity::reconstruct::{VertexKey, vertex_key};
+use crate::radiosity::reconstruct::{VertexMap, vertex_key};
 use glam::{Vec2, Vec3A};
 use rayon::prelude::*;
-use std::collections::HashMap;
 
 impl Hierarchy {
     /// Computes the leaves' vertex radiance for the smooth display: at each
@@ -39,7 +38,7 @@ impl Hierarchy {
             let n = &self.nodes[k as usize];
             (n.exposure, -n.element.area)
         };
-        let mut index: HashMap<VertexKey, usize> = HashMap::new();
+        let mut index: VertexMap<usize> = VertexMap::default();
         let mut vertices: Vec<(u32, Vec3A)> = Vec::new();
         for &k in &leaves {
             let e = &self.nodes[k as usize].element;
@@ -87,27 +86,33 @@ impl Hierarchy {
                 (radiance, open)
             })
             .collect();
+        let leaf_corners: Vec<[Rgb; 3]> = leaves
+            .par_iter()
+            .map(|&k| {
+                let e = &self.nodes[k as usize].element;
+                let corners = e.vertices.map(|v| values[index[&vertex_key(v, e)]]);
+                // A leaf partly hidden (the ceiling's edge around the light, the
+                // floor's around a block) shows its open part: hidden corners,
+                // dark, take the open corners' mean instead of shading it
+                // towards black. Cornell box, masked RMSE without -> with: ε 1e-4
+                // 0.00236 -> 0.00233, 7e-5 0.00222 -> 0.00217 (large leaves);
+                // 1e-5 0.00130 -> 0.00131 (small ones, where it hardly matters).
+                let (sum, count) = corners
+                    .iter()
+                    .filter(|c| c.1)
+                    .fold((Rgb::ZERO, 0.0), |(s, n), c| (s + c.0, n + 1.0));
+                corners.map(|(value, is_open)| {
+                    if is_open || count == 0.0 {
+                        value
+                    } else {
+                        sum / count
+                    }
+                })
+            })
+            .collect();
         let mut per_node = vec![[Rgb::ZERO; 3]; self.nodes.len()];
-        for &k in &leaves {
-            let e = &self.nodes[k as usize].element;
-            let corners = e.vertices.map(|v| values[index[&vertex_key(v, e)]]);
-            // A leaf partly hidden (the ceiling's edge around the light, the
-            // floor's around a block) shows its open part: hidden corners,
-            // dark, take the open corners' mean instead of shading it
-            // towards black. Cornell box, masked RMSE without -> with: ε 1e-4
-            // 0.00236 -> 0.00233, 7e-5 0.00222 -> 0.00217 (large leaves);
-            // 1e-5 0.00130 -> 0.00131 (small ones, where it hardly matters).
-            let (sum, count) = corners
-                .iter()
-                .filter(|c| c.1)
-                .fold((Rgb::ZERO, 0.0), |(s, n), c| (s + c.0, n + 1.0));
-            per_node[k as usize] = corners.map(|(value, is_open)| {
-                if is_open || count == 0.0 {
-                    value
-                } else {
-                    sum / count
-                }
-            });
+        for (&k, corners) in leaves.iter().zip(leaf_corners) {
+            per_node[k as usize] = corners;
         }
         let elements = leaves
             .iter()
@@ -250,7 +255,7 @@ fn gather_point(e: &crate::radiosity::Element, v: Vec3A) -> Vec3A {
 
 /// The first pass's vertex radiance, found by vertex key.
 struct NearField<'a> {
-    index: &'a HashMap<VertexKey, usize>,
+    index: &'a VertexMap<usize>,
     radiance: Vec<Rgb>,
 }
 
