@@ -20,9 +20,15 @@ for spec in "path scenes/cornell_box.toml 16" "bdpt scenes/cornell_box.toml 4" \
   tn=$(run $N $(($3 * N)) $2 $1)
   echo "$1 $2 $3 $t1 $tn $(echo "$t1 $tn" | awk '{ if ($2 > 0) printf "%.2f", $1 / $2 }')"
 done
-for t in 1 $N; do
-  start=$(date +%s.%N)
-  $BIN render scenes/cornell_box.toml --integrator radiosity --solver hierarchical \
-      --epsilon 1e-5 --patch-size 0.002 --threads $t --out $OUT/r.png >/dev/null 2>&1
-  echo "radiosity-hierarchical threads=$t wall_s=$(echo "$start $(date +%s.%N)" | awk '{printf "%.3f", $2 - $1}')"
+# The Cornell box, and the sphere room of 100 000 triangles, where the
+# clusters' links and the backs' exposure rays add work of their own.
+for spec in "scenes/cornell_box.toml --epsilon 1e-5 --patch-size 0.002" \
+            "scenes/cluster_room.toml --patch-size 0.02"; do
+  set -- $spec
+  for t in 1 $N; do
+    start=$(date +%s.%N)
+    $BIN render "$@" --integrator radiosity --solver hierarchical \
+        --threads $t --out $OUT/r.png >/dev/null 2>&1
+    echo "radiosity-hierarchical $1 threads=$t wall_s=$(echo "$start $(date +%s.%N)" | awk '{printf "%.3f", $2 - $1}')"
+  done
 done
