@@ -670,8 +670,9 @@ pub fn exposed_backs(scene: &Scene) -> Vec<bool> {
                 .0
         })
     };
-    // In parallel: each triangle's rays are its own (one thread, this was
-    // a third of the solve's serial time for a sphere of 100 000 triangles).
+    // In parallel: each triangle's rays are its own (on one thread, this
+    // was about half of the serial time of a solve of a sphere of 100 000
+    // triangles).
     geometry
         .triangles()
         .par_iter()

@@ -17,10 +17,9 @@ impl Hierarchy {
         pending: &mut Vec<(u32, u32, f32)>,
     ) {
         while !wave.is_empty() {
-            // The oracle's verdicts in parallel (a forced pair is split
-            // whatever it says), the subdivisions in order, the children's
-            // facing tests in parallel: serial, the verdicts and tests were
-            // a third of the solve's serial time (Cornell box, ε 1e-5).
+            // The oracle's verdicts (a forced pair is split whatever it
+            // says) and the children's facing tests in parallel; only the
+            // subdivisions, which grow the tree, in order.
             let verdicts: Vec<(f32, Option<bool>)> = wave
                 .par_iter()
                 .map(|&(p, q, forced)| {
