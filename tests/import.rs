@@ -30,8 +30,10 @@ pub(crate) fn load(
     Scene::load_with(&path, &options)
 }
 
-/// A unit quad as ASCII PLY, a one-triangle serialized mesh, an include.
+/// A unit quad as ASCII PLY, a one-triangle serialized mesh, an include,
+/// an OBJ without faces.
 fn write_assets(dir: &std::path::Path) {
+    std::fs::write(dir.join("empty.obj"), "# no faces\nv 0 0 0\n").unwrap();
     std::fs::write(
         dir.join("quad.ply"),
         "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n",
@@ -331,6 +333,7 @@ fn what_is_not_rendered_is_a_warning_and_strict_makes_it_an_error() {
   </shape>
   <shape type="hair"/>
   <emitter type="sunsky"/>
+  <shape type="obj"><string name="filename" value="empty.obj"/></shape>
 </scene>"##
     );
     let scene = load("warnings", &xml, &[], false).unwrap_or_else(|e| panic!("{e}"));
@@ -339,6 +342,8 @@ fn what_is_not_rendered_is_a_warning_and_strict_makes_it_an_error() {
         "scene.xml:13:5: shape `cube`: property `mystery` ignored",
         "scene.xml:15:3: shape \"hair\" is not supported: skipped",
         "scene.xml:16:3: emitter \"sunsky\" is not supported: skipped",
+        "scene.xml:17:3: ",
+        "empty.obj holds no triangles: the shape adds nothing",
     ] {
         assert!(w.contains(expected), "missing {expected:?} in\n{w}");
     }
@@ -665,4 +670,28 @@ fn nested_instances_compose_their_transforms() {
             .expect("the nested tile is hit");
         assert!((hit.t + z).abs() < 1e-5, "{} at y {y}", hit.t);
     }
+}
+
+/// A mesh file without a face: a bare mesh is an error (nothing to render),
+/// a scene's mesh a warning naming file and line; neither is silent.
+#[test]
+fn a_mesh_without_triangles_is_never_silent() {
+    let dir = temp_dir("empty-mesh");
+    write_assets(&dir);
+    let e = Scene::load_with(&dir.join("empty.obj"), &LoadOptions::default())
+        .expect_err("a bare mesh without triangles");
+    assert!(e.to_string().contains("empty.obj: no triangles"), "{e}");
+    let toml = dir.join("scene.toml");
+    std::fs::write(
+        &toml,
+        "[camera]\neye = [0, 1, -3]\nlook_at = [0, 1, 0]\nfov_y = 40\nwidth = 4\nheight = 4\n\n\
+         [[mesh]]\nfile = \"empty.obj\"\n\n[[point_light]]\nposition = [0, 2, 0]\nintensity = [1, 1, 1]\n",
+    )
+    .unwrap();
+    let scene = Scene::load_with(&toml, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let w = scene.warnings.join("\n");
+    assert!(
+        w.contains("scene.toml:8: mesh file `empty.obj` holds no triangles"),
+        "{w}"
+    );
 }

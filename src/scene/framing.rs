@@ -79,6 +79,9 @@ pub fn bare_mesh(path: &Path, limits: &Limits) -> Result<SceneInput> {
             normals: t.normals,
         }));
     }
+    if triangles.is_empty() {
+        return Err(Error::at(path, None, "no triangles: nothing to render"));
+    }
     if triangles.len() > limits.max_triangles {
         return Err(Error::at(
             path,

@@ -141,6 +141,7 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         }
         Ok(Some(v))
     };
+    let mut warnings = Vec::new();
     for mesh in &file.mesh {
         let desc = mesh.get_ref();
         let obj_path = dir.join(&desc.file);
@@ -156,6 +157,14 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         }
         let transform = mesh_transform(desc).map_err(|m| at(mesh.span(), m))?;
         let obj = load_obj(&obj_path)?;
+        if obj.triangles.is_empty() {
+            warnings.push(format!(
+                "{}:{}: mesh file `{}` holds no triangles: it adds nothing",
+                path.display(),
+                line_of(text, mesh.span().start),
+                desc.file
+            ));
+        }
         let override_id = match &desc.material {
             Some(name) => Some(lookup(name, mesh.span(), &by_name)?),
             None => None,
@@ -416,7 +425,7 @@ pub fn parse_scene(path: &Path, text: &str, limits: &Limits) -> Result<SceneInpu
         instances: Default::default(),
         sphere_sampling: file.lights.sphere_sampling,
         triangle_sampling: file.lights.triangle_sampling,
-        warnings: Vec::new(),
+        warnings,
         hints: Default::default(),
     })
 }

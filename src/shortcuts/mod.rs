@@ -95,6 +95,8 @@ pub enum NotApplied {
     Masks,
     /// More triangles than a soup holds: the BVH already tests few.
     ManyTriangles(usize),
+    /// No triangle at all (spheres alone, or nothing).
+    NoTriangles,
     /// Instanced geometry: the lists name the geometry's own triangles.
     Instances,
     /// A thin lens: camera rays leave from anywhere on the lens.
@@ -129,6 +131,7 @@ impl fmt::Display for NotApplied {
                 f,
                 "{n} triangles, more than {SOUP_MAX_TRIANGLES}: the BVH decides"
             ),
+            NotApplied::NoTriangles => write!(f, "the scene has no triangles"),
             NotApplied::ThinLens => write!(f, "thin lens"),
             NotApplied::WideFilter => write!(f, "the pixel filter is wider than a pixel"),
             NotApplied::BehindEye => write!(f, "a triangle reaches behind the eye"),
@@ -239,6 +242,8 @@ fn static_soup(geometry: &Geometry) -> Result<(), NotApplied> {
         Err(NotApplied::Masks)
     } else if geometry.instance_count() > 0 {
         Err(NotApplied::Instances)
+    } else if geometry.triangle_count() == 0 {
+        Err(NotApplied::NoTriangles)
     } else if !geometry.is_static_soup() {
         Err(NotApplied::ManyTriangles(geometry.triangle_count()))
     } else {

@@ -63,6 +63,15 @@ impl<'a> Importer<'a> {
                     Some(mesh) => mesh,
                     None => file.read()?,
                 };
+                if mesh.indices.is_empty() {
+                    let what = format!(
+                        "{} holds no triangles: the shape adds nothing",
+                        file.path.display()
+                    );
+                    self.warn(&e.loc, &what);
+                    p.unused(&mut self.warnings);
+                    return Ok(());
+                }
                 (mesh, Orientation::Winding, face_normals)
             }
             "rectangle" => (MeshData::rectangle(), Orientation::Normal, false),
