@@ -695,3 +695,21 @@ fn a_mesh_without_triangles_is_never_silent() {
         "{w}"
     );
 }
+
+/// A `-D` the file never reads changes nothing, and says so: a user who
+/// types `-D resx=320` at a file with a fixed width gets a warning, not a
+/// full-size render with no word.
+#[test]
+fn a_define_the_file_never_reads_is_a_warning() {
+    let xml = format!(
+        "<scene version=\"3.0.0\">\n<default name=\"res\" value=\"8\"/><default name=\"spp\" value=\"1\"/>\
+         <default name=\"power\" value=\"1\"/>\n{SENSOR}\n<shape type=\"cube\"/>\n</scene>"
+    );
+    let scene = load("defines", &xml, &[("res", "4"), ("resx", "320")], false)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let w = scene.warnings.join("\n");
+    assert!(
+        w.contains("-D resx: the file never reads `$resx`: ignored") && !w.contains("-D res:"),
+        "{w}"
+    );
+}

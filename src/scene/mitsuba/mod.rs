@@ -65,6 +65,12 @@ pub fn load_mitsuba(path: &Path, options: &LoadOptions) -> Result<SceneInput> {
     importer
         .triangles
         .reserve(expected.min(options.limits.max_triangles));
+    for name in &doc.unused_defines {
+        importer.warnings.push(format!(
+            "{}: -D {name}: the file never reads `${name}`: ignored",
+            path.display()
+        ));
+    }
     let camera = importer.scene()?;
     // The meshes the walk consumed were decoded on worker threads, so
     // glibc freed them into those threads' arenas, where the build on this

@@ -3,7 +3,7 @@
 //! Mitsuba 3's snake_case, and every element located by file, line and column.
 
 use crate::error::{Error, Result};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -67,6 +67,9 @@ pub struct Document {
     pub search_paths: Vec<PathBuf>,
     /// Major version of the file's format (0 for Mitsuba 0.x, 3 for Mitsuba 3).
     pub major_version: u32,
+    /// Names given by `-D` that no `$name` of the file (or its includes)
+    /// reads, in the order given.
+    pub unused_defines: Vec<String>,
 }
 
 impl Document {
@@ -113,20 +116,30 @@ pub fn read(path: &Path, defines: &[(String, String)]) -> Result<Document> {
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mut reader = Reader {
         params: defines.iter().cloned().collect(),
+        read: HashSet::new(),
         search_paths: vec![dir],
         major_version: 3,
         depth: 0,
     };
     let root = reader.read_file(path, None)?;
+    let mut unused_defines: Vec<String> = Vec::new();
+    for (name, _) in defines {
+        if !reader.read.contains(name) && !unused_defines.contains(name) {
+            unused_defines.push(name.clone());
+        }
+    }
     Ok(Document {
         root,
         search_paths: reader.search_paths,
         major_version: reader.major_version,
+        unused_defines,
     })
 }
 
 struct Reader {
     params: HashMap<String, String>,
+    /// Every `$name` substituted so far.
+    read: HashSet<String>,
     search_paths: Vec<PathBuf>,
     major_version: u32,
     depth: usize,
@@ -207,7 +220,7 @@ impl Reader {
         let tag = node.tag_name().name();
         let mut attrs = Vec::new();
         for a in node.attributes() {
-            let value = substitute(a.value(), &self.params, &loc)?;
+            let value = substitute(a.value(), &self.params, &mut self.read, &loc)?;
             let value = match (a.name(), self.major_version) {
                 ("name", 0..=2) => camel_to_snake(&value),
                 _ => value,
@@ -272,7 +285,12 @@ impl Reader {
 }
 
 /// Replaces `$name` by its value; an unknown name is an error, as in Mitsuba.
-fn substitute(value: &str, params: &HashMap<String, String>, loc: &Loc) -> Result<String> {
+fn substitute(
+    value: &str,
+    params: &HashMap<String, String>,
+    read: &mut HashSet<String>,
+    loc: &Loc,
+) -> Result<String> {
     if !value.contains('$') {
         return Ok(value.to_string());
     }
@@ -286,7 +304,12 @@ fn substitute(value: &str, params: &HashMap<String, String>, loc: &Loc) -> Resul
             .unwrap_or(after.len());
         let name = &after[..len];
         match params.get(name) {
-            Some(v) if !name.is_empty() => out.push_str(v),
+            Some(v) if !name.is_empty() => {
+                if !read.contains(name) {
+                    read.insert(name.to_string());
+                }
+                out.push_str(v);
+            }
             _ => {
                 return Err(loc.error(format!(
                     "`${name}` is not defined (add <default name=\"{name}\" value=\"...\"/> or -D {name}=...)"
@@ -350,6 +373,7 @@ mod tests {
             },
             search_paths: vec![PathBuf::new(), PathBuf::from("textures")],
             major_version: 0,
+            unused_defines: Vec::new(),
         };
         let e = document.resolve("none.jpg", &loc).unwrap_err().to_string();
         assert!(e.ends_with("(looked in ., textures)"), "{e}");
@@ -359,9 +383,15 @@ mod tests {
     fn parameters_substitute_and_unknown_ones_are_errors() {
         let loc = loc("s.xml", 3, 5);
         let params: HashMap<String, String> = [("spp".to_string(), "64".to_string())].into();
-        assert_eq!(substitute("$spp", &params, &loc).unwrap(), "64");
-        assert_eq!(substitute("a$spp.b", &params, &loc).unwrap(), "a64.b");
-        let e = substitute("$res", &params, &loc).unwrap_err();
+        assert_eq!(
+            substitute("$spp", &params, &mut HashSet::new(), &loc).unwrap(),
+            "64"
+        );
+        assert_eq!(
+            substitute("a$spp.b", &params, &mut HashSet::new(), &loc).unwrap(),
+            "a64.b"
+        );
+        let e = substitute("$res", &params, &mut HashSet::new(), &loc).unwrap_err();
         assert!(
             e.message().starts_with("s.xml:3:5: `$res` is not defined"),
             "{e}"
