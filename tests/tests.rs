@@ -13,6 +13,8 @@ mod bitterli;
 mod filtered_film;
 // Mitsuba XML, PLY and serialized import: every element, every error.
 mod import;
+// A mesh without triangles, a -D the file never reads: warnings, not silence.
+mod import_silence;
 // Blends of two BSDFs against the weighted sum of their parts.
 mod import_blends;
 // Mitsuba 3's principled BSDF against its own eval.
