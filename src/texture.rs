@@ -276,6 +276,10 @@ impl Bitmap {
     /// 16-bit colour is sRGB-decoded unless `raw` (data such as roughness);
     /// float images (EXR, HDR) are linear. Non-finite texels become 0.
     pub fn read(path: &Path, raw: bool) -> Result<Bitmap, String> {
+        // The decoders' own word for it is "failed to fill whole buffer".
+        if std::fs::metadata(path).is_ok_and(|m| m.len() == 0) {
+            return Err(format!("{}: the file is empty (0 bytes)", path.display()));
+        }
         if path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("pfm"))

@@ -46,3 +46,25 @@ fn a_define_the_file_never_reads_is_a_warning() {
         "{w}"
     );
 }
+
+/// An image file of 0 bytes (a snapshot that lacks its large files) is an
+/// error that says so, at the element that names it.
+#[test]
+fn an_empty_image_file_is_named_as_empty() {
+    let xml = format!(
+        "<scene version=\"3.0.0\">\n<default name=\"res\" value=\"8\"/><default name=\"spp\" value=\"1\"/>\
+         <default name=\"power\" value=\"1\"/>\n{SENSOR}\n<emitter type=\"envmap\">\
+         <string name=\"filename\" value=\"sky.hdr\"/></emitter>\n</scene>"
+    );
+    let dir = temp_dir("empty-image");
+    write_assets(&dir);
+    std::fs::write(dir.join("sky.hdr"), b"").unwrap();
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, xml).unwrap();
+    let e = Scene::load_with(&path, &LoadOptions::default()).expect_err("an empty image");
+    let e = e.to_string();
+    assert!(
+        e.contains("scene.xml:10:1: ") && e.contains("sky.hdr: the file is empty (0 bytes)"),
+        "{e}"
+    );
+}
