@@ -231,6 +231,18 @@ impl Texture {
     }
 }
 
+/// What an image of 0 bytes is called (a download that lacks its large
+/// files); the decoders' own word for it is "failed to fill whole buffer".
+const EMPTY: &str = "the file is empty (0 bytes)";
+
+/// An image held in memory, decoded; an empty one named as such.
+fn from_memory(bytes: &[u8]) -> Result<image::DynamicImage, String> {
+    if bytes.is_empty() {
+        return Err(EMPTY.into());
+    }
+    image::load_from_memory(bytes).map_err(|e| e.to_string())
+}
+
 impl Bitmap {
     /// A bitmap of `texels` given row-major from the top row; bytes are
     /// stored in tiles ([`TILE`]). Floats stay as given: an EXR sky of
@@ -276,9 +288,8 @@ impl Bitmap {
     /// 16-bit colour is sRGB-decoded unless `raw` (data such as roughness);
     /// float images (EXR, HDR) are linear. Non-finite texels become 0.
     pub fn read(path: &Path, raw: bool) -> Result<Bitmap, String> {
-        // The decoders' own word for it is "failed to fill whole buffer".
         if std::fs::metadata(path).is_ok_and(|m| m.len() == 0) {
-            return Err(format!("{}: the file is empty (0 bytes)", path.display()));
+            return Err(format!("{}: {EMPTY}", path.display()));
         }
         if path
             .extension()
@@ -293,7 +304,7 @@ impl Bitmap {
 
     /// Decodes an image held in memory (a glTF file's embedded images).
     pub fn decode(bytes: &[u8], raw: bool) -> Result<Bitmap, String> {
-        let image = image::load_from_memory(bytes).map_err(|e| e.to_string())?;
+        let image = from_memory(bytes)?;
         Self::from_image(image, raw)
     }
 
@@ -301,7 +312,7 @@ impl Bitmap {
     /// grey bitmap; cut to 0 or 1 at `cutoff` where given (glTF's MASK).
     /// An image without alpha is opaque.
     pub fn decode_alpha(bytes: &[u8], factor: f32, cutoff: Option<f32>) -> Result<Bitmap, String> {
-        let image = image::load_from_memory(bytes).map_err(|e| e.to_string())?;
+        let image = from_memory(bytes)?;
         let rgba = image.to_rgba32f();
         let (width, height) = (rgba.width() as usize, rgba.height() as usize);
         if width == 0 || height == 0 {
@@ -332,7 +343,7 @@ impl Bitmap {
         map: impl Fn(f32) -> f32,
     ) -> Result<Bitmap, String> {
         use image::ColorType;
-        let image = image::load_from_memory(bytes).map_err(|e| e.to_string())?;
+        let image = from_memory(bytes)?;
         let (width, height) = (image.width() as usize, image.height() as usize);
         if width == 0 || height == 0 {
             return Err("the image is empty".into());

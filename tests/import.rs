@@ -31,9 +31,10 @@ pub(crate) fn load(
 }
 
 /// A unit quad as ASCII PLY, a one-triangle serialized mesh, an include,
-/// an OBJ without faces.
+/// an OBJ without faces, an image of 0 bytes.
 pub(crate) fn write_assets(dir: &std::path::Path) {
     std::fs::write(dir.join("empty.obj"), "# no faces\nv 0 0 0\n").unwrap();
+    std::fs::write(dir.join("empty.hdr"), b"").unwrap();
     std::fs::write(
         dir.join("quad.ply"),
         "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n",

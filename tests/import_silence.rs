@@ -1,5 +1,6 @@
 //! What a user asked for and did not get is never silent: a mesh file
-//! without triangles, a `-D` that the file never reads.
+//! without triangles, a `-D` that the file never reads; an image of 0
+//! bytes is called empty, not a decoder's riddle.
 
 use crate::common::temp_dir;
 use crate::import::{SENSOR, load, write_assets};
@@ -54,17 +55,12 @@ fn an_empty_image_file_is_named_as_empty() {
     let xml = format!(
         "<scene version=\"3.0.0\">\n<default name=\"res\" value=\"8\"/><default name=\"spp\" value=\"1\"/>\
          <default name=\"power\" value=\"1\"/>\n{SENSOR}\n<emitter type=\"envmap\">\
-         <string name=\"filename\" value=\"sky.hdr\"/></emitter>\n</scene>"
+         <string name=\"filename\" value=\"empty.hdr\"/></emitter>\n</scene>"
     );
-    let dir = temp_dir("empty-image");
-    write_assets(&dir);
-    std::fs::write(dir.join("sky.hdr"), b"").unwrap();
-    let path = dir.join("scene.xml");
-    std::fs::write(&path, xml).unwrap();
-    let e = Scene::load_with(&path, &LoadOptions::default()).expect_err("an empty image");
+    let e = load("empty-image", &xml, &[], false).expect_err("an empty image");
     let e = e.to_string();
     assert!(
-        e.contains("scene.xml:10:1: ") && e.contains("sky.hdr: the file is empty (0 bytes)"),
+        e.contains("scene.xml:10:1: ") && e.contains("empty.hdr: the file is empty (0 bytes)"),
         "{e}"
     );
 }

@@ -13,7 +13,7 @@ mod bitterli;
 mod filtered_film;
 // Mitsuba XML, PLY and serialized import: every element, every error.
 mod import;
-// A mesh without triangles, a -D the file never reads: warnings, not silence.
+// A mesh without triangles, a -D the file never reads, an empty image: never silent.
 mod import_silence;
 // Blends of two BSDFs against the weighted sum of their parts.
 mod import_blends;
